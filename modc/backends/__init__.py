@@ -1,0 +1,40 @@
+"""Backends: registered by name; each turns a checked design into {relative path: content}.
+
+A new backend is one module here (plus its templates) that calls ``register``.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from .build import Build
+
+Files = dict[str, "str | bytes"]
+
+
+@dataclass(frozen=True)
+class Backend:
+    name: str
+    summary: str
+    emit: Callable[[Build], Files]
+    heavy: bool = False  # needs more than the core (meshes: trimesh on a cache miss)
+
+
+BACKENDS: dict[str, Backend] = {}
+
+
+def register(name: str, summary: str, heavy: bool = False):
+    def deco(fn: Callable[[Build], Files]):
+        BACKENDS[name] = Backend(name, summary, fn, heavy)
+        return fn
+
+    return deco
+
+
+def load_all() -> dict[str, Backend]:
+    from . import meshes, report, urdf  # noqa: F401  (registration happens on import; report last)
+
+    return BACKENDS
+
+
+__all__ = ["BACKENDS", "Backend", "Build", "Files", "register", "load_all"]

@@ -1,0 +1,26 @@
+"""What backends share during one compile: the checked design and per-robot descriptions."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..diagnostics import Diagnostic
+from ..model import Design, Robot
+from ..physical.assembly import Description, describe
+
+
+@dataclass
+class Build:
+    design: Design
+    diagnostics: list[Diagnostic] = field(default_factory=list)  # warnings that survived the passes
+    files: dict[str, str | bytes] = field(default_factory=dict)  # what earlier backends produced
+    _descriptions: dict[str, Description] = field(default_factory=dict)
+
+    @property
+    def source_name(self) -> str:
+        return Path(self.design.path).name
+
+    def description(self, robot: Robot) -> Description:
+        if robot.name not in self._descriptions:
+            self._descriptions[robot.name] = describe(robot)
+        return self._descriptions[robot.name]

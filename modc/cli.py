@@ -1,0 +1,192 @@
+"""Command line: `modc FILE -o OUT`, `modc lint`, `modc schema`, `modc codes`.
+
+Exit codes: 0 success, 1 diagnostics with errors, 2 usage or I/O error. Heavy libraries
+(numpy, jinja2, trimesh, pinocchio…) are imported inside commands, never at start-up.
+"""
+from __future__ import annotations
+
+import sys
+from enum import Enum
+from typing import Annotated, Optional
+
+import typer
+
+from . import __version__
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
+                  help="modc: compile .mod files describing MOIRs Mark-2 modular arms into URDF and friends.")
+
+EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
+
+
+class Verbosity:
+    quiet = False
+    verbose = False
+
+
+def _err(text: str) -> None:
+    print(text, file=sys.stderr)
+
+
+def _print_diagnostics(diags, sources) -> None:
+    from .diagnostics.render import render_text
+
+    shown = [d for d in diags if not (Verbosity.quiet and not d.is_error)]
+    if shown:
+        _err(render_text(shown, sources))
+
+
+LibraryOpt = Annotated[Optional[str], typer.Option("--library", help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file")]
+
+
+@app.command("compile")
+def compile_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
+    library: LibraryOpt = None,
+    only: Annotated[Optional[str], typer.Option(help="comma-separated backends to run (default: all); see `modc backends`")] = None,
+    force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
+    verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
+):
+    """Check FILE and write URDF, meshes and a report into OUT."""
+    from .compiler import InputError, build, check_file, write_tree
+
+    Verbosity.quiet, Verbosity.verbose = quiet, verbose
+    try:
+        checked = check_file(file, library)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    if not checked.ok:
+        from .diagnostics.render import summary
+
+        _err(f"modc: {summary(checked.diagnostics)}; nothing written to {out}")
+        raise typer.Exit(EXIT_ERRORS)
+    selected = None
+    if only:
+        from .backends import load_all
+
+        selected = [s.strip() for s in only.split(",") if s.strip()]
+        unknown = [s for s in selected if s not in load_all()]
+        if unknown:
+            _err(f"modc: unknown backend(s) {', '.join(unknown)}; available: {', '.join(load_all())}")
+            raise typer.Exit(EXIT_USAGE)
+    files = build(checked, selected)
+    try:
+        write_tree(files, out, force=force)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    except OSError as e:
+        _err(f"modc: cannot write {out}: {e}")
+        raise typer.Exit(EXIT_USAGE)
+    if verbose:
+        for rel in files:
+            _err(f"  wrote {out.rstrip('/')}/{rel}")
+    if not quiet:
+        robots = ", ".join(f"{r.file_stem} ({r.sequence})" for r in checked.design.robots)
+        _err(f"modc: {len(files)} files written to {out}: {robots}")
+
+
+class LintFormat(str, Enum):
+    text = "text"
+    json = "json"
+
+
+def _expand(paths: list[str]) -> list[str]:
+    """Files as given; directories searched for *.mod (sorted, for stable output)."""
+    from pathlib import Path
+
+    out: list[str] = []
+    for p in paths:
+        q = Path(p)
+        if q.is_dir():
+            out += sorted(str(f) for f in q.rglob("*.mod"))
+        else:
+            out.append(p)
+    return out
+
+
+@app.command("lint")
+def lint_cmd(
+    files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
+    format: Annotated[LintFormat, typer.Option("--format", "-f", help="output format")] = LintFormat.text,
+    library: LibraryOpt = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
+):
+    """Check files without writing anything."""
+    from .compiler import InputError, check_file
+    from .diagnostics.render import render_json, summary
+
+    Verbosity.quiet = quiet
+    diags, sources, io_error = [], {}, False
+    paths = _expand(files)
+    for path in paths:
+        try:
+            c = check_file(path, library)
+        except InputError as e:
+            diags.append(e.diagnostic)
+            io_error = True
+            continue
+        diags += c.diagnostics
+        sources.update(c.sources)
+    if format is LintFormat.json:
+        print(render_json(diags))
+    else:
+        _print_diagnostics(diags, sources)
+        if not quiet:
+            _err(f"modc lint: {len(paths)} file{'s' * (len(paths) != 1)}, {summary(diags)}")
+    if io_error:
+        raise typer.Exit(EXIT_USAGE)
+    raise typer.Exit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
+
+
+@app.command("schema")
+def schema_cmd():
+    """Print the JSON Schema of the YAML form of .mod files."""
+    import json
+
+    from .syntax.document import json_schema
+
+    print(json.dumps(json_schema(), indent=2))
+
+
+@app.command("codes")
+def codes_cmd():
+    """List every diagnostic code with its severity and meaning."""
+    from .diagnostics import REGISTRY
+
+    for code in REGISTRY.values():
+        allow = " (allowable)" if code.allowable else ""
+        print(f"{code.name:28} {code.severity.value:8} {code.summary}{allow}")
+
+
+@app.command("backends")
+def backends_cmd():
+    """List the output backends."""
+    from .backends import load_all
+
+    for b in load_all().values():
+        print(f"{b.name:10} {b.summary}")
+
+
+def _version(value: bool):
+    if value:
+        print(f"modc {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True, help="print the version")] = False):
+    pass
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = list(sys.argv[1:] if argv is None else argv)
+    # `modc FILE -o OUT` is `modc compile FILE -o OUT`.
+    commands = {c.name or c.callback.__name__ for c in app.registered_commands}
+    if args and not args[0].startswith("-") and args[0] not in commands:
+        args.insert(0, "compile")
+    app(args=args, prog_name="modc")

@@ -1,0 +1,125 @@
+"""The pipeline, end to end: source -> AST -> model -> passes -> backends -> files on disk."""
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .diagnostics import Diagnostic, Span, codes
+from .model import Design
+from .model.lower import lower
+from .passes import Context, run_all
+from .syntax import ast
+
+YAML_SUFFIXES = (".yaml", ".yml")
+
+
+@dataclass
+class Checked:
+    """A checked design, its diagnostics and the source texts they point into."""
+
+    design: Design
+    diagnostics: list[Diagnostic]
+    sources: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return not any(d.is_error for d in self.diagnostics)
+
+
+class InputError(Exception):
+    """A file that cannot be read at all (exit 2)."""
+
+    def __init__(self, diagnostic: Diagnostic):
+        super().__init__(diagnostic.message)
+        self.diagnostic = diagnostic
+
+
+def read_source(path: str | os.PathLike) -> str:
+    p = str(path)
+    try:
+        data = Path(p).read_bytes()
+    except OSError as e:
+        raise InputError(codes.FILE_NOT_FOUND.at(Span.point(p), path=p, detail=e.strerror or str(e))) from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        line = data[: e.start].count(b"\n") + 1
+        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
+        diag = codes.BAD_ENCODING.at(Span(p, line, col, line, col + 1, e.start, e.start + 1), detail=f"byte 0x{data[e.start]:02x}")
+        raise InputError(diag) from None
+
+
+def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
+    if path.endswith(YAML_SUFFIXES):
+        from .syntax.yaml_form import parse_yaml
+
+        return parse_yaml(text, path)
+    from .syntax import parse
+
+    return parse(text, path)
+
+
+def check_text(text: str, path: str = "<string>", library: str | None = None) -> Checked:
+    tree, diags = parse_text(text, path)
+    ctx = Context(diagnostics=diags, library_override=library)
+    design = lower(tree, ctx.diagnostics)
+    design = run_all(design, ctx)
+    return Checked(design, ctx.diagnostics, {path: text})
+
+
+def check_file(path: str | os.PathLike, library: str | None = None) -> Checked:
+    p = str(path)
+    text = read_source(p)
+    return check_text(text, p, library)
+
+
+def build(checked: Checked, only: list[str] | None = None) -> dict[str, str | bytes]:
+    """Run the backends over a design without errors. Nothing touches the disk."""
+    from .backends import Build, load_all
+
+    assert checked.ok, "build() needs a design without errors"
+    backends = load_all()
+    names = [n for n in backends if only is None or n in only or n == "report"]
+    b = Build(checked.design, diagnostics=list(checked.diagnostics))
+    for name in names:
+        for rel, content in backends[name].emit(b).items():
+            b.files[rel] = content
+    return dict(sorted(b.files.items()))
+
+
+MARKER = "report.json"
+
+
+def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False) -> None:
+    """Write files into a fresh directory next to OUT, then swap it in: OUT is either the old
+    tree or the complete new one, never half-written. Refuses to replace a directory modc did
+    not make unless force is set."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
+    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).is_file() and not force:
+        raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
+    parent = out.resolve().parent
+    parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent))
+    try:
+        for rel, content in files.items():
+            target = tmp / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if isinstance(content, bytes):
+                target.write_bytes(content)
+            else:
+                target.write_text(content, encoding="utf-8", newline="\n")
+        old = None
+        if out.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=parent))
+            os.replace(out, old / "tree")
+        os.replace(tmp, out)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise

@@ -1,0 +1,166 @@
+"""The one registry of diagnostic codes.
+
+Codes are stable kebab-case names (tests, CI annotations and editors rely on them), each with
+its default severity, a message template and a hint template. A code is created once here and
+raised anywhere with ``CODE.at(span, **fields)``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+from .span import Span
+
+
+class Severity(str, Enum):
+    ERROR = "error"
+    WARNING = "warning"
+    NOTE = "note"
+
+
+@dataclass(frozen=True)
+class Code:
+    name: str
+    severity: Severity
+    summary: str  # one line for docs and `modc codes`
+    message: str  # str.format template
+    hint: str = ""
+    allowable: bool = False  # may be silenced with `allow NAME` inside a robot block (assembly rules)
+
+    def at(self, span: Span, **fields) -> "Diagnostic":
+        from .diagnostic import Diagnostic
+
+        return Diagnostic(
+            code=self.name,
+            severity=self.severity,
+            span=span,
+            message=self.message.format(**fields),
+            hint=self.hint.format(**fields) if self.hint else "",
+        )
+
+
+REGISTRY: dict[str, Code] = {}
+
+
+def _register(name: str, severity: Severity, summary: str, message: str, hint: str = "", allowable: bool = False) -> Code:
+    assert name not in REGISTRY, name
+    code = Code(name, severity, summary, message, hint, allowable)
+    REGISTRY[name] = code
+    return code
+
+
+E, W, N = Severity.ERROR, Severity.WARNING, Severity.NOTE
+
+# --- syntax ------------------------------------------------------------------------------------
+SYNTAX_ERROR = _register("syntax-error", E, "the file does not follow the .mod grammar",
+    "unexpected {found}; expected {expected}", "{hint}")
+UNEXPECTED_CHARACTER = _register("unexpected-character", E, "a character that cannot start any token",
+    "unexpected character {char!r}", "names are letters, digits and '_'; comments start with '#'")
+UNCLOSED_BLOCK = _register("unclosed-block", E, "a `robot NAME {` block is never closed",
+    "the file ends inside robot block '{name}'", "add '}}' to close the block")
+MISSING_DASH = _register("missing-dash", E, "two units in a chain without '-' between them",
+    "expected '-' between units in a chain, found {found}", "write units as H1 - H4 - L4")
+MISSING_EQUALS = _register("missing-equals", E, "a unit parameter without '='",
+    "expected '=' after parameter name, found {found}", "write parameters as (pivot=45deg, port=90deg)")
+EXPECTED_STATEMENT = _register("expected-statement", E, "something that is not a statement inside a robot block",
+    "expected a statement, found {found}",
+    "statements are: chain, library, base, tool, payload, pose, limit, box, sphere, cylinder, target, allow")
+EXPECTED_ROBOT = _register("expected-robot", E, "top-level content outside a `robot NAME { … }` block",
+    "expected 'robot NAME {{', found {found}", "every statement lives inside a robot block: robot arm {{ chain H1 - L1 }}")
+EMPTY_FILE = _register("empty-file", W, "a file with no robot block",
+    "no robot is defined in this file", "add a block such as: robot arm {{ chain H1 - L1 }}")
+INPUT_TOO_LARGE = _register("input-too-large", E, "a file or chain beyond the size modc accepts",
+    "{what} is too large ({size}; the limit is {limit})", "split the file or check that it is really a .mod file")
+BAD_ENCODING = _register("bad-encoding", E, "a file that is not UTF-8 text",
+    "the file is not UTF-8 text ({detail})", "save the file as UTF-8")
+
+# --- quantities and lowering -------------------------------------------------------------------
+MISSING_UNIT = _register("missing-unit", E, "a number written without its unit of measure",
+    "{what} needs a unit", "write e.g. {example}")
+WRONG_UNIT = _register("wrong-unit", E, "a unit of the wrong kind (a length where an angle belongs, …)",
+    "{what} takes {kind}, not '{unit}'", "use one of: {allowed}")
+UNKNOWN_UNIT_OF_MEASURE = _register("unknown-unit-of-measure", E, "a unit of measure modc does not know",
+    "unknown unit '{unit}'", "use one of: {allowed}")
+VECTOR_ARITY = _register("vector-arity", E, "a vector with the wrong number of components",
+    "{what} takes {expected} values, got {got}", "write it as {example}")
+UNKNOWN_PARAMETER = _register("unknown-parameter", E, "a unit parameter that does not exist",
+    "unknown parameter '{name}'", "unit parameters are pivot, port and link{suggest}")
+DUPLICATE_PARAMETER = _register("duplicate-parameter", E, "the same parameter twice on one unit",
+    "parameter '{name}' is given twice", "keep one of them")
+DUPLICATE_STATEMENT = _register("duplicate-statement", E, "a statement that may appear once, given twice",
+    "'{what}' is given twice in robot '{robot}'", "keep one of them")
+MISSING_CHAIN = _register("missing-chain", E, "a robot block without a chain",
+    "robot '{robot}' has no chain", "add e.g.: chain H1 - H4(pivot=-90deg) - L4")
+NOT_FINITE = _register("not-finite", E, "a value that is infinite or not a number",
+    "{what} must be a finite number", "write an ordinary decimal number")
+
+# --- YAML form ---------------------------------------------------------------------------------
+YAML_SYNTAX = _register("yaml-syntax", E, "a YAML file that does not parse",
+    "YAML syntax error: {detail}", "check indentation and quoting near this line")
+YAML_SCHEMA = _register("yaml-schema", E, "a YAML document that does not match the modc schema",
+    "{detail}", "`modc schema` prints the JSON Schema of the YAML form")
+
+# --- library -----------------------------------------------------------------------------------
+LIBRARY_NOT_FOUND = _register("library-not-found", E, "a module library that cannot be found",
+    "module library '{name}' not found", "give a built-in name ({builtins}) or a path to a library YAML file")
+LIBRARY_INVALID = _register("library-invalid", E, "a module library file that fails validation",
+    "module library '{name}' is invalid: {detail}", "compare with libraries/mark2.yaml shipped with modc")
+
+# --- units and parameters ----------------------------------------------------------------------
+UNKNOWN_MODULE = _register("unknown-module", E, "a unit name that the library does not define",
+    "unknown module unit '{name}'", "units are a variant letter and a type 1-4: {known}{suggest}")
+PARAMETER_NOT_APPLICABLE = _register("parameter-not-applicable", E, "`port` or `link` on a unit without a link module",
+    "'{param}' does not apply to {unit}: type {kind} units have no link module",
+    "use type 3 or 4 ({variant}3, {variant}4) to get a link module, or drop '{param}'")
+LINK_LENGTH_RANGE = _register("link-length-range", E, "a link length outside what the library can print",
+    "link length {value} is outside {low}..{high}", "choose a length between {low} and {high}")
+TOO_MANY_UNITS = _register("too-many-units", E, "more units in a chain than the library can assemble",
+    "the chain has {n} units; the library allows at most {max}", "modules are limited by ε per variant: {limits}")
+TOO_FEW_UNITS = _register("too-few-units", E, "fewer units than the library's minimum",
+    "the chain has {n} units; at least {min} are needed", "add units to the chain")
+
+# --- assembly rules (paper section 3) ----------------------------------------------------------
+FIRST_VARIANT = _register("first-variant", E, "link 1 must be of the base variant (paper rule 1: H)",
+    "the first unit is {unit}; the paper's rule 1 fixes link 1 as {want}", "start the chain with an {want} unit, "
+    "or write `allow first-variant` for a sub-assembly such as a wrist", allowable=True)
+LAST_VARIANT = _register("last-variant", E, "link n must be of the end variant (paper rule 1: L)",
+    "the last unit is {unit}; the paper's rule 1 fixes link n as {want}", "end the chain with an {want} unit", allowable=True)
+ILLEGAL_SUCCESSION = _register("illegal-succession", E, "a variant that may not follow the previous one (L→H)",
+    "{after} may not follow {before} (paper rules 2-3: {allowed})", "heavier modules go nearer the base", allowable=True)
+EPSILON_EXCEEDED = _register("epsilon-exceeded", E, "more modules of one variant than ε allows",
+    "{count} {variant} modules exceed ε = {eps} (paper rule 4, Table 1)", "replace some {variant} units or use another variant", allowable=True)
+
+# --- twists ------------------------------------------------------------------------------------
+TWIST_NOT_REALISABLE = _register("twist-not-realisable", E, "a twist the library's hardware cannot set",
+    "{what} {value} cannot be set: {reason}", "nearest realisable value: {nearest}")
+
+# --- names, poses, limits, environment ---------------------------------------------------------
+DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",
+    "robot '{name}' is defined twice", "rename one of them; output files are named after robots")
+DUPLICATE_NAME = _register("duplicate-name", E, "two poses, targets or obstacles with one name",
+    "'{name}' is already defined in robot '{robot}'", "names of poses, targets and obstacles must be unique")
+POSE_ARITY = _register("pose-arity", E, "a pose with the wrong number of joint values",
+    "pose '{name}' has {got} values; robot '{robot}' has {dof} joints", "give one angle per joint, base first")
+POSE_OUT_OF_LIMITS = _register("pose-out-of-limits", E, "a pose outside the joint limits",
+    "pose '{name}': joint_{joint} = {value} is outside its limits {low}..{high}", "change the pose or the joint limit")
+UNKNOWN_JOINT = _register("unknown-joint", E, "a joint name that does not exist",
+    "robot '{robot}' has no joint '{name}'", "joints are named joint_1 … joint_{dof}")
+LIMIT_ORDER = _register("limit-order", E, "a joint limit whose lower bound is not below its upper bound",
+    "limit for {joint}: lower {low} is not below upper {high}", "write the limit as (lower, upper)")
+LIMIT_EXCEEDS_HARDWARE = _register("limit-exceeds-hardware", W, "a joint limit wider than the module's range",
+    "limit for {joint} ({low}..{high}) is wider than the module's range {hlow}..{hhigh}",
+    "the library's range is used where yours is wider")
+NONPOSITIVE_SIZE = _register("nonpositive-size", E, "an obstacle size, radius or mass that is zero or negative",
+    "{what} must be positive, got {value}", "give a positive value")
+UNKNOWN_ALLOW = _register("unknown-allow", E, "`allow` naming a code that cannot be silenced",
+    "'{name}' cannot be allowed", "allowable codes: {allowable}")
+
+# --- command line / IO (rendered like the others, exit code 2) ---------------------------------
+FILE_NOT_FOUND = _register("file-not-found", E, "an input file that cannot be read",
+    "cannot read '{path}': {detail}", "check the path")
+OUTPUT_NOT_MODC = _register("output-not-modc", E, "an output directory that modc did not create",
+    "'{path}' exists and was not written by modc", "choose a new or empty directory, or pass --force to replace it")
+UNSUPPORTED_INPUT = _register("unsupported-input", E, "an input file type modc cannot read",
+    "'{path}' is neither .mod nor .yaml/.yml", "pass a .mod file or its YAML form")
+
+del E, W, N

@@ -1,0 +1,50 @@
+"""Render diagnostics for people (text with a caret excerpt) and for machines (JSON)."""
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Mapping
+
+from .diagnostic import Diagnostic, sort_key
+
+
+def excerpt(source: str, d: Diagnostic) -> list[str]:
+    """The offending source line and a caret line under the span (clipped to that line)."""
+    lines = source.splitlines()
+    if not (1 <= d.span.line <= len(lines)):
+        return []
+    text = lines[d.span.line - 1].expandtabs(1)
+    if len(text) > 200:  # a minified or binary "line": show a window around the column
+        lo = max(0, d.span.col - 60)
+        text, col = text[lo:lo + 120], d.span.col - lo
+    else:
+        col = d.span.col
+    end = d.span.end_col if d.span.end_line == d.span.line else len(text) + 1
+    width = max(1, min(end, len(text) + 1) - col)
+    gutter = f"{d.span.line:>4} | "
+    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * (col - 1) + "^" * width]
+
+
+def format_text(d: Diagnostic, sources: Mapping[str, str] | None = None) -> str:
+    head = f"{d.span.file}:{d.span.line}:{d.span.col}: {d.severity.value}[{d.code}]: {d.message}"
+    out = [head]
+    src = (sources or {}).get(d.span.file)
+    if src is not None:
+        out += excerpt(src, d)
+    if d.hint:
+        out.append(f"     = hint: {d.hint}")
+    return "\n".join(out)
+
+
+def render_text(diags: Iterable[Diagnostic], sources: Mapping[str, str] | None = None) -> str:
+    return "\n".join(format_text(d, sources) for d in sorted(diags, key=sort_key))
+
+
+def render_json(diags: Iterable[Diagnostic]) -> str:
+    items = [d.to_json() for d in sorted(diags, key=sort_key)]
+    return json.dumps({"version": 1, "diagnostics": items}, indent=2, sort_keys=False)
+
+
+def summary(diags: list[Diagnostic]) -> str:
+    e = sum(d.severity.value == "error" for d in diags)
+    w = sum(d.severity.value == "warning" for d in diags)
+    return f"{e} error{'s' * (e != 1)}, {w} warning{'s' * (w != 1)}"

@@ -1,0 +1,161 @@
+"""The paper's modular kinematics (section 3.1; SPEC section 2, normative), in numpy.
+
+Per unit i, with the library's constants (x01, z01, z12, x23) and the unit's twists:
+
+    A_t1(pivot) = [Ry(pivot) | (x01, 0, z01)]     unit base -> twist1           (paper eq. 4)
+    A_J(theta)  = [Rz(theta) | (0, 0, z12)]       twist1    -> joint (axis z)   (paper eq. 5)
+    A_t2(port)  = [Rx(port)  | (x23, 0, 0)]       joint     -> twist2, units 3/4 (paper eq. 6)
+
+    T_base_tool(q) = prod_i A_t1 . A_J . A_t2  (eq. 3), then the tool offset.
+
+This is not DH of either kind: each unit has three frames. Names read T_<from>_<to>.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model import Robot
+
+
+def Rx(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def Ry(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def Rz(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def homogeneous(R: np.ndarray, p) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = p
+    return T
+
+
+def A_t1(pivot: float, x01: float, z01: float) -> np.ndarray:
+    """Paper eq. (4): unit base frame -> twist1 frame."""
+    return homogeneous(Ry(pivot), (x01, 0.0, z01))
+
+
+def A_J(theta: float, z12: float) -> np.ndarray:
+    """Paper eq. (5): twist1 frame -> joint frame; the joint turns about this frame's z."""
+    return homogeneous(Rz(theta), (0.0, 0.0, z12))
+
+
+def A_t2(port: float, x23: float) -> np.ndarray:
+    """Paper eq. (6): joint frame -> twist2 frame at the end of the link module."""
+    return homogeneous(Rx(port), (x23, 0.0, 0.0))
+
+
+def rpy_matrix(rpy) -> np.ndarray:
+    """URDF convention: fixed axes X, Y, Z -> R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    return Rz(rpy[2]) @ Ry(rpy[1]) @ Rx(rpy[0])
+
+
+def transform(xyz, rpy) -> np.ndarray:
+    return homogeneous(rpy_matrix(rpy), xyz)
+
+
+def matrix_rpy(R: np.ndarray) -> tuple[float, float, float]:
+    """Inverse of rpy_matrix, accurate everywhere including pitch = ±90° (pivots of ±90° hit it).
+
+    Yaw first, then roll and pitch from M = Rz(-yaw) R = Ry(pitch) Rx(roll), whose entries used
+    here are all of order one: no division by cos(pitch), so no loss of accuracy near the pole.
+    """
+    if np.hypot(R[0, 0], R[1, 0]) < 1e-12:
+        yaw = 0.0  # gimbal lock: only roll - yaw is defined; a canonical choice keeps output stable
+    else:
+        yaw = float(np.arctan2(R[1, 0], R[0, 0]))
+    M = Rz(-yaw) @ R
+    roll = float(np.arctan2(-M[1, 2], M[1, 1]))
+    pitch = float(np.arctan2(-M[2, 0], M[0, 0]))
+    return roll, pitch, yaw
+
+
+@dataclass(frozen=True)
+class UnitGeometry:
+    """The numbers eqs. (4)-(6) need for one unit, resolved from the library."""
+
+    x01: float
+    z01: float
+    z12: float
+    x23: float  # 0 for units without a link module
+    pivot: float
+    port: float
+    has_link: bool
+
+
+def unit_geometry(robot: Robot) -> list[UnitGeometry]:
+    lib = robot.library
+    assert lib is not None, "resolve the library first"
+    out = []
+    for u in robot.units:
+        t = lib.units[u.kind]
+        out.append(UnitGeometry(t.x01, t.z01, t.z12, robot.link_length(u), u.pivot, u.port if t.link else 0.0, t.link))
+    return out
+
+
+class Chain:
+    """Forward kinematics of a checked robot, frame by frame."""
+
+    def __init__(self, robot: Robot):
+        self.units = unit_geometry(robot)
+        self.T_flange_tool = transform(robot.tool.xyz, robot.tool.rpy)
+        self.dof = len(self.units)
+
+    # Fixed parts between joints, used for URDF joint origins (q = 0 at each joint).
+    def T_unit_twist1(self, i: int) -> np.ndarray:
+        u = self.units[i]
+        return A_t1(u.pivot, u.x01, u.z01)
+
+    def T_joint_end(self, i: int) -> np.ndarray:
+        """Joint frame of unit i -> its last frame (twist2 for units 3/4, itself for 1/2)."""
+        u = self.units[i]
+        return A_t2(u.port, u.x23) if u.has_link else np.eye(4)
+
+    def T_parent_joint(self, i: int) -> np.ndarray:
+        """Joint i's origin (q_i = 0) in the frame of the link before it (base_link for i = 0)."""
+        T = np.eye(4) if i == 0 else self.T_joint_end(i - 1)
+        u = self.units[i]
+        return T @ self.T_unit_twist1(i) @ A_J(0.0, u.z12)
+
+    def T_last_tool(self) -> np.ndarray:
+        """Last joint frame -> tool0."""
+        return self.T_joint_end(self.dof - 1) @ self.T_flange_tool
+
+    def frames(self, q) -> list[dict[str, np.ndarray]]:
+        """Per unit: T_base_unit, T_base_twist1, T_base_joint, T_base_end (all in base_link)."""
+        q = np.asarray(q, dtype=float)
+        if q.shape != (self.dof,):
+            raise ValueError(f"expected {self.dof} joint values, got {q.shape}")
+        T = np.eye(4)
+        out = []
+        for u, qi in zip(self.units, q):
+            f = {"T_base_unit": T}
+            f["T_base_twist1"] = T @ A_t1(u.pivot, u.x01, u.z01)
+            f["T_base_joint"] = f["T_base_twist1"] @ A_J(qi, u.z12)
+            T = f["T_base_joint"] @ A_t2(u.port, u.x23) if u.has_link else f["T_base_joint"]
+            f["T_base_end"] = T
+            out.append(f)
+        return out
+
+    def T_base_flange(self, q) -> np.ndarray:
+        """Eq. (3): the product of all units' matrices."""
+        return self.frames(q)[-1]["T_base_end"] if self.dof else np.eye(4)
+
+    def T_base_tool(self, q) -> np.ndarray:
+        return self.T_base_flange(q) @ self.T_flange_tool
+
+    def joint_axes(self, q=None) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(point, unit direction) of every joint axis in base_link."""
+        q = np.zeros(self.dof) if q is None else q
+        return [(f["T_base_joint"][:3, 3].copy(), f["T_base_joint"][:3, 2].copy()) for f in self.frames(q)]

@@ -1,0 +1,228 @@
+"""The module library: a validated data file (SPEC section 1), never code.
+
+All lengths in metres, masses in kilograms, torques in N·m; fields ending in _deg are degrees.
+"""
+from __future__ import annotations
+
+import math
+from functools import cache
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class Actuator(_Frozen):
+    model: str
+    mass: float = Field(gt=0, description="kg (paper Table 1)")
+    rpm: float = Field(gt=0, description="rated speed, rev/min (paper Table 1)")
+    torque_nominal: float = Field(gt=0, description="N·m (paper Table 1)")
+    torque_peak: float = Field(gt=0, description="N·m (paper Table 1)")
+    epsilon: int = Field(ge=1, description="modules of this kind one module can carry (paper Table 1)")
+    diameter: float = Field(gt=0, description="m, housing diameter")
+    length: float = Field(gt=0, description="m, housing length along the joint axis")
+
+    @property
+    def velocity(self) -> float:
+        """Rated speed in rad/s."""
+        return self.rpm * 2.0 * math.pi / 60.0
+
+
+class Part(_Frozen):
+    mass: float = Field(gt=0, description="kg")
+
+
+class Casings(_Frozen):
+    input_mass: float = Field(gt=0)
+    output_mass: float = Field(gt=0)
+    wall: float = Field(gt=0, description="m, casing wall thickness")
+    output_thickness: float = Field(gt=0, description="m, output casing (flange) thickness")
+    boss_radius: float = Field(gt=0, description="m, radius of the pivotal extension")
+
+
+class TwistUnit(_Frozen):
+    mass: float = Field(gt=0)
+    plate: float = Field(gt=0, description="m, base plate thickness")
+    cheek_thickness: float = Field(gt=0)
+    cheek_width: float = Field(gt=0)
+
+
+class LinkModule(_Frozen):
+    mass_per_length: float = Field(gt=0, description="kg/m of a printed link bar")
+    width: float = Field(gt=0, description="m, along y of the joint frame")
+    height: float = Field(gt=0, description="m, along z of the joint frame")
+
+
+class Variant(_Frozen):
+    description: str
+    actuator: Actuator
+    casings: Casings
+    twist_unit: TwistUnit
+    link_module: LinkModule
+    lower_deg: float = Field(description="joint position limit")
+    upper_deg: float
+
+    @model_validator(mode="after")
+    def _limits(self):
+        if not self.lower_deg < self.upper_deg:
+            raise ValueError("lower_deg must be below upper_deg")
+        return self
+
+
+class UnitType(_Frozen):
+    """One of the paper's four modular units (section 3.1, eqs. 7-10)."""
+
+    port: Literal["Ip1", "Ip2"]
+    link: bool
+    x01: float
+    z01: float
+    z12: float
+    x23: float = Field(0.0, description="default link length for units with a link module")
+
+
+class TwistSet(_Frozen):
+    """Realisable twist values: min..max in steps of step (all degrees)."""
+
+    min_deg: float
+    max_deg: float
+    step_deg: float = Field(gt=0)
+    wraps: bool = Field(False, description="angles are taken modulo 360 (ports)")
+
+    def nearest(self, deg: float) -> float:
+        v = _wrap(deg) if self.wraps else deg
+        k = round((v - self.min_deg) / self.step_deg)
+        top = math.floor((self.max_deg - self.min_deg) / self.step_deg + 1e-9)
+        k = min(max(k, 0), top)
+        return _clean(self.min_deg + k * self.step_deg)
+
+    def realisable(self, deg: float) -> bool:
+        v = _wrap(deg) if self.wraps else deg
+        return abs(self.nearest(v) - v) < 1e-6
+
+
+def _wrap(deg: float) -> float:
+    """To (-180, 180]."""
+    v = math.fmod(deg, 360.0)
+    if v <= -180.0:
+        v += 360.0
+    elif v > 180.0:
+        v -= 360.0
+    return v
+
+
+def _clean(x: float) -> float:
+    return 0.0 if abs(x) < 1e-12 else x
+
+
+class Twists(_Frozen):
+    pivot: TwistSet
+    port: TwistSet
+
+
+class Rules(_Frozen):
+    """Assembly rules (paper section 3, rules 1-4)."""
+
+    first_variant: str
+    last_variant: str
+    may_follow: dict[str, list[str]]
+    min_dof: int = Field(1, ge=1)
+    max_dof: int = Field(ge=1)
+
+
+class Control(_Frozen):
+    p: float
+    i: float
+    d: float
+
+
+class Library(_Frozen):
+    name: str
+    description: str
+    source: str
+    variants: dict[str, Variant]
+    units: dict[int, UnitType]
+    twists: Twists
+    link_length_min: float = Field(gt=0)
+    link_length_max: float = Field(gt=0)
+    rules: Rules
+    control: Control
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        for v in (self.rules.first_variant, self.rules.last_variant, *self.rules.may_follow):
+            if v not in self.variants:
+                raise ValueError(f"rules name variant '{v}' that is not defined")
+        for succ in self.rules.may_follow.values():
+            for v in succ:
+                if v not in self.variants:
+                    raise ValueError(f"rules name variant '{v}' that is not defined")
+        if not self.units:
+            raise ValueError("no unit types defined")
+        return self
+
+    def unit_names(self) -> list[str]:
+        return [f"{v}{k}" for v in self.variants for k in sorted(self.units)]
+
+    def split(self, name: str) -> tuple[str, int] | None:
+        """'H4' -> ('H', 4) if the library defines it."""
+        for v in sorted(self.variants, key=len, reverse=True):
+            if name.startswith(v) and name[len(v):].isdigit():
+                k = int(name[len(v):])
+                if k in self.units:
+                    return v, k
+        return None
+
+
+class LibraryError(Exception):
+    pass
+
+
+@cache
+def _load_path(path: str, mtime: float) -> Library:
+    import yaml
+
+    from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
+
+    try:
+        data = yaml.load(Path(path).read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    except (OSError, UnicodeDecodeError) as e:
+        raise LibraryError(str(e)) from None
+    except yaml.YAMLError as e:
+        raise LibraryError(f"YAML error: {e}") from None
+    from pydantic import ValidationError
+
+    try:
+        return Library.model_validate(data)
+    except ValidationError as e:
+        first = e.errors()[0]
+        loc = ".".join(str(p) for p in first["loc"])
+        raise LibraryError(f"{loc}: {first['msg']}" if loc else first["msg"]) from None
+
+
+def resolve(ref: str, relative_to: Path | None = None) -> Path | None:
+    """A built-in library name or a path (relative to the including file) -> file path."""
+    from ..resources import data_dir
+
+    if ref in BUILTIN:
+        return data_dir("libraries") / BUILTIN[ref]
+    p = Path(ref)
+    if not p.is_absolute() and relative_to is not None:
+        p = relative_to / p
+    return p if p.is_file() else None
+
+
+def load(ref: str = "mark2", relative_to: Path | None = None) -> Library:
+    path = resolve(ref, relative_to)
+    if path is None:
+        raise LibraryError(f"library '{ref}' not found")
+    return _load_path(str(path.resolve()), path.stat().st_mtime)
+
+
+def default() -> Library:
+    return load("mark2")

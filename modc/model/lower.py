@@ -1,0 +1,165 @@
+"""Lowering: AST -> model. Converts units to SI and reports what is wrong with quantities and
+statement structure. Anything needing the module library is left to the passes."""
+from __future__ import annotations
+
+import difflib
+import math
+from pathlib import Path
+
+from ..diagnostics import REGISTRY, Diagnostic, codes
+from ..syntax import ast
+from . import quantities as Q
+from .robot import Design, JointLimit, Obstacle, Payload, Pose, Robot, Target, Transform, UnitSpec
+
+UNIT_PARAMS = {"pivot": "an angle", "port": "an angle", "link": "a length"}
+ONCE = ("chain", "library", "base", "tool", "payload")
+
+
+class _Lowerer:
+    def __init__(self, diags: list[Diagnostic]):
+        self.diags = diags
+
+    def error(self, d: Diagnostic) -> None:
+        self.diags.append(d)
+
+    def _scale(self, unit: str | None, kind: str, what: str, span) -> float | None:
+        table = Q.KINDS[kind]
+        if unit is None:
+            self.error(codes.MISSING_UNIT.at(span, what=what, example=Q.EXAMPLE[kind]))
+            return None
+        if unit in table:
+            return table[unit]
+        if unit in Q.ALL:
+            self.error(codes.WRONG_UNIT.at(span, what=what, kind=kind, unit=unit, allowed=", ".join(table)))
+        else:
+            self.error(codes.UNKNOWN_UNIT_OF_MEASURE.at(span, unit=unit, allowed=", ".join(table)))
+        return None
+
+    def _finite(self, values, what, span) -> bool:
+        if all(math.isfinite(v) for v in values):
+            return True
+        self.error(codes.NOT_FINITE.at(span, what=what))
+        return False
+
+    def quantity(self, q: ast.Quantity, kind: str, what: str) -> float | None:
+        s = self._scale(q.unit, kind, what, q.span)
+        if s is None or not self._finite([q.value], what, q.span):
+            return None
+        return q.value * s
+
+    def vector(self, v: ast.Vector, kind: str, what: str, n: int | None = 3) -> tuple[float, ...] | None:
+        s = self._scale(v.unit, kind, what, v.span)
+        if n is not None and len(v.values) != n:
+            example = "(" + ", ".join(["0"] * n) + ") " + next(iter(Q.KINDS[kind]))
+            self.error(codes.VECTOR_ARITY.at(v.span, what=what, expected=n, got=len(v.values), example=example))
+            return None
+        if s is None or not self._finite(v.values, what, v.span):
+            return None
+        return tuple(x * s for x in v.values)
+
+    def unit(self, u: ast.Unit) -> UnitSpec:
+        values: dict[str, float] = {}
+        spans = {}
+        for p in u.params:
+            key = p.name.text
+            if key not in UNIT_PARAMS:
+                close = difflib.get_close_matches(key, list(UNIT_PARAMS), n=1)
+                suggest = f"; did you mean '{close[0]}'?" if close else ""
+                self.error(codes.UNKNOWN_PARAMETER.at(p.name.span, name=key, suggest=suggest))
+                continue
+            if key in spans:
+                self.error(codes.DUPLICATE_PARAMETER.at(p.span, name=key))
+                continue
+            spans[key] = p.span
+            v = self.quantity(p.value, UNIT_PARAMS[key], f"'{key}'")
+            if v is not None:
+                values[key] = v
+        return UnitSpec(name=u.name.text, span=u.span, param_spans=spans, **values)
+
+    def placement(self, p: ast.Placement) -> Transform:
+        xyz = self.vector(p.at, "a length", f"{p.keyword} position") if p.at else None
+        rpy = self.vector(p.rpy, "an angle", f"{p.keyword} orientation") if p.rpy else None
+        return Transform(xyz=xyz or (0.0, 0.0, 0.0), rpy=rpy or (0.0, 0.0, 0.0))
+
+    def robot(self, r: ast.Robot, source_dir: str | None) -> Robot:
+        fields: dict = {}
+        seen: dict[str, object] = {}
+        poses, limits, obstacles, targets, allow = [], [], [], [], set()
+        for st in r.body:
+            kind = {ast.Chain: "chain", ast.Library: "library", ast.Payload: "payload"}.get(type(st))
+            if isinstance(st, ast.Placement):
+                kind = st.keyword
+            if kind in ONCE:
+                if kind in seen:
+                    self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=r.name.text))
+                    continue
+                seen[kind] = st
+            match st:
+                case ast.Chain():
+                    fields["units"] = tuple(self.unit(u) for u in st.units)
+                case ast.Library():
+                    fields["library_ref"] = st.ref
+                    fields["library_dir"] = source_dir if st.is_path else None
+                    fields["library_span"] = st.span
+                case ast.Placement():
+                    fields[st.keyword] = self.placement(st)
+                case ast.Payload():
+                    mass = self.quantity(st.mass, "a mass", "payload mass")
+                    com = self.vector(st.at, "a length", "payload centre of mass") if st.at else (0.0, 0.0, 0.0)
+                    if mass is not None and com is not None:
+                        fields["payload"] = Payload(mass=mass, com=com, span=st.span)
+                case ast.Pose():
+                    q = self.vector(st.values, "an angle", f"pose '{st.name.text}'", n=None)
+                    if q is not None:
+                        poses.append(Pose(name=st.name.text, q=q, span=st.span))
+                case ast.Limit():
+                    v = self.vector(st.values, "an angle", f"limit of '{st.joint.text}'", n=2)
+                    if v is not None:
+                        limits.append(JointLimit(joint=st.joint.text, lower=v[0], upper=v[1], span=st.span))
+                case ast.Box() | ast.Sphere() | ast.Cylinder():
+                    o = self.obstacle(st)
+                    if o is not None:
+                        obstacles.append(o)
+                case ast.Target():
+                    xyz = self.vector(st.at, "a length", f"target '{st.name.text}'")
+                    if xyz is not None:
+                        targets.append(Target(name=st.name.text, xyz=xyz, span=st.span))
+                case ast.Allow():
+                    for c in st.codes:
+                        if c.text in REGISTRY and REGISTRY[c.text].allowable:
+                            allow.add(c.text)
+                        else:
+                            names = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
+                            self.error(codes.UNKNOWN_ALLOW.at(c.span, name=c.text, allowable=names))
+        if "chain" not in seen:
+            self.error(codes.MISSING_CHAIN.at(r.name.span, robot=r.name.text))
+        fields.pop("library_span", None)
+        return Robot(
+            name=r.name.text, poses=tuple(poses), limits=tuple(limits), obstacles=tuple(obstacles),
+            targets=tuple(targets), allow=frozenset(allow), span=r.span, name_span=r.name.span, **fields,
+        )
+
+    def obstacle(self, st) -> Obstacle | None:
+        name = st.name.text
+        at = self.vector(st.at, "a length", f"position of '{name}'")
+        rpy = self.vector(st.rpy, "an angle", f"orientation of '{name}'") if getattr(st, "rpy", None) else (0.0, 0.0, 0.0)
+        match st:
+            case ast.Box():
+                size = self.vector(st.size, "a length", f"size of box '{name}'")
+                shape = "box"
+            case ast.Sphere():
+                r = self.quantity(st.radius, "a length", f"radius of sphere '{name}'")
+                size, shape = (None if r is None else (r,)), "sphere"
+            case ast.Cylinder():
+                r = self.quantity(st.radius, "a length", f"radius of cylinder '{name}'")
+                h = self.quantity(st.length, "a length", f"length of cylinder '{name}'")
+                size, shape = (None if r is None or h is None else (r, h)), "cylinder"
+        if at is None or rpy is None or size is None:
+            return None
+        return Obstacle(name=name, shape=shape, size=size, origin=Transform(xyz=at, rpy=rpy), span=st.span)
+
+
+def lower(file: ast.File, diags: list[Diagnostic]) -> Design:
+    source_dir = str(Path(file.path).parent) if not file.path.startswith("<") else None
+    low = _Lowerer(diags)
+    return Design(path=file.path, robots=tuple(low.robot(r, source_dir) for r in file.robots))

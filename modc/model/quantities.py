@@ -1,0 +1,11 @@
+"""Units of measure: everything becomes SI (m, kg, rad) here, once."""
+from __future__ import annotations
+
+import math
+
+ANGLE = {"deg": math.pi / 180.0, "rad": 1.0}
+LENGTH = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+MASS = {"kg": 1.0, "g": 0.001}
+KINDS = {"an angle": ANGLE, "a length": LENGTH, "a mass": MASS}
+ALL = {**ANGLE, **LENGTH, **MASS}
+EXAMPLE = {"an angle": "45deg or 0.785 rad", "a length": "0.22 m or 220 mm", "a mass": "0.5 kg or 500 g"}

@@ -1,0 +1,136 @@
+"""The checked model: what a .mod (or YAML) file means, in SI units (m, kg, rad).
+
+Backends read only this (and the library it points to), never the syntax.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, SkipValidation
+
+from ..diagnostics import NOWHERE, Span
+from .library import Library
+
+Vec3 = tuple[float, float, float]
+SpanField = Annotated[SkipValidation[Span], Field(default=NOWHERE, exclude=True, repr=False)]
+
+
+class _M(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
+
+
+class Transform(_M):
+    """A placement: position (m) then fixed-axis roll-pitch-yaw (rad), as in URDF."""
+
+    xyz: Vec3 = (0.0, 0.0, 0.0)
+    rpy: Vec3 = (0.0, 0.0, 0.0)
+
+
+class UnitSpec(_M):
+    """One modular unit of the chain, e.g. H4(pivot=-90deg, port=45deg)."""
+
+    name: str
+    variant: str = ""  # filled once the library is known
+    kind: int = 0
+    pivot: float = 0.0  # rad, twist in the adaptive twist unit (rotation about y, eq. 4)
+    port: float = 0.0  # rad, twist at the connection port after the link (rotation about x, eq. 6)
+    link: float | None = None  # m, link-module length; None = the library's default
+    span: SpanField
+    param_spans: Annotated[SkipValidation[dict[str, Span]], Field(default_factory=dict, exclude=True, repr=False)]
+
+
+class Payload(_M):
+    mass: float  # kg
+    com: Vec3 = (0.0, 0.0, 0.0)  # m, in the tool0 frame
+    span: SpanField
+
+
+class Pose(_M):
+    name: str
+    q: tuple[float, ...]  # rad, joint_1 first
+    span: SpanField
+
+
+class JointLimit(_M):
+    joint: str
+    lower: float
+    upper: float
+    span: SpanField
+
+
+class Obstacle(_M):
+    name: str
+    shape: Literal["box", "sphere", "cylinder"]
+    size: tuple[float, ...]  # box: (x, y, z); sphere: (r,); cylinder: (r, length along z)
+    origin: Transform
+    span: SpanField
+
+
+class Target(_M):
+    name: str
+    xyz: Vec3  # m, in base_link
+    span: SpanField
+
+
+class Robot(_M):
+    name: str
+    library_ref: str = "mark2"
+    library_dir: str | None = None  # where a relative library path is resolved
+    library: Library | None = None  # resolved by the resolve_library pass
+    units: tuple[UnitSpec, ...] = ()
+    base: Transform = Transform()  # base_link in the world (cell) frame
+    tool: Transform = Transform()  # tool0 relative to the last unit's last frame
+    payload: Payload | None = None
+    poses: tuple[Pose, ...] = ()
+    limits: tuple[JointLimit, ...] = ()
+    obstacles: tuple[Obstacle, ...] = ()
+    targets: tuple[Target, ...] = ()
+    allow: frozenset[str] = frozenset()
+    span: SpanField
+    name_span: SpanField
+
+    @property
+    def dof(self) -> int:
+        return len(self.units)
+
+    @property
+    def sequence(self) -> str:
+        return "-".join(u.name for u in self.units)
+
+    @property
+    def file_stem(self) -> str:
+        """SPEC section 1: the URDF for the Kinova bring-up is named mod<n>_<name>."""
+        return f"mod{self.dof}_{self.name}"
+
+    def link_length(self, u: UnitSpec) -> float:
+        assert self.library is not None
+        t = self.library.units[u.kind]
+        if not t.link:
+            return 0.0
+        return t.x23 if u.link is None else u.link
+
+    def pose(self, name: str) -> Pose | None:
+        return next((p for p in self.poses if p.name == name), None)
+
+    def home(self) -> tuple[float, ...]:
+        p = self.pose("home")
+        return p.q if p is not None else (0.0,) * self.dof
+
+    def joint_range(self, i: int) -> tuple[float, float]:
+        """Position limits of joint i (1-based), rad: the library's range, narrowed by `limit`."""
+        import math
+
+        assert self.library is not None
+        v = self.library.variants[self.units[i - 1].variant]
+        lo, hi = math.radians(v.lower_deg), math.radians(v.upper_deg)
+        for lim in self.limits:
+            if lim.joint == f"joint_{i}":
+                lo, hi = max(lo, lim.lower), min(hi, lim.upper)
+        return lo, hi
+
+
+class Design(_M):
+    """Everything one input file defines."""
+
+    path: str
+    robots: tuple[Robot, ...] = ()

@@ -1,0 +1,33 @@
+"""Semantic passes: one module per pass, run in this order over the whole design."""
+from __future__ import annotations
+
+from ..model import Design
+from . import (
+    check_assembly,
+    check_environment,
+    check_names,
+    check_poses,
+    check_twists,
+    check_units,
+    resolve_library,
+)
+from .context import Context
+
+PASSES = (
+    resolve_library,
+    check_names,
+    check_units,
+    check_assembly,
+    check_twists,
+    check_poses,
+    check_environment,
+)
+
+
+def run_all(design: Design, ctx: Context) -> Design:
+    for p in PASSES:
+        design = p.run(design, ctx)
+    return design
+
+
+__all__ = ["PASSES", "Context", "run_all"]

@@ -1,0 +1,20 @@
+"""Robot names are unique in a file; pose, target and obstacle names are unique in a robot."""
+from __future__ import annotations
+
+from ..diagnostics import codes
+from ..model import Design
+from .context import Context
+
+
+def run(design: Design, ctx: Context) -> Design:
+    robots: set[str] = set()
+    for r in design.robots:
+        if r.name in robots:
+            ctx.report(codes.DUPLICATE_ROBOT.at(r.name_span, name=r.name))
+        robots.add(r.name)
+        names: set[str] = set()
+        for item in (*r.poses, *r.targets, *r.obstacles):
+            if item.name in names:
+                ctx.report(codes.DUPLICATE_NAME.at(item.span, name=item.name, robot=r.name))
+            names.add(item.name)
+    return design

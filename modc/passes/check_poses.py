@@ -1,0 +1,42 @@
+"""Joint-limit overrides name real joints and are ordered; named poses fit the arm and its limits."""
+from __future__ import annotations
+
+import math
+
+from ..diagnostics import codes
+from ..model import Design
+from .context import Context
+
+
+def _deg(x: float) -> str:
+    return f"{math.degrees(x):.6g}deg"
+
+
+def run(design: Design, ctx: Context) -> Design:
+    for r in design.robots:
+        lib = r.library
+        if lib is None or not r.units or any(not u.variant for u in r.units):
+            continue
+        joints = {f"joint_{i}": i for i in range(1, r.dof + 1)}
+        for lim in r.limits:
+            if lim.joint not in joints:
+                ctx.report(codes.UNKNOWN_JOINT.at(lim.span, robot=r.name, name=lim.joint, dof=r.dof), r)
+                continue
+            if not lim.lower < lim.upper:
+                ctx.report(codes.LIMIT_ORDER.at(lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper)), r)
+                continue
+            v = lib.variants[r.units[joints[lim.joint] - 1].variant]
+            hlo, hhi = math.radians(v.lower_deg), math.radians(v.upper_deg)
+            if lim.lower < hlo - 1e-12 or lim.upper > hhi + 1e-12:
+                ctx.report(codes.LIMIT_EXCEEDS_HARDWARE.at(
+                    lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper), hlow=_deg(hlo), hhigh=_deg(hhi)), r)
+        for pose in r.poses:
+            if len(pose.q) != r.dof:
+                ctx.report(codes.POSE_ARITY.at(pose.span, name=pose.name, got=len(pose.q), robot=r.name, dof=r.dof), r)
+                continue
+            for i, q in enumerate(pose.q, start=1):
+                lo, hi = r.joint_range(i)
+                if lo < hi and not (lo - 1e-12 <= q <= hi + 1e-12):
+                    ctx.report(codes.POSE_OUT_OF_LIMITS.at(
+                        pose.span, name=pose.name, joint=i, value=_deg(q), low=_deg(lo), high=_deg(hi)), r)
+    return design

@@ -1,0 +1,36 @@
+"""Pivot and port twists must be settable on the library's hardware (SPEC section 1)."""
+from __future__ import annotations
+
+import math
+
+from ..diagnostics import codes
+from ..model import Design
+from ..model.library import TwistSet
+from .context import Context
+
+
+def _deg(x: float) -> str:
+    return f"{x:.6g}deg"
+
+
+def _reason(ts: TwistSet, deg: float) -> str:
+    if not ts.wraps and not (ts.min_deg - 1e-9 <= deg <= ts.max_deg + 1e-9):
+        return f"the range is {_deg(ts.min_deg)}..{_deg(ts.max_deg)}"
+    return f"it is set in steps of {_deg(ts.step_deg)}"
+
+
+def run(design: Design, ctx: Context) -> Design:
+    for r in design.robots:
+        lib = r.library
+        if lib is None:
+            continue
+        for u in r.units:
+            for param, ts in (("pivot", lib.twists.pivot), ("port", lib.twists.port)):
+                if param not in u.param_spans:
+                    continue
+                deg = math.degrees(getattr(u, param))
+                if not ts.realisable(deg):
+                    ctx.report(codes.TWIST_NOT_REALISABLE.at(
+                        u.param_spans[param], what=f"{u.name} {param}", value=_deg(deg),
+                        reason=_reason(ts, deg), nearest=_deg(ts.nearest(deg))), r)
+    return design

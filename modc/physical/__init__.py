@@ -1,0 +1,1 @@
+"""Physical model: representative part geometry, meshes and inertials of an assembled arm."""

@@ -1,0 +1,134 @@
+"""Parse .mod text into AST nodes, turning every Lark error into a Diagnostic."""
+from __future__ import annotations
+
+from functools import cache
+
+from ..diagnostics import Diagnostic, Span, codes
+from ..resources import data_dir
+from . import ast
+from .errors import EXAMPLES, HINTS, TERMINAL_NAMES
+
+MAX_BYTES = 1_000_000
+
+
+@cache
+def _lark():
+    from lark import Lark
+
+    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
+    # cache=True keeps the LALR tables in the temp dir: a cold `modc lint` skips building them.
+    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True, cache=True)
+
+
+def grammar_keywords() -> set[str]:
+    """The keywords of the grammar (used by editors' grammars and their tests)."""
+    import re
+
+    return {t.pattern.value for t in _lark().terminals if t.pattern.type == "str" and re.fullmatch(r"[a-z]+", t.pattern.value)}
+
+
+def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]]:
+    """Parse one file. On a syntax error returns no robots and one diagnostic."""
+    if len(text) > MAX_BYTES:
+        d = codes.INPUT_TOO_LARGE.at(Span.point(file), what="the file", size=f"{len(text):,} characters", limit=f"{MAX_BYTES:,}")
+        return ast.File(file, ()), [d]
+    from lark.exceptions import UnexpectedInput
+
+    from .transform import ToAst
+
+    lark = _lark()
+    try:
+        tree = lark.parse(text)
+    except UnexpectedInput as e:
+        return ast.File(file, ()), [_diagnose(e, text, file)]
+    robots = ToAst(file).transform(tree)
+    diags = []
+    if not robots:
+        diags.append(codes.EMPTY_FILE.at(Span.point(file)))
+    return ast.File(file, tuple(robots)), diags
+
+
+def _describe(name: str) -> str:
+    if name in TERMINAL_NAMES:
+        return TERMINAL_NAMES[name]
+    try:
+        pattern = _lark().get_terminal(name).pattern
+    except KeyError:
+        return name
+    return f"'{pattern.value}'" if pattern.type == "str" else name.lower()
+
+
+def _expected(names) -> str:
+    items = sorted({_describe(n) for n in names})
+    if len(items) > 6:
+        items = items[:6] + ["…"]
+    return ", ".join(items) if items else "nothing more"
+
+
+def _label(e, text: str) -> str | None:
+    try:
+        return e.match_examples(_lark().parse, EXAMPLES, use_accepts=True)
+    except Exception:  # a label is a nicety; the generic message is still right
+        return None
+
+
+def _diagnose(e, text: str, file: str) -> Diagnostic:
+    from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedToken
+
+    line, col = max(1, e.line if e.line != -1 else 1), max(1, e.column if e.column != -1 else 1)
+    if isinstance(e, UnexpectedCharacters):
+        pos = e.pos_in_stream
+        span = Span(file, line, col, line, col + 1, pos, pos + 1)
+        label = _label(e, text)
+        if label == "missing-equals":
+            return codes.MISSING_EQUALS.at(span, found=repr(text[pos]))
+        return codes.UNEXPECTED_CHARACTER.at(span, char=text[pos])
+
+    token = getattr(e, "token", None)
+    if isinstance(e, UnexpectedEOF) or (token is not None and token.type == "$END"):
+        name = _open_robot(text)
+        span = _eof_span(text, file)
+        if name is not None:
+            return codes.UNCLOSED_BLOCK.at(span, name=name)
+        return codes.SYNTAX_ERROR.at(span, found="end of file", expected=_expected(getattr(e, "expected", ())), hint="the file ends too early")
+
+    assert isinstance(e, UnexpectedToken)
+    found = f"'{token}'" if token.type not in ("$END",) else "end of file"
+    span = Span(file, line, col, token.end_line or line, token.end_column or col + 1, token.start_pos or 0, token.end_pos or 0)
+    label = _label(e, text)
+    if label == "missing-dash":
+        return codes.MISSING_DASH.at(span, found=found)
+    if label == "missing-equals":
+        return codes.MISSING_EQUALS.at(span, found=found)
+    if label == "expected-statement":
+        return codes.EXPECTED_STATEMENT.at(span, found=found)
+    if label == "expected-robot":
+        return codes.EXPECTED_ROBOT.at(span, found=found)
+    expected = e.accepts or e.expected
+    hint = next((HINTS[n] for n in sorted(expected) if n in HINTS), "see the .mod language reference in the README")
+    return codes.SYNTAX_ERROR.at(span, found=found, expected=_expected(expected), hint=hint)
+
+
+def _open_robot(text: str) -> str | None:
+    """Name of the robot block left open at end of file, if any (comments ignored)."""
+    import re
+
+    depth, name = 0, None
+    for m in re.finditer(r"#[^\n]*|\brobot\s+([A-Za-z_]\w*)|[{}]", text):
+        s = m.group(0)
+        if s.startswith("#"):
+            continue
+        if m.group(1):
+            name = m.group(1)
+        elif s == "{":
+            depth += 1
+        elif s == "}":
+            depth = max(0, depth - 1)
+    return name if depth > 0 else None
+
+
+def _eof_span(text: str, file: str) -> Span:
+    lines = text.split("\n")
+    line = len(lines)
+    col = len(lines[-1]) + 1
+    return Span(file, line, col, line, col + 1, len(text), len(text) + 1)

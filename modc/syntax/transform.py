@@ -1,0 +1,108 @@
+"""A thin Lark Transformer: parse tree -> frozen, spanned AST nodes. No checking happens here."""
+from __future__ import annotations
+
+from lark import Token, Transformer, v_args
+
+from ..diagnostics import Span
+from . import ast
+
+
+def token_span(file: str, t: Token) -> Span:
+    return Span(file, t.line, t.column, t.end_line, t.end_column, t.start_pos, t.end_pos)
+
+
+def _num(t: Token) -> float:
+    return float(t)
+
+
+@v_args(meta=True)
+class ToAst(Transformer):
+    def __init__(self, file: str):
+        super().__init__()
+        self.file = file
+
+    def _span(self, meta) -> Span:
+        return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column, meta.start_pos, meta.end_pos)
+
+    def _name(self, t: Token) -> ast.Name:
+        return ast.Name(str(t), token_span(self.file, t))
+
+    def start(self, meta, robots):
+        return list(robots)
+
+    def robot(self, meta, items):
+        name, *body = items
+        return ast.Robot(self._name(name), tuple(body), self._span(meta))
+
+    def quantity(self, meta, items):
+        unit = str(items[1]) if len(items) > 1 else None
+        return ast.Quantity(_num(items[0]), unit, self._span(meta))
+
+    def vector(self, meta, items):
+        unit = None
+        if items and items[-1].type == "MEASURE":
+            unit = str(items[-1])
+            items = items[:-1]
+        return ast.Vector(tuple(_num(t) for t in items), unit, self._span(meta))
+
+    def param(self, meta, items):
+        return ast.Param(self._name(items[0]), items[1], self._span(meta))
+
+    def params(self, meta, items):
+        return tuple(p for p in items if p is not None)
+
+    def unit(self, meta, items):
+        params = items[1] if len(items) > 1 else ()
+        return ast.Unit(self._name(items[0]), params, self._span(meta))
+
+    def chain(self, meta, units):
+        return ast.Chain(tuple(units), self._span(meta))
+
+    def library(self, meta, items):
+        t = items[0]
+        if t.type == "STRING":
+            return ast.Library(str(t)[1:-1], True, self._span(meta))
+        return ast.Library(str(t), False, self._span(meta))
+
+    def at(self, meta, items):
+        return ("at", items[0])
+
+    def rpy(self, meta, items):
+        return ("rpy", items[0])
+
+    def _placement(self, keyword, meta, items):
+        parts = dict(items)
+        return ast.Placement(keyword, parts.get("at"), parts.get("rpy"), self._span(meta))
+
+    def base(self, meta, items):
+        return self._placement("base", meta, items)
+
+    def tool(self, meta, items):
+        return self._placement("tool", meta, items)
+
+    def payload(self, meta, items):
+        at = items[1][1] if len(items) > 1 else None
+        return ast.Payload(items[0], at, self._span(meta))
+
+    def pose(self, meta, items):
+        return ast.Pose(self._name(items[0]), items[1], self._span(meta))
+
+    def limit(self, meta, items):
+        return ast.Limit(self._name(items[0]), items[1], self._span(meta))
+
+    def box(self, meta, items):
+        rest = dict(items[2:])
+        return ast.Box(self._name(items[0]), items[1], rest["at"], rest.get("rpy"), self._span(meta))
+
+    def sphere(self, meta, items):
+        return ast.Sphere(self._name(items[0]), items[1], items[2][1], self._span(meta))
+
+    def cylinder(self, meta, items):
+        rest = dict(items[3:])
+        return ast.Cylinder(self._name(items[0]), items[1], items[2], rest["at"], rest.get("rpy"), self._span(meta))
+
+    def target(self, meta, items):
+        return ast.Target(self._name(items[0]), items[1][1], self._span(meta))
+
+    def allow(self, meta, items):
+        return ast.Allow(tuple(self._name(t) for t in items), self._span(meta))
