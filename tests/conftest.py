@@ -44,3 +44,14 @@ def compiled_examples(tmp_path_factory) -> dict[str, Path]:
         compile_file(ex, d)
         out[ex.stem] = d
     return out
+
+
+def pytest_addoption(parser):
+    parser.addoption("--update-golden", action="store_true", help="rewrite tests/golden from the current output")
+
+
+@pytest.fixture
+def update_golden(request) -> bool:
+    import os
+
+    return bool(request.config.getoption("--update-golden") or os.environ.get("MODC_UPDATE_GOLDEN"))

@@ -17,7 +17,8 @@ def _lark():
 
     text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
     # cache=True keeps the LALR tables in the temp dir: a cold `modc lint` skips building them.
-    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True, cache=True)
+    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True, cache=True,
+                start=["start", "unit_text", "quantity_text", "vector_text"])
 
 
 def grammar_keywords() -> set[str]:
@@ -38,7 +39,7 @@ def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]
 
     lark = _lark()
     try:
-        tree = lark.parse(text)
+        tree = lark.parse(text, start="start")
     except UnexpectedInput as e:
         return ast.File(file, ()), [_diagnose(e, text, file)]
     robots = ToAst(file).transform(tree)
@@ -67,7 +68,7 @@ def _expected(names) -> str:
 
 def _label(e, text: str) -> str | None:
     try:
-        return e.match_examples(_lark().parse, EXAMPLES, use_accepts=True)
+        return e.match_examples(lambda t: _lark().parse(t, start="start"), EXAMPLES, use_accepts=True)
     except Exception:  # a label is a nicety; the generic message is still right
         return None
 

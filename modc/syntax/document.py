@@ -1,0 +1,80 @@
+"""The YAML form of a .mod file: its structure as pydantic models, and the JSON Schema.
+
+Quantities are strings written exactly as in .mod ("45deg", "220 mm", "(0.3, 0, 0.25) m"),
+so both forms share one meaning and one set of unit diagnostics.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field
+
+Quantity = Annotated[Union[str, float], Field(description='a number with its unit, as in .mod: "45deg", "0.22 m", "500 g"')]
+Vector = Annotated[str, Field(description='a parenthesised tuple with one unit, as in .mod: "(0.3, 0, 0.25) m"')]
+
+
+class _Doc(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class UnitItem(_Doc):
+    unit: str = Field(description="unit name, e.g. H4")
+    pivot: Quantity | None = None
+    port: Quantity | None = None
+    link: Quantity | None = None
+
+
+class PlacementDoc(_Doc):
+    at: Vector | None = None
+    rpy: Vector | None = None
+
+
+class PayloadDoc(_Doc):
+    mass: Quantity
+    at: Vector | None = None
+
+
+class BoxDoc(_Doc):
+    box: str = Field(description="obstacle name")
+    size: Vector
+    at: Vector
+    rpy: Vector | None = None
+
+
+class SphereDoc(_Doc):
+    sphere: str
+    radius: Quantity
+    at: Vector
+
+
+class CylinderDoc(_Doc):
+    cylinder: str
+    radius: Quantity
+    length: Quantity
+    at: Vector
+    rpy: Vector | None = None
+
+
+class RobotDoc(_Doc):
+    name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    library: str | None = Field(None, description="built-in library name, or a path to a library YAML file")
+    chain: list[Union[str, UnitItem]] = Field(description='units base first: "H1", "H4(pivot=-90deg)" or {unit: H4, pivot: -90deg}')
+    base: PlacementDoc | None = None
+    tool: PlacementDoc | None = None
+    payload: PayloadDoc | None = None
+    poses: dict[str, Vector] = Field(default_factory=dict, description='name -> joint angles, e.g. home: "(0, 30, -45) deg"')
+    limits: dict[str, Vector] = Field(default_factory=dict, description='joint name -> "(lower, upper) deg"')
+    obstacles: list[Union[BoxDoc, SphereDoc, CylinderDoc]] = Field(default_factory=list)
+    targets: dict[str, Vector] = Field(default_factory=dict, description='name -> position of tool0 in base_link')
+    allow: list[str] = Field(default_factory=list, description="assembly-rule codes to silence, e.g. first-variant")
+
+
+class Document(_Doc):
+    robots: list[RobotDoc]
+
+
+def json_schema() -> dict:
+    schema = Document.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "modc robot file (YAML form)"
+    return schema

@@ -1,0 +1,202 @@
+"""Read the YAML form into the same AST as .mod text, keeping YAML line/column spans."""
+from __future__ import annotations
+
+from ..diagnostics import Diagnostic, Span, codes
+from . import ast
+from .parser import MAX_BYTES
+
+
+def _span(file: str, node) -> Span:
+    s, e = node.start_mark, node.end_mark
+    return Span(file, s.line + 1, s.column + 1, e.line + 1, max(e.column + 1, s.column + 2), s.index, e.index)
+
+
+def _plain(node, path: tuple, spans: dict, file: str):
+    """YAML node -> Python data, recording each value's span by its path."""
+    import yaml
+
+    spans[path] = _span(file, node)
+    if isinstance(node, yaml.MappingNode):
+        out = {}
+        for k, v in node.value:
+            key = k.value
+            spans[path + (key, "__key__")] = _span(file, k)
+            out[key] = _plain(v, path + (key,), spans, file)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        return [_plain(v, path + (i,), spans, file) for i, v in enumerate(node.value)]
+    value = node.value
+    if node.tag.endswith(":int") or node.tag.endswith(":float"):
+        try:
+            return float(value)
+        except ValueError:
+            return value
+    if node.tag.endswith(":null"):
+        return None
+    return value
+
+
+class _Reader:
+    def __init__(self, file: str, spans: dict, diags: list[Diagnostic]):
+        self.file, self.spans, self.diags = file, spans, diags
+
+    def span(self, path: tuple) -> Span:
+        while path not in self.spans and path:
+            path = path[:-1]
+        return self.spans.get(path, Span.point(self.file))
+
+    def _sub(self, rule: str, text, path: tuple):
+        """Parse one .mod fragment (a unit, quantity or vector) written in a YAML scalar."""
+        from lark.exceptions import UnexpectedInput
+
+        from .parser import _lark
+        from .transform import ToAst
+
+        span = self.span(path)
+        if isinstance(text, float):
+            return ast.Quantity(text, None, span) if rule == "quantity_text" else ast.Vector((text,), None, span)
+        try:
+            tree = _lark().parse(str(text), start=rule)
+        except UnexpectedInput:
+            what = {"unit_text": "a unit such as H4(pivot=-90deg)", "quantity_text": "a number with a unit such as 45deg",
+                    "vector_text": "a vector such as (0.3, 0, 0.25) m"}[rule]
+            self.diags.append(codes.YAML_SCHEMA.at(span, detail=f"{_dotted(path)}: expected {what}, got {text!r}"))
+            return None
+        node = ToAst(self.file).transform(tree).children[0]
+        return _respan(node, span)
+
+    def robot(self, r, path: tuple) -> ast.Robot:
+        body: list = []
+        units = []
+        for i, item in enumerate(r.chain):
+            p = path + ("chain", i)
+            if isinstance(item, str):
+                u = self._sub("unit_text", item, p)
+            else:
+                params = []
+                for key in ("pivot", "port", "link"):
+                    val = getattr(item, key)
+                    if val is not None:
+                        q = self._sub("quantity_text", val, p + (key,))
+                        if q is not None:
+                            params.append(ast.Param(ast.Name(key, self.span(p + (key, "__key__"))), q, self.span(p + (key,))))
+                u = ast.Unit(ast.Name(item.unit, self.span(p + ("unit",))), tuple(params), self.span(p))
+            if u is not None:
+                units.append(u)
+        body.append(ast.Chain(tuple(units), self.span(path + ("chain",))))
+        if r.library is not None:
+            is_path = r.library.endswith((".yaml", ".yml")) or "/" in r.library
+            body.append(ast.Library(r.library, is_path, self.span(path + ("library",))))
+        for key in ("base", "tool"):
+            pl = getattr(r, key)
+            if pl is not None:
+                at = self._vec(pl.at, path + (key, "at"))
+                rpy = self._vec(pl.rpy, path + (key, "rpy"))
+                body.append(ast.Placement(key, at, rpy, self.span(path + (key,))))
+        if r.payload is not None:
+            m = self._sub("quantity_text", r.payload.mass, path + ("payload", "mass"))
+            if m is not None:
+                body.append(ast.Payload(m, self._vec(r.payload.at, path + ("payload", "at")), self.span(path + ("payload",))))
+        for name, text in r.poses.items():
+            v = self._vec(text, path + ("poses", name))
+            if v is not None:
+                body.append(ast.Pose(ast.Name(name, self.span(path + ("poses", name, "__key__"))), v, self.span(path + ("poses", name))))
+        for name, text in r.limits.items():
+            v = self._vec(text, path + ("limits", name))
+            if v is not None:
+                body.append(ast.Limit(ast.Name(name, self.span(path + ("limits", name, "__key__"))), v, self.span(path + ("limits", name))))
+        for i, o in enumerate(r.obstacles):
+            body.extend(self._obstacle(o, path + ("obstacles", i)))
+        for name, text in r.targets.items():
+            v = self._vec(text, path + ("targets", name))
+            if v is not None:
+                body.append(ast.Target(ast.Name(name, self.span(path + ("targets", name, "__key__"))), v, self.span(path + ("targets", name))))
+        if r.allow:
+            names = tuple(ast.Name(c, self.span(path + ("allow", i))) for i, c in enumerate(r.allow))
+            body.append(ast.Allow(names, self.span(path + ("allow",))))
+        return ast.Robot(ast.Name(r.name, self.span(path + ("name",))), tuple(body), self.span(path))
+
+    def _vec(self, text, path):
+        return None if text is None else self._sub("vector_text", text, path)
+
+    def _obstacle(self, o, p):
+        from .document import BoxDoc, SphereDoc
+
+        at = self._vec(o.at, p + ("at",))
+        rpy = self._vec(getattr(o, "rpy", None), p + ("rpy",))
+        if isinstance(o, BoxDoc):
+            size = self._vec(o.size, p + ("size",))
+            if at is not None and size is not None:
+                yield ast.Box(ast.Name(o.box, self.span(p + ("box",))), size, at, rpy, self.span(p))
+        elif isinstance(o, SphereDoc):
+            r = self._sub("quantity_text", o.radius, p + ("radius",))
+            if at is not None and r is not None:
+                yield ast.Sphere(ast.Name(o.sphere, self.span(p + ("sphere",))), r, at, self.span(p))
+        else:
+            r = self._sub("quantity_text", o.radius, p + ("radius",))
+            h = self._sub("quantity_text", o.length, p + ("length",))
+            if at is not None and r is not None and h is not None:
+                yield ast.Cylinder(ast.Name(o.cylinder, self.span(p + ("cylinder",))), r, h, at, rpy, self.span(p))
+
+
+def _dotted(path: tuple) -> str:
+    return ".".join(str(p) for p in path if p != "__key__") or "document"
+
+
+def _respan(node, span: Span):
+    """Fragments were parsed out of context: point all their spans at the YAML scalar."""
+    import dataclasses
+
+    changes = {}
+    for f in dataclasses.fields(node):
+        v = getattr(node, f.name)
+        if isinstance(v, Span):
+            changes[f.name] = span
+        elif dataclasses.is_dataclass(v):
+            changes[f.name] = _respan(v, span)
+        elif isinstance(v, tuple) and v and dataclasses.is_dataclass(v[0]):
+            changes[f.name] = tuple(_respan(x, span) for x in v)
+    return dataclasses.replace(node, **changes)
+
+
+def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
+    import yaml
+    from pydantic import ValidationError
+
+    from .document import Document
+
+    diags: list[Diagnostic] = []
+    if len(text) > MAX_BYTES:
+        diags.append(codes.INPUT_TOO_LARGE.at(Span.point(file), what="the file", size=f"{len(text):,} characters", limit=f"{MAX_BYTES:,}"))
+        return ast.File(file, ()), diags
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
+        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+        detail = getattr(e, "problem", None) or str(e).splitlines()[0]
+        diags.append(codes.YAML_SYNTAX.at(Span(file, line, col, line, col + 1), detail=detail))
+        return ast.File(file, ()), diags
+    if node is None:
+        diags.append(codes.EMPTY_FILE.at(Span.point(file)))
+        return ast.File(file, ()), diags
+    spans: dict = {}
+    data = _plain(node, (), spans, file)
+    try:
+        doc = Document.model_validate(data)
+    except ValidationError as e:
+        seen = set()
+        for err in e.errors():
+            loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and p[:1].isupper() or p in ("str", "float")))
+            key = (loc, err["msg"])
+            if key in seen:
+                continue
+            seen.add(key)
+            reader = _Reader(file, spans, diags)
+            diags.append(codes.YAML_SCHEMA.at(reader.span(loc), detail=f"{_dotted(loc)}: {err['msg']}"))
+        return ast.File(file, ()), diags
+    reader = _Reader(file, spans, diags)
+    robots = tuple(reader.robot(r, ("robots", i)) for i, r in enumerate(doc.robots))
+    if not robots:
+        diags.append(codes.EMPTY_FILE.at(Span.point(file)))
+    return ast.File(file, robots), diags
