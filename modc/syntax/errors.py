@@ -35,7 +35,8 @@ TERMINAL_NAMES = {
     "UNIT_NAME": "a unit such as H1 or L4",
     "NUMBER": "a number",
     "MEASURE": "a unit of measure",
-    "STRING": 'a "quoted path"',
+    "STRING": "a \"quoted path\"",
+    "LIBRARY_REF": "a library name such as mark2",
     "CODE_NAME": "a diagnostic code such as first-variant",
     "$END": "end of file",
 }
