@@ -12,8 +12,8 @@ def load(path, robot=None, library=None):
     return _load(path, robot, library)
 
 
-def kinematics(robot):
+def chain(robot):
     """Forward kinematics (the paper's three-frame product) of a loaded robot."""
-    from .api import kinematics as _k
+    from .api import chain as _k
 
     return _k(robot)

@@ -2,7 +2,7 @@
 
     import modc
     robot = modc.load("examples/farm.mod")          # the only robot, or robot="name"
-    chain = modc.kinematics(robot)
+    chain = modc.chain(robot)
     chain.T_base_tool([0.1, -0.5, 0.3])              # 4x4, base_link -> tool0
     chain.frames(q)                                  # every unit's frames (T_base_unit, T_base_twist1, …)
 """

@@ -106,7 +106,7 @@ def test_python_api_loads_and_computes():
     from modc.api import ModcError
 
     robot = modc.load(ROOT / "examples" / "farm.mod")
-    T = modc.kinematics(robot).T_base_tool([0, 0, 0])
+    T = modc.chain(robot).T_base_tool([0, 0, 0])
     assert T.shape == (4, 4) and robot.file_stem == "mod3_farm"
     with pytest.raises(ModcError) as e:
         modc.load(ROOT / "tests" / "golden")  # a directory is not a file
