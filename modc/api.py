@@ -46,7 +46,7 @@ def load(path: str | Path, robot: str | None = None, library: str | None = None)
     raise KeyError(f"{path} has no robot '{robot}'")
 
 
-def kinematics(robot: Robot):
+def chain(robot: Robot):
     from .kinematics import Chain
 
     return Chain(robot)
