@@ -143,6 +143,58 @@ def lint_cmd(
     raise typer.Exit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
 
 
+@app.command("dh2mod")
+def dh2mod_cmd(
+    table: Annotated[str, typer.Argument(help="CSV with header a,alpha,d,theta (metres, radians), one row per joint")],
+    json_out: Annotated[bool, typer.Option("--json", help="print requested vs realised DH as JSON instead of .mod text")] = False,
+    fit_links: Annotated[bool, typer.Option("--fit-links", help="print link modules at the lengths that realise each a exactly")] = False,
+    name: Annotated[Optional[str], typer.Option(help="robot name (default: from the file name)")] = None,
+    library: LibraryOpt = None,
+):
+    """Convert a standard DH table into a module chain (paper section 4.2); .mod text on stdout."""
+    from .compiler import InputError, read_source
+    from .dh.convert_file import convert_table
+
+    try:
+        text = read_source(table)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    out, diags, ok = convert_table(text, table, name=name, fit_links=fit_links, library=library, as_json=json_out)
+    _print_diagnostics(diags, {table: text})
+    if not ok:
+        raise typer.Exit(EXIT_ERRORS)
+    sys.stdout.write(out)
+
+
+@app.command("dh")
+def dh_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    json_out: Annotated[bool, typer.Option("--json", help="JSON instead of a table")] = False,
+    library: LibraryOpt = None,
+):
+    """Show the realised standard DH table of every robot (and the requested one, for dh tables)."""
+    import json
+
+    from .compiler import InputError, check_file
+    from .dh.report import compare, text_table
+
+    try:
+        checked = check_file(file, library)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    if not checked.ok:
+        _print_diagnostics(checked.diagnostics, checked.sources)
+        raise typer.Exit(EXIT_ERRORS)
+    robots = checked.design.robots
+    if json_out:
+        doc = {"robots": [{"name": r.name, "sequence": r.sequence, "joints": compare(r)} for r in robots]}
+        print(json.dumps(doc, indent=2))
+    else:
+        print("\n\n".join(text_table(r) for r in robots))
+
+
 @app.command("schema")
 def schema_cmd():
     """Print the JSON Schema of the YAML form of .mod files."""

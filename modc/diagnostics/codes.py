@@ -83,14 +83,18 @@ UNKNOWN_UNIT_OF_MEASURE = _register("unknown-unit-of-measure", E, "a unit of mea
     "unknown unit '{unit}'", "use one of: {allowed}")
 VECTOR_ARITY = _register("vector-arity", E, "a vector with the wrong number of components",
     "{what} takes {expected} values, got {got}", "write it as {example}")
-UNKNOWN_PARAMETER = _register("unknown-parameter", E, "a unit parameter that does not exist",
-    "unknown parameter '{name}'", "unit parameters are pivot, port and link{suggest}")
+UNKNOWN_PARAMETER = _register("unknown-parameter", E, "a parameter that does not exist (on a unit or a DH row)",
+    "unknown parameter '{name}'", "parameters here are {allowed}{suggest}")
 DUPLICATE_PARAMETER = _register("duplicate-parameter", E, "the same parameter twice on one unit",
     "parameter '{name}' is given twice", "keep one of them")
 DUPLICATE_STATEMENT = _register("duplicate-statement", E, "a statement that may appear once, given twice",
     "'{what}' is given twice in robot '{robot}'", "keep one of them")
-MISSING_CHAIN = _register("missing-chain", E, "a robot block without a chain",
-    "robot '{robot}' has no chain", "add e.g.: chain H1 - H4(pivot=-90deg) - L4")
+MISSING_CHAIN = _register("missing-chain", E, "a robot block without a chain or DH table",
+    "robot '{robot}' has no chain", "add e.g.: chain H1 - H4(pivot=-90deg) - L4, or a dh {{ row … }} table")
+CHAIN_AND_DH = _register("chain-and-dh", E, "a robot with both a chain and a DH table",
+    "robot '{robot}' has both a chain and a dh table", "keep one: the dh table is converted into a chain")
+DH_ROW_INCOMPLETE = _register("dh-row-incomplete", E, "a DH row without a, alpha or d",
+    "DH row {row} lacks {missing}", "write rows as: row a=0.3 m, alpha=90deg, d=0 m (theta optional)")
 NOT_FINITE = _register("not-finite", E, "a value that is infinite or not a number",
     "{what} must be a finite number", "write an ordinary decimal number")
 
@@ -133,6 +137,18 @@ EPSILON_EXCEEDED = _register("epsilon-exceeded", E, "more modules of one variant
 # --- twists ------------------------------------------------------------------------------------
 TWIST_NOT_REALISABLE = _register("twist-not-realisable", E, "a twist the library's hardware cannot set",
     "{what} {value} cannot be set: {reason}", "nearest realisable value: {nearest}")
+
+# --- DH conversion (paper section 4.2) ---------------------------------------------------------
+TWIST_ROUNDED = _register("twist-rounded", W, "a DH twist the modules can only approximate",
+    "DH row {row}: alpha {requested} is realised as {realised} ({where})", "the library sets twists in steps of {step}")
+DH_APPROXIMATION = _register("dh-approximation", N, "how closely the converted modules realise a DH table",
+    "robot '{robot}' realises its DH table within |da| <= {da}, |dalpha| <= {dalpha}, |dd| <= {dd}",
+    "{hint}")
+DH_CSV_HEADER = _register("dh-csv-header", E, "a DH CSV file whose header is not a,alpha,d,theta",
+    "the header must name the columns a, alpha, d, theta; found {found}", "the first line reads: a,alpha,d,theta (metres and radians)")
+DH_CSV_VALUE = _register("dh-csv-value", E, "a DH CSV cell that is not a finite number",
+    "row {row}, column '{column}': {problem}", "cells are plain numbers: metres for a and d, radians for alpha and theta")
+DH_CSV_EMPTY = _register("dh-csv-empty", E, "a DH CSV file without rows", "the DH table has no rows", "add one row per joint, base first")
 
 # --- names, poses, limits, environment ---------------------------------------------------------
 DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",

@@ -9,10 +9,11 @@ from pathlib import Path
 from ..diagnostics import REGISTRY, Diagnostic, codes
 from ..syntax import ast
 from . import quantities as Q
-from .robot import Design, JointLimit, Obstacle, Payload, Pose, Robot, Target, Transform, UnitSpec
+from .robot import Design, DHRow, JointLimit, Obstacle, Payload, Pose, Robot, Target, Transform, UnitSpec
 
 UNIT_PARAMS = {"pivot": "an angle", "port": "an angle", "link": "a length"}
-ONCE = ("chain", "library", "base", "tool", "payload")
+DH_PARAMS = {"a": "a length", "alpha": "an angle", "d": "a length", "theta": "an angle"}
+ONCE = ("chain", "dh", "library", "base", "tool", "payload")
 
 
 class _Lowerer:
@@ -57,24 +58,41 @@ class _Lowerer:
             return None
         return tuple(x * s for x in v.values)
 
-    def unit(self, u: ast.Unit) -> UnitSpec:
+    def params(self, params: tuple[ast.Param, ...], allowed: dict[str, str]) -> tuple[dict[str, float], dict]:
+        """Named quantities -> SI values (and their spans), reporting unknown and repeated names."""
         values: dict[str, float] = {}
         spans = {}
-        for p in u.params:
+        for p in params:
             key = p.name.text
-            if key not in UNIT_PARAMS:
-                close = difflib.get_close_matches(key, list(UNIT_PARAMS), n=1)
+            if key not in allowed:
+                close = difflib.get_close_matches(key, list(allowed), n=1)
                 suggest = f"; did you mean '{close[0]}'?" if close else ""
-                self.error(codes.UNKNOWN_PARAMETER.at(p.name.span, name=key, suggest=suggest))
+                self.error(codes.UNKNOWN_PARAMETER.at(p.name.span, name=key, allowed=", ".join(allowed), suggest=suggest))
                 continue
             if key in spans:
                 self.error(codes.DUPLICATE_PARAMETER.at(p.span, name=key))
                 continue
             spans[key] = p.span
-            v = self.quantity(p.value, UNIT_PARAMS[key], f"'{key}'")
+            v = self.quantity(p.value, allowed[key], f"'{key}'")
             if v is not None:
                 values[key] = v
+        return values, spans
+
+    def unit(self, u: ast.Unit) -> UnitSpec:
+        values, spans = self.params(u.params, UNIT_PARAMS)
         return UnitSpec(name=u.name.text, span=u.span, param_spans=spans, **values)
+
+    def dh(self, table: ast.DH) -> tuple[DHRow, ...]:
+        rows = []
+        for i, row in enumerate(table.rows, start=1):
+            values, spans = self.params(row.params, DH_PARAMS)
+            missing = [k for k in ("a", "alpha", "d") if k not in spans]
+            if missing:
+                self.error(codes.DH_ROW_INCOMPLETE.at(row.span, row=i, missing=" and ".join(missing)))
+                continue
+            if len(values) == len(spans):
+                rows.append(DHRow(span=row.span, **values))
+        return tuple(rows)
 
     def placement(self, p: ast.Placement) -> Transform:
         xyz = self.vector(p.at, "a length", f"{p.keyword} position") if p.at else None
@@ -86,7 +104,7 @@ class _Lowerer:
         seen: dict[str, object] = {}
         poses, limits, obstacles, targets, allow = [], [], [], [], set()
         for st in r.body:
-            kind = {ast.Chain: "chain", ast.Library: "library", ast.Payload: "payload"}.get(type(st))
+            kind = {ast.Chain: "chain", ast.DH: "dh", ast.Library: "library", ast.Payload: "payload"}.get(type(st))
             if isinstance(st, ast.Placement):
                 kind = st.keyword
             if kind in ONCE:
@@ -97,6 +115,9 @@ class _Lowerer:
             match st:
                 case ast.Chain():
                     fields["units"] = tuple(self.unit(u) for u in st.units)
+                case ast.DH():
+                    fields["dh"] = self.dh(st)
+                    fields["dh_fit_links"] = st.fit_links
                 case ast.Library():
                     fields["library_ref"] = st.ref
                     fields["library_dir"] = source_dir if st.is_path else None
@@ -131,7 +152,10 @@ class _Lowerer:
                         else:
                             names = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
                             self.error(codes.UNKNOWN_ALLOW.at(c.span, name=c.text, allowable=names))
-        if "chain" not in seen:
+        if "chain" in seen and "dh" in seen:
+            self.error(codes.CHAIN_AND_DH.at(seen["dh"].span, robot=r.name.text))
+            fields.pop("dh")
+        elif "chain" not in seen and "dh" not in seen:
             self.error(codes.MISSING_CHAIN.at(r.name.span, robot=r.name.text))
         fields.pop("library_span", None)
         return Robot(

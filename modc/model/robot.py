@@ -39,6 +39,16 @@ class UnitSpec(_M):
     param_spans: Annotated[SkipValidation[dict[str, Span]], Field(default_factory=dict, exclude=True, repr=False)]
 
 
+class DHRow(_M):
+    """One row of a standard DH table: Rz(theta) Tz(d) Tx(a) Rx(alpha), SI units."""
+
+    a: float
+    alpha: float
+    d: float
+    theta: float = 0.0
+    span: SpanField
+
+
 class Payload(_M):
     mass: float  # kg
     com: Vec3 = (0.0, 0.0, 0.0)  # m, in the tool0 frame
@@ -78,6 +88,8 @@ class Robot(_M):
     library_dir: str | None = None  # where a relative library path is resolved
     library: Library | None = None  # resolved by the resolve_library pass
     units: tuple[UnitSpec, ...] = ()
+    dh: tuple[DHRow, ...] | None = None  # a DH table to convert (the convert_dh pass fills units)
+    dh_fit_links: bool = False
     base: Transform = Transform()  # base_link in the world (cell) frame
     tool: Transform = Transform()  # tool0 relative to the last unit's last frame
     payload: Payload | None = None

@@ -9,12 +9,14 @@ from . import (
     check_poses,
     check_twists,
     check_units,
+    convert_dh,
     resolve_library,
 )
 from .context import Context
 
 PASSES = (
     resolve_library,
+    convert_dh,
     check_names,
     check_units,
     check_assembly,

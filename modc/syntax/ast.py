@@ -51,6 +51,21 @@ class Chain:
 
 
 @dataclass(frozen=True, slots=True)
+class DHRow:
+    params: tuple[Param, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class DH:
+    """A standard DH table, to be converted into a chain (paper section 4.2)."""
+
+    rows: tuple[DHRow, ...]
+    fit_links: bool
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
 class Library:
     ref: str  # built-in name or path (relative to the source file)
     is_path: bool
@@ -128,7 +143,7 @@ class Allow:
     span: Span
 
 
-Statement = Chain | Library | Placement | Payload | Pose | Limit | Box | Sphere | Cylinder | Target | Allow
+Statement = Chain | DH | Library | Placement | Payload | Pose | Limit | Box | Sphere | Cylinder | Target | Allow
 
 
 @dataclass(frozen=True, slots=True)

@@ -58,6 +58,13 @@ class ToAst(Transformer):
     def chain(self, meta, units):
         return ast.Chain(tuple(units), self._span(meta))
 
+    def dh_row(self, meta, params):
+        return ast.DHRow(tuple(params), self._span(meta))
+
+    def dh(self, meta, items):
+        fit, *rows = items
+        return ast.DH(tuple(rows), fit is not None, self._span(meta))
+
     def library(self, meta, items):
         t = items[0]
         if t.type == "STRING":

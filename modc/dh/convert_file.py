@@ -1,0 +1,42 @@
+"""`modc dh2mod`: a DH CSV -> checked model -> .mod text or JSON, through the normal passes."""
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+from ..diagnostics import Diagnostic
+from ..model import Design, Robot
+from ..model.write import robot_text
+from ..passes import Context, run_all
+from .report import compare
+from .table import read_csv
+
+
+def _name(path: str) -> str:
+    stem = re.sub(r"\W", "_", Path(path).stem) or "arm"
+    return stem if re.match(r"[A-Za-z_]", stem) else f"arm_{stem}"
+
+
+def convert_table(text: str, path: str, name: str | None = None, fit_links: bool = False,
+                  library: str | None = None, as_json: bool = False) -> tuple[str, list[Diagnostic], bool]:
+    rows, diags = read_csv(text, path)
+    if any(d.is_error for d in diags):
+        return "", diags, False
+    robot = Robot(name=name or _name(path), dh=tuple(rows), dh_fit_links=fit_links)
+    ctx = Context(diagnostics=diags, library_override=library)
+    design = run_all(Design(path=path, robots=(robot,)), ctx)
+    if ctx.has_errors:
+        return "", ctx.diagnostics, False
+    r = design.robots[0]
+    table = compare(r)
+    if as_json:
+        return json.dumps({"sequence": r.sequence, "joints": table}, indent=2) + "\n", ctx.diagnostics, True
+    comments = [f"Converted by modc dh2mod from {Path(path).name} (standard DH; paper section 4.2)."]
+    comments.append("joint   requested a, alpha, d        realised a, alpha, d")
+    for i, row in enumerate(table, start=1):
+        q, x = row["requested"], row["realised"]
+        comments.append(f"{i:>3}   {q['a']:.4f} m {math.degrees(q['alpha']):8.3f}° {q['d']:.4f} m"
+                        f"   {x['a']:.4f} m {math.degrees(x['alpha']):8.3f}° {x['d']:.4f} m")
+    return robot_text(r, comments), ctx.diagnostics, True

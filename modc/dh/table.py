@@ -1,0 +1,58 @@
+"""Read a DH table from CSV (header a,alpha,d,theta; metres and radians), with cell spans."""
+from __future__ import annotations
+
+import math
+
+from ..diagnostics import Diagnostic, Span, codes
+from ..model import DHRow
+
+COLUMNS = ("a", "alpha", "d", "theta")
+REQUIRED = ("a", "alpha", "d")
+
+
+def _cells(line: str) -> list[tuple[str, int]]:
+    """Comma-separated cells with their 1-based start columns (numbers need no CSV quoting)."""
+    out, col = [], 1
+    for cell in line.split(","):
+        out.append((cell, col))
+        col += len(cell) + 1
+    return out
+
+
+def read_csv(text: str, path: str) -> tuple[list[DHRow], list[Diagnostic]]:
+    diags: list[Diagnostic] = []
+    lines = [(i, l) for i, l in enumerate(text.splitlines(), start=1) if l.strip() and not l.lstrip().startswith("#")]
+    if not lines:
+        return [], [codes.DH_CSV_EMPTY.at(Span.point(path))]
+    head_no, head = lines[0]
+    names = [c.strip().lower() for c, _ in _cells(head)]
+    if sorted(set(names)) != sorted(names) or not set(REQUIRED) <= set(names) or not set(names) <= set(COLUMNS):
+        span = Span(path, head_no, 1, head_no, len(head) + 1)
+        return [], [codes.DH_CSV_HEADER.at(span, found=repr(head.strip()))]
+    rows: list[DHRow] = []
+    for row_no, (line_no, line) in enumerate(lines[1:], start=1):
+        cells = _cells(line)
+        row_span = Span(path, line_no, 1, line_no, len(line) + 1)
+        if len(cells) != len(names):
+            diags.append(codes.DH_CSV_VALUE.at(row_span, row=row_no, column="*",
+                                               problem=f"{len(cells)} cells for {len(names)} columns"))
+            continue
+        values, ok = {}, True
+        for name, (cell, col) in zip(names, cells):
+            span = Span(path, line_no, col, line_no, col + max(1, len(cell)))
+            try:
+                v = float(cell)
+            except ValueError:
+                diags.append(codes.DH_CSV_VALUE.at(span, row=row_no, column=name, problem=f"{cell.strip()!r} is not a number"))
+                ok = False
+                continue
+            if not math.isfinite(v):
+                diags.append(codes.DH_CSV_VALUE.at(span, row=row_no, column=name, problem=f"{cell.strip()} is not finite"))
+                ok = False
+                continue
+            values[name] = v
+        if ok:
+            rows.append(DHRow(span=row_span, **values))
+    if not rows and not diags:
+        diags.append(codes.DH_CSV_EMPTY.at(Span(path, head_no, 1, head_no, len(head) + 1)))
+    return rows, diags

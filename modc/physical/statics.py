@@ -1,0 +1,61 @@
+"""Static gravity torques of an assembled arm (numpy; no dynamics library needed).
+
+tau_i(q) = z_i . sum_{bodies j after joint i} (c_j - p_i) x (m_j g), base_link upright (g = -9.81 z).
+Used to choose H or L modules when converting DH tables, where only a ranking is needed; the
+`check` command refines worst cases further.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics import Chain
+from ..model import Robot
+from .assembly import describe
+
+G = np.array([0.0, 0.0, -9.81])
+
+
+class Statics:
+    def __init__(self, robot: Robot):
+        self.robot = robot
+        self.chain = Chain(robot)
+        desc = describe(robot)
+        by_name = {l.name: l for l in desc.links}
+        # bodies rigid with link_i (i = 1..n), payload folded into link_n at its tool0 offset
+        self.masses = []
+        self.coms = []  # in the link (joint) frame
+        n = robot.dof
+        for i in range(1, n + 1):
+            inert = by_name[f"link_{i}"].inertial
+            m, c = inert.mass, inert.com
+            if i == n and robot.payload is not None:
+                T = self.chain.T_last_tool()
+                pc = T[:3, :3] @ np.array(robot.payload.com) + T[:3, 3]
+                m, c = m + robot.payload.mass, (m * c + robot.payload.mass * pc) / (m + robot.payload.mass)
+            self.masses.append(m)
+            self.coms.append(np.asarray(c))
+
+    def torques(self, q) -> np.ndarray:
+        frames = self.chain.frames(q)
+        n = len(frames)
+        P = np.array([f["T_base_joint"][:3, 3] for f in frames])
+        Z = np.array([f["T_base_joint"][:3, 2] for f in frames])
+        C = np.array([f["T_base_joint"][:3, :3] @ c + f["T_base_joint"][:3, 3] for f, c in zip(frames, self.coms)])
+        M = np.array(self.masses)
+        tau = np.empty(n)
+        for i in range(n):
+            F = (M[i:, None] * (C[i:] - P[i])).sum(axis=0)
+            tau[i] = Z[i] @ np.cross(F, G)
+        return tau
+
+    def worst(self, samples: int = 256, seed: int = 0) -> np.ndarray:
+        """max_q |tau_i(q)| over random poses within the joint ranges (a lower bound of the true max)."""
+        rng = np.random.default_rng(seed)
+        lo, hi = np.array([self.robot.joint_range(i + 1) for i in range(self.robot.dof)]).T
+        best = np.zeros(self.robot.dof)
+        for q in rng.uniform(lo, hi, size=(samples, self.robot.dof)):
+            best = np.maximum(best, np.abs(self.torques(q)))
+        return best
+
+
+__all__ = ["Statics"]
