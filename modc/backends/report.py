@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 
 from .. import __version__
+from ..dh.report import compare
 from ..kinematics import Chain
 from ..physical.assembly import library_mass
 from . import Build, register
@@ -35,6 +36,7 @@ def robot_report(build: Build, robot) -> dict:
         "poses": {p.name: [_r(x) for x in p.q] for p in robot.poses},
         "tool0_at_home": [_r(x) for x in T[:3, 3]],
         "targets": {t.name: [_r(x) for x in t.xyz] for t in robot.targets},
+        "dh": compare(robot),  # realised standard DH at q = 0 (and the requested table, if any)
     }
 
 
