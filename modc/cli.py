@@ -36,6 +36,12 @@ def _print_diagnostics(diags, sources) -> None:
         _err(render_text(shown, sources))
 
 
+class TorqueLevel(str, Enum):
+    error = "error"
+    warning = "warning"
+    off = "off"
+
+
 LibraryOpt = Annotated[Optional[str], typer.Option("--library", help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file")]
 
 
@@ -46,15 +52,16 @@ def compile_cmd(
     library: LibraryOpt = None,
     only: Annotated[Optional[str], typer.Option(help="comma-separated backends to run (default: all); see `modc backends`")] = None,
     force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
+    torque: Annotated[Optional[TorqueLevel], typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
 ):
     """Check FILE and write URDF, meshes and a report into OUT."""
-    from .compiler import InputError, build, check_file, write_tree
+    from .compiler import COMPILE_ANALYSES, InputError, build, check_file, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
     try:
-        checked = check_file(file, library)
+        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=(torque or TorqueLevel.error).value)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
         raise typer.Exit(EXIT_USAGE)
@@ -141,6 +148,59 @@ def lint_cmd(
     if io_error:
         raise typer.Exit(EXIT_USAGE)
     raise typer.Exit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
+
+
+def _mass(text: str) -> float | None:
+    import math
+    import re
+
+    m = re.fullmatch(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(kg|g)?\s*", text)
+    if not m:
+        return None
+    value = float(m.group(1)) * (0.001 if m.group(2) == "g" else 1.0)
+    return value if math.isfinite(value) and value >= 0 else None
+
+
+@app.command("check")
+def check_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    payload: Annotated[Optional[str], typer.Option(help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="print the torque table as JSON")] = False,
+    library: LibraryOpt = None,
+):
+    """Torque feasibility: the worst static gravity torque of every joint over its range, against
+    the actuator's nominal and peak torque. Exit 1 if a joint can exceed its peak torque."""
+    import json
+    import math
+
+    from .compiler import COMPILE_ANALYSES, InputError, check_file
+    from .diagnostics import Span, codes
+
+    mass = None
+    if payload is not None:
+        mass = _mass(payload)
+        if mass is None:
+            _print_diagnostics([codes.BAD_PAYLOAD.at(Span.point("<command line>"), value=payload)], {})
+            raise typer.Exit(EXIT_USAGE)
+    try:
+        checked = check_file(file, library, analyses=COMPILE_ANALYSES, payload_override=mass)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    robots = [r for r in checked.design.robots if r.torque is not None]
+    if json_out:
+        doc = {"robots": [{"name": r.name, "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
+                           "joints": [j.to_json() for j in r.torque]} for r in robots]}
+        print(json.dumps(doc, indent=2))
+    else:
+        for r in robots:
+            print(f"robot {r.name} ({r.sequence}), payload {mass if mass is not None else (r.payload.mass if r.payload else 0):g} kg")
+            print(f"  {'joint':<9}{'unit':<6}{'worst |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}  worst pose (deg)")
+            for j in r.torque:
+                pose = ", ".join(f"{math.degrees(x):.0f}" for x in j.q)
+                print(f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}  ({pose})  {j.level}")
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    raise typer.Exit(EXIT_OK if checked.ok else EXIT_ERRORS)
 
 
 @app.command("dh2mod")

@@ -14,6 +14,8 @@ from .passes import Context, run_all
 from .syntax import ast
 
 YAML_SUFFIXES = (".yaml", ".yml")
+# What `modc FILE -o OUT` and `modc check` analyse beyond the checks lint runs.
+COMPILE_ANALYSES = frozenset({"torque"})
 
 
 @dataclass
@@ -62,18 +64,19 @@ def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
     return parse(text, path)
 
 
-def check_text(text: str, path: str = "<string>", library: str | None = None) -> Checked:
+def check_text(text: str, path: str = "<string>", library: str | None = None, **options) -> Checked:
+    """Parse, lower and run the passes. options go to the pass Context (analyses=…, torque_severity=…)."""
     tree, diags = parse_text(text, path)
-    ctx = Context(diagnostics=diags, library_override=library)
+    ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
     design = run_all(design, ctx)
     return Checked(design, ctx.diagnostics, {path: text})
 
 
-def check_file(path: str | os.PathLike, library: str | None = None) -> Checked:
+def check_file(path: str | os.PathLike, library: str | None = None, **options) -> Checked:
     p = str(path)
     text = read_source(p)
-    return check_text(text, p, library)
+    return check_text(text, p, library, **options)
 
 
 def build(checked: Checked, only: list[str] | None = None) -> dict[str, str | bytes]:

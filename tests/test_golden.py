@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from conftest import EXAMPLES, ROOT
-from modc.compiler import build, check_file
+from modc.compiler import COMPILE_ANALYSES, build, check_file
 
 GOLDEN = ROOT / "tests" / "golden"
 REFRESH = "refresh with: python -m pytest tests/test_golden.py --update-golden"
@@ -31,7 +31,7 @@ def _expected_files(files: dict) -> dict[str, str]:
 @pytest.mark.parametrize("example", EXAMPLES, ids=lambda p: p.stem)
 def test_golden(example: Path, update_golden: bool, monkeypatch):
     monkeypatch.chdir(ROOT)  # diagnostics in report.json name files relative to the repo
-    c = check_file(example.relative_to(ROOT))
+    c = check_file(example.relative_to(ROOT), analyses=COMPILE_ANALYSES)  # what `modc FILE -o OUT` runs
     assert c.ok
     got = _expected_files(build(c))
     folder = GOLDEN / example.stem

@@ -37,6 +37,7 @@ def robot_report(build: Build, robot) -> dict:
         "tool0_at_home": [_r(x) for x in T[:3, 3]],
         "targets": {t.name: [_r(x) for x in t.xyz] for t in robot.targets},
         "dh": compare(robot),  # realised standard DH at q = 0 (and the requested table, if any)
+        "torque": None if robot.torque is None else [j.to_json() for j in robot.torque],
     }
 
 

@@ -150,6 +150,18 @@ DH_CSV_VALUE = _register("dh-csv-value", E, "a DH CSV cell that is not a finite 
     "row {row}, column '{column}': {problem}", "cells are plain numbers: metres for a and d, radians for alpha and theta")
 DH_CSV_EMPTY = _register("dh-csv-empty", E, "a DH CSV file without rows", "the DH table has no rows", "add one row per joint, base first")
 
+# --- torque (paper section 3: epsilon comes from a worst-case torque analysis) -------------------
+TORQUE_OVER_PEAK = _register("torque-over-peak", E, "a joint whose worst static gravity torque exceeds its actuator's peak",
+    "{joint} ({unit}) must hold {tau} against gravity at q = {pose}, above its peak {tau_max}",
+    "use a stronger module there, shorter links or a lighter payload{eps}")
+TORQUE_OVER_NOMINAL = _register("torque-over-nominal", W, "a joint whose worst static gravity torque exceeds its nominal torque",
+    "{joint} ({unit}) must hold {tau} against gravity at q = {pose}, above its nominal {tau_nom} (peak {tau_max})",
+    "the actuator can hold this only briefly; use a stronger module, shorter links or a lighter payload{eps}")
+EPSILON_DISAGREES = _register("epsilon-disagrees", N, "the paper's ε rule and the torque check disagree",
+    "{message}", "ε is the paper's rule of thumb; the torque check is the physics behind it")
+BAD_PAYLOAD = _register("bad-payload", E, "a --payload value that is not a mass",
+    "--payload {value!r} is not a mass", "write e.g. --payload 0.5kg or --payload 500g (a plain number means kg)")
+
 # --- names, poses, limits, environment ---------------------------------------------------------
 DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",
     "robot '{name}' is defined twice", "rename one of them; output files are named after robots")

@@ -98,6 +98,7 @@ class Robot(_M):
     obstacles: tuple[Obstacle, ...] = ()
     targets: tuple[Target, ...] = ()
     allow: frozenset[str] = frozenset()
+    torque: tuple | None = Field(default=None, exclude=True, repr=False)  # set by check_torque
     span: SpanField
     name_span: SpanField
 

@@ -7,6 +7,7 @@ from . import (
     check_environment,
     check_names,
     check_poses,
+    check_torque,
     check_twists,
     check_units,
     convert_dh,
@@ -23,6 +24,7 @@ PASSES = (
     check_twists,
     check_poses,
     check_environment,
+    check_torque,
 )
 
 

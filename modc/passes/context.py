@@ -11,6 +11,10 @@ from ..model import Robot
 class Context:
     diagnostics: list[Diagnostic] = field(default_factory=list)
     library_override: str | None = None  # `--library` on the command line
+    # Analyses that need the dynamics model run in compile and check, not in lint (kept fast).
+    analyses: frozenset[str] = frozenset()
+    torque_severity: str = "error"  # error | warning | off: how an over-peak joint is reported
+    payload_override: float | None = None  # `check --payload MASS`, kg at tool0
 
     def report(self, d: Diagnostic, robot: Robot | None = None) -> None:
         # `allow CODE` in a robot block silences that robot's allowable rule diagnostics.

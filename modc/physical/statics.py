@@ -1,6 +1,7 @@
 """Static gravity torques of an assembled arm (numpy; no dynamics library needed).
 
-tau_i(q) = z_i . sum_{bodies j after joint i} (c_j - p_i) x (m_j g), base_link upright (g = -9.81 z).
+tau_i(q) = -z_i . sum_{bodies j after joint i} (c_j - p_i) x (m_j g): the torque holding the arm still,
+base_link upright (g = -9.81 z); the same convention as pinocchio's g(q).
 Used to choose H or L modules when converting DH tables, where only a ranking is needed; the
 `check` command refines worst cases further.
 """
@@ -45,7 +46,7 @@ class Statics:
         tau = np.empty(n)
         for i in range(n):
             F = (M[i:, None] * (C[i:] - P[i])).sum(axis=0)
-            tau[i] = Z[i] @ np.cross(F, G)
+            tau[i] = -(Z[i] @ np.cross(F, G))  # the torque that holds the arm against gravity (pinocchio's g(q))
         return tau
 
     def worst(self, samples: int = 256, seed: int = 0) -> np.ndarray:

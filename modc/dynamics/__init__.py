@@ -1,0 +1,1 @@
+"""Dynamics of a compiled robot (pinocchio) and the worst-case static torque check."""
