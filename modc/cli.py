@@ -100,20 +100,25 @@ def compile_cmd(
 class LintFormat(str, Enum):
     text = "text"
     json = "json"
+    github = "github"
+    sarif = "sarif"
 
 
 def _expand(paths: list[str]) -> list[str]:
-    """Files as given; directories searched for *.mod (sorted, for stable output)."""
+    """Files as given; directories searched for *.mod; glob patterns (also '**') expanded here,
+    so quoted patterns work in CI shells. Sorted and de-duplicated, for stable output."""
+    import glob
     from pathlib import Path
 
     out: list[str] = []
     for p in paths:
-        q = Path(p)
-        if q.is_dir():
-            out += sorted(str(f) for f in q.rglob("*.mod"))
+        if Path(p).is_dir():
+            out += sorted(str(f) for f in Path(p).rglob("*.mod"))
+        elif glob.has_magic(p):
+            out += sorted(f for f in glob.glob(p, recursive=True) if Path(f).is_file())
         else:
             out.append(p)
-    return out
+    return list(dict.fromkeys(out))
 
 
 @app.command("lint")
@@ -125,7 +130,7 @@ def lint_cmd(
 ):
     """Check files without writing anything."""
     from .compiler import InputError, check_file
-    from .diagnostics.render import render_json, summary
+    from .diagnostics.render import render_github, render_json, render_sarif, summary
 
     Verbosity.quiet = quiet
     diags, sources, io_error = [], {}, False
@@ -139,8 +144,14 @@ def lint_cmd(
             continue
         diags += c.diagnostics
         sources.update(c.sources)
+    shown = [d for d in diags if not (quiet and not d.is_error)]
     if format is LintFormat.json:
-        print(render_json(diags))
+        print(render_json(shown))
+    elif format is LintFormat.github:
+        if shown:
+            print(render_github(shown))
+    elif format is LintFormat.sarif:
+        print(render_sarif(shown, __version__))
     else:
         _print_diagnostics(diags, sources)
         if not quiet:

@@ -48,3 +48,60 @@ def summary(diags: list[Diagnostic]) -> str:
     e = sum(d.severity.value == "error" for d in diags)
     w = sum(d.severity.value == "warning" for d in diags)
     return f"{e} error{'s' * (e != 1)}, {w} warning{'s' * (w != 1)}"
+
+
+def _gh_escape(text: str, prop: bool = False) -> str:
+    # GitHub workflow-command escaping: data escapes %, CR, LF; properties also ':' and ','
+    text = text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+    if prop:
+        text = text.replace(":", "%3A").replace(",", "%2C")
+    return text
+
+
+def render_github(diags: Iterable[Diagnostic]) -> str:
+    """GitHub Actions annotations: ::error file=…,line=…,col=…,endLine=…,endColumn=…,title=…::message"""
+    level = {"error": "error", "warning": "warning", "note": "notice"}
+    lines = []
+    for d in sorted(diags, key=sort_key):
+        s = d.span
+        props = f"file={_gh_escape(s.file, True)},line={s.line},col={s.col},endLine={s.end_line},endColumn={s.end_col},title={_gh_escape('modc ' + d.code, True)}"
+        body = d.message + (f" (hint: {d.hint})" if d.hint else "")
+        lines.append(f"::{level[d.severity.value]} {props}::{_gh_escape(body)}")
+    return "\n".join(lines)
+
+
+def render_sarif(diags: Iterable[Diagnostic], version: str) -> str:
+    """SARIF 2.1.0, one run; every registered code is a rule (so rule indices are stable)."""
+    from .codes import REGISTRY
+
+    level = {"error": "error", "warning": "warning", "note": "note"}
+    names = list(REGISTRY)
+    rules = [{
+        "id": c.name,
+        "name": "".join(w.capitalize() for w in c.name.split("-")),
+        "shortDescription": {"text": c.summary},
+        "defaultConfiguration": {"level": level[c.severity.value]},
+    } for c in REGISTRY.values()]
+    results = []
+    for d in sorted(diags, key=sort_key):
+        s = d.span
+        results.append({
+            "ruleId": d.code,
+            "ruleIndex": names.index(d.code),
+            "level": level[d.severity.value],
+            "message": {"text": d.message + (f"\nhint: {d.hint}" if d.hint else "")},
+            "locations": [{"physicalLocation": {
+                "artifactLocation": {"uri": s.file.replace("\\", "/")},
+                "region": {"startLine": s.line, "startColumn": s.col, "endLine": s.end_line, "endColumn": max(s.end_col, s.col + 1)},
+            }}],
+        })
+    doc = {
+        "$schema": "https://json.schemastore.org/sarif-2.1.0.json",
+        "version": "2.1.0",
+        "runs": [{
+            "tool": {"driver": {"name": "modc", "version": version, "informationUri": "https://pypi.org/project/modc/", "rules": rules}},
+            "columnKind": "unicodeCodePoints",
+            "results": results,
+        }],
+    }
+    return json.dumps(doc, indent=2)
