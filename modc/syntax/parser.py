@@ -25,7 +25,7 @@ def grammar_keywords() -> set[str]:
     """The keywords of the grammar (used by editors' grammars and their tests)."""
     import re
 
-    return {t.pattern.value for t in _lark().terminals if t.pattern.type == "str" and re.fullmatch(r"[a-z]+", t.pattern.value)}
+    return {t.pattern.value for t in _lark().terminals if t.pattern.type == "str" and re.fullmatch(r"[a-z]+(?:-[a-z]+)*", t.pattern.value)}
 
 
 def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]]:

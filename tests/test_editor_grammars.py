@@ -1,0 +1,284 @@
+"""Editor grammars: the VS Code extension (TextMate grammar) and the Pygments lexer.
+
+Both are hand-written highlighting grammars of the language that grammar/modc.lark defines, so
+they are checked against it here: same keywords, same units of measure (modc.model.quantities).
+A keyword added to the Lark grammar fails these tests until both editor grammars know it. The
+TextMate grammar's own assertions (editors/vscode/tests/*.mod) run under vscode-tmgrammar-test
+through editors/vscode/test.sh, which needs node and npm (skipped, saying so, without npm).
+"""
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+pygments = pytest.importorskip("pygments")
+from pygments.token import Comment, Error, Keyword, Name, Number, Operator, Punctuation, String  # noqa: E402
+
+from modc.model.quantities import ALL as MEASURES  # noqa: E402
+from modc.pygments_lexer import ModLexer  # noqa: E402
+from modc.syntax import grammar_keywords  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+VSCODE = ROOT / "editors" / "vscode"
+TMLANGUAGE = VSCODE / "syntaxes" / "mod.tmLanguage.json"
+GRAMMAR_TESTS = sorted((VSCODE / "tests").glob("*.mod"))
+EXAMPLES = sorted((ROOT / "examples").glob("*.mod"))
+LEXER_FILE = ROOT / "modc" / "pygments_lexer.py"
+
+# keyword.control.<kw>.mod (statements) or keyword.other.<kw>.mod (clauses); units of measure
+# are keyword.other.unit.<unit>.mod (one segment more, so never taken for a keyword).
+KEYWORD_SCOPE = re.compile(r"keyword\.(?:control|other)\.([a-z]+(?:-[a-z]+)*)\.mod")
+MEASURE_SCOPE = re.compile(r"keyword\.other\.unit\.([a-z]+)\.mod")
+WORD = re.compile(r"[a-z]+(?:-[a-z]+)*")
+
+
+def lark_keywords() -> set[str]:
+    """Every keyword of grammar/modc.lark: grammar_keywords() (the anonymous "word" terminals)
+    plus named terminals whose pattern is a literal word, such as DH_FIT: "fit-links"."""
+    from modc.syntax.parser import _lark
+
+    named = {t.pattern.value for t in _lark().terminals if t.pattern.type == "str" and WORD.fullmatch(t.pattern.value)}
+    return set(grammar_keywords()) | named
+
+
+def scope_names(node) -> set[str]:
+    """Every scope named anywhere in a TextMate grammar (rules, captures, nested patterns)."""
+    out: set[str] = set()
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key in ("name", "contentName") and isinstance(value, str):
+                out.update(value.split())
+            else:
+                out |= scope_names(value)
+    elif isinstance(node, list):
+        for value in node:
+            out |= scope_names(value)
+    return out
+
+
+def asserted_scopes(path: Path) -> set[str]:
+    """Scopes that the vscode-tmgrammar-test assertions of a test file require (not the ones after ' - ')."""
+    out: set[str] = set()
+    for line in path.read_text(encoding="utf-8").splitlines():
+        m = re.match(r"#\s*(?:\^+|<-+|<~*-+)\s+(.*)$", line)
+        if m:
+            out.update(m.group(1).split(" - ")[0].split())
+    return out
+
+
+@pytest.fixture(scope="module")
+def tmlanguage() -> dict:
+    return json.loads(TMLANGUAGE.read_text(encoding="utf-8"))
+
+
+# --- keywords and units: one language, three grammars ---------------------------------------
+
+
+def test_lark_keywords_include_the_named_terminal():
+    keywords = lark_keywords()
+    assert "fit-links" in keywords and {"robot", "chain", "at"} <= keywords
+    assert grammar_keywords() <= keywords
+
+
+def test_textmate_keywords_match_the_lark_grammar(tmlanguage):
+    textmate = {m.group(1) for s in scope_names(tmlanguage) if (m := KEYWORD_SCOPE.fullmatch(s))}
+    lark = lark_keywords()
+    assert textmate == lark, (
+        f"editors/vscode/syntaxes/mod.tmLanguage.json lacks {sorted(lark - textmate)}, "
+        f"has extra {sorted(textmate - lark)}: give each keyword a rule with scope keyword.control.<kw>.mod "
+        "(statement) or keyword.other.<kw>.mod (clause) and an assertion in editors/vscode/tests/*.mod"
+    )
+
+
+def test_textmate_units_of_measure_match_the_model(tmlanguage):
+    textmate = {m.group(1) for s in scope_names(tmlanguage) if (m := MEASURE_SCOPE.fullmatch(s))}
+    assert textmate == set(MEASURES)
+
+
+def test_every_keyword_and_unit_is_asserted_in_the_grammar_tests():
+    asserted: set[str] = set()
+    for path in GRAMMAR_TESTS:
+        asserted |= asserted_scopes(path)
+    keywords = {m.group(1) for s in asserted if (m := KEYWORD_SCOPE.fullmatch(s))}
+    measures = {m.group(1) for s in asserted if (m := MEASURE_SCOPE.fullmatch(s))}
+    assert lark_keywords() <= keywords, f"no assertion for {sorted(lark_keywords() - keywords)}"
+    assert set(MEASURES) <= measures, f"no assertion for {sorted(set(MEASURES) - measures)}"
+
+
+def test_pygments_keywords_match_the_lark_grammar():
+    from modc import pygments_lexer
+
+    lark = lark_keywords()
+    assert set(pygments_lexer.KEYWORDS) == lark, (
+        f"modc/pygments_lexer.py lacks {sorted(lark - set(pygments_lexer.KEYWORDS))}, "
+        f"has extra {sorted(set(pygments_lexer.KEYWORDS) - lark)}"
+    )
+    assert set(pygments_lexer.MEASURES) == set(MEASURES)
+
+
+def test_pygments_lexes_every_keyword_as_a_keyword():
+    """The lists above are what the lexer does: every keyword in the grammar tests comes out as
+    Keyword (outside comments), and nothing else does."""
+    lexer = ModLexer()
+    seen, measures = set(), set()
+    for path in GRAMMAR_TESTS + EXAMPLES:
+        for ttype, value in lexer.get_tokens(path.read_text(encoding="utf-8")):
+            if ttype in Keyword.Type:
+                measures.add(value)
+            elif ttype in Keyword:
+                seen.add(value)
+    assert seen == lark_keywords()
+    assert measures == set(MEASURES)
+
+
+# --- Pygments ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("path", EXAMPLES + GRAMMAR_TESTS, ids=lambda p: p.name)
+def test_pygments_highlights_without_errors(path):
+    text = path.read_text(encoding="utf-8")
+    tokens = list(ModLexer().get_tokens(text))
+    errors = [v for t, v in tokens if t in Error]
+    assert not errors, f"{path.name}: Error tokens {errors[:10]}"
+
+
+SNIPPET = """\
+# comment
+robot farm {
+    chain H1 - L4(pivot=-90deg, port=0.5 rad) - L3(link=180mm)
+    library "libs/my.yaml"
+    payload 50 g at (0.01, 0, 0) m
+    pose ready (90, -45, -90) deg
+    box shelf size (0.6, 0.4, 0.02) m at (30, 0, 25) cm
+    limit joint_2 (-90, 90) deg
+    allow first-variant
+}
+robot dhbot {
+    dh fit-links { row a=0.3 m, alpha=-1.5e0rad, d=0 mm }
+}
+"""
+
+
+def _tokens(text: str) -> list[tuple[object, str]]:
+    return [(t, v) for t, v in ModLexer().get_tokens(text) if v.strip()]
+
+
+@pytest.mark.parametrize(
+    "value, ttype",
+    [
+        ("# comment", Comment.Single),
+        ("robot", Keyword.Declaration),
+        ("farm", Name.Class),
+        ("chain", Keyword),
+        ("H1", Name.Builtin),
+        ("L3", Name.Builtin),
+        ("-", Punctuation),
+        ("pivot", Name.Attribute),
+        ("=", Operator),
+        ("-90", Number.Float),
+        ("deg", Keyword.Type),
+        ("rad", Keyword.Type),
+        ("mm", Keyword.Type),
+        ('"libs/my.yaml"', String.Double),
+        ("payload", Keyword),
+        ("50", Number.Float),
+        ("g", Keyword.Type),
+        ("at", Keyword),
+        ("m", Keyword.Type),
+        ("ready", Name.Function),
+        ("shelf", Name.Variable),
+        ("size", Keyword),
+        ("cm", Keyword.Type),
+        ("joint_2", Name.Variable),
+        ("first-variant", Name.Constant),
+        ("fit-links", Keyword),
+        ("row", Keyword),
+        ("-1.5e0", Number.Float),
+    ],
+)
+def test_pygments_token_types(value, ttype):
+    types = {t for t, v in _tokens(SNIPPET) if v == value}
+    assert types == {ttype}, f"{value!r}: {types}"
+
+
+def test_pygments_lexer_loads_from_its_file():
+    from pygments.lexers import load_lexer_from_file
+
+    lexer = load_lexer_from_file(str(LEXER_FILE), "ModLexer")
+    assert lexer.name == "modc"
+    assert [v for _, v in lexer.get_tokens("robot r { chain H1 }") if v.strip()] == ["robot", "r", "{", "chain", "H1", "}"]
+
+
+def test_pyproject_registers_the_lexer():
+    text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    section = re.search(r'^\[project\.entry-points\."pygments\.lexers"\]\s*\n((?:[^\[\n].*\n?)*)', text, re.M)
+    assert section and re.search(r'^modc\s*=\s*"modc\.pygments_lexer:ModLexer"', section.group(1), re.M), (
+        'pyproject.toml needs [project.entry-points."pygments.lexers"] modc = "modc.pygments_lexer:ModLexer"'
+    )
+
+
+def test_pygments_finds_the_lexer_by_name_and_file_name():
+    from importlib.metadata import entry_points
+
+    if not any(ep.name == "modc" for ep in entry_points(group="pygments.lexers")):
+        pytest.skip("the pygments.lexers entry point is not installed: reinstall modc (pip install -e .)")
+    from pygments.lexers import get_lexer_by_name, get_lexer_for_filename
+
+    assert isinstance(get_lexer_by_name("modc"), ModLexer)
+    assert isinstance(get_lexer_by_name("mod"), ModLexer)
+    # Modula-2 also claims *.mod: the robot block decides
+    assert isinstance(get_lexer_for_filename("farm.mod", EXAMPLES[0].read_text(encoding="utf-8")), ModLexer)
+
+
+# --- VS Code extension ---------------------------------------------------------------------
+
+
+def test_vscode_extension_manifest(tmlanguage):
+    package = json.loads((VSCODE / "package.json").read_text(encoding="utf-8"))
+    (language,) = package["contributes"]["languages"]
+    assert language["id"] == "mod" and ".mod" in language["extensions"] and language["aliases"]
+    (grammar,) = package["contributes"]["grammars"]
+    assert grammar["language"] == "mod" and grammar["scopeName"] == tmlanguage["scopeName"] == "source.mod"
+    assert (VSCODE / grammar["path"]).resolve() == TMLANGUAGE
+    assert (VSCODE / package["main"]).is_file()
+    assert "vscode-languageclient" in package["dependencies"]
+    assert "modc.path" in package["contributes"]["configuration"]["properties"]
+    config = json.loads((VSCODE / language["configuration"]).read_text(encoding="utf-8"))
+    assert config["comments"]["lineComment"] == "#"
+    assert ["{", "}"] in config["brackets"] and ["(", ")"] in config["brackets"]
+    assert {"open": "(", "close": ")"} in config["autoClosingPairs"]
+    extension = (VSCODE / "extension.js").read_text(encoding="utf-8")
+    assert "vscode-languageclient/node" in extension and '"lsp"' in extension
+
+
+def test_grammar_tests_have_the_header():
+    assert GRAMMAR_TESTS
+    for path in GRAMMAR_TESTS:
+        assert path.read_text(encoding="utf-8").startswith('# SYNTAX TEST "source.mod"'), path.name
+
+
+def _run_grammar_tests(*files: Path) -> subprocess.CompletedProcess:
+    if shutil.which("npm") is None or shutil.which("node") is None:
+        pytest.skip("npm/node not installed: the TextMate grammar tests (editors/vscode/test.sh) need them")
+    return subprocess.run(["bash", str(VSCODE / "test.sh"), *map(str, files)], capture_output=True, text=True, timeout=600)
+
+
+def test_textmate_grammar_tests_pass():
+    r = _run_grammar_tests()
+    assert r.returncode == 0, r.stdout + r.stderr
+    for path in GRAMMAR_TESTS:
+        assert f"tests/{path.name} run successfuly" in r.stdout, r.stdout
+
+
+def test_textmate_grammar_tests_catch_a_wrong_scope(tmp_path):
+    """The harness really fails: a test file asserting a wrong scope makes test.sh exit non-zero."""
+    broken = tmp_path / "broken.mod"
+    broken.write_text('# SYNTAX TEST "source.mod"\nrobot r { chain H1 }\n#         ^^^^^ keyword.other.at.mod\n', encoding="utf-8")
+    r = _run_grammar_tests(broken)
+    assert r.returncode != 0
+    assert "missing required scopes: keyword.other.at.mod" in r.stdout, r.stdout + r.stderr
