@@ -6,11 +6,11 @@
 # `modc dh examples/example_b_dh.mod` shows requested and realised DH side by side.
 robot example_b_dh {
     dh fit-links {
-        row a=0 m,   alpha=-90deg,   d=0.148 m
-        row a=0.3 m, alpha=135deg,  d=0 m
-        row a=0.3 m, alpha=135deg,  d=0 m
-        row a=0 m,   alpha=-90deg,   d=0.148 m
-        row a=0 m,   alpha=-90deg,   d=0.148 m
-        row a=0 m,   alpha=0deg,     d=0.075 m
+        row a=0m, alpha=-90deg, d=0.148m
+        row a=0.3m, alpha=135deg, d=0m
+        row a=0.3m, alpha=135deg, d=0m
+        row a=0m, alpha=-90deg, d=0.148m
+        row a=0m, alpha=-90deg, d=0.148m
+        row a=0m, alpha=0deg, d=0.075m
     }
 }

@@ -52,6 +52,8 @@ def compile_cmd(
     library: LibraryOpt = None,
     only: Annotated[Optional[str], typer.Option(help="comma-separated backends to run (default: all); see `modc backends`")] = None,
     force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
+    collision_samples: Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")] = 10_000,
+    seed: Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")] = 0,
     torque: Annotated[Optional[TorqueLevel], typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
@@ -80,7 +82,7 @@ def compile_cmd(
         if unknown:
             _err(f"modc: unknown backend(s) {', '.join(unknown)}; available: {', '.join(load_all())}")
             raise typer.Exit(EXIT_USAGE)
-    files = build(checked, selected)
+    files = build(checked, selected, collision_samples=collision_samples, seed=seed)
     try:
         write_tree(files, out, force=force)
     except InputError as e:
@@ -264,6 +266,63 @@ def dh_cmd(
         print(json.dumps(doc, indent=2))
     else:
         print("\n\n".join(text_table(r) for r in robots))
+
+
+@app.command("fmt")
+def fmt_cmd(
+    files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
+    check: Annotated[bool, typer.Option("--check", help="write nothing; list the files that would change and exit 1 if any")] = False,
+):
+    """Rewrite .mod files in the canonical layout (comments kept, meaning unchanged)."""
+    from .compiler import YAML_SUFFIXES, InputError, read_source
+    from .syntax.format import FormatterBug, format_text, rewrite_file
+
+    diags, sources, io_error, changed = [], {}, False, []
+    for path in _expand(files):
+        if path.endswith(YAML_SUFFIXES):
+            _err(f"modc fmt: {path}: only .mod files are formatted")
+            io_error = True
+            continue
+        try:
+            text = read_source(path)
+        except InputError as e:
+            diags.append(e.diagnostic)
+            io_error = True
+            continue
+        try:
+            out, errors = format_text(text, path)
+        except FormatterBug as e:
+            _err(f"modc fmt: internal error: {e}")
+            io_error = True
+            continue
+        if out is None:  # does not parse: reported, never touched
+            diags += errors
+            sources[path] = text
+            continue
+        with open(path, "rb") as f:  # a BOM or CRLF line ends count as a change
+            if f.read() == out.encode("utf-8"):
+                continue
+        changed.append(path)
+        if not check:
+            try:
+                rewrite_file(path, out)
+            except OSError as e:
+                _err(f"modc fmt: {path}: {e.strerror or e}")
+                io_error = True
+                continue
+        print(path)
+    _print_diagnostics(diags, sources)
+    if io_error:
+        raise typer.Exit(EXIT_USAGE)
+    raise typer.Exit(EXIT_ERRORS if diags or (check and changed) else EXIT_OK)
+
+
+@app.command("lsp")
+def lsp_cmd() -> None:
+    """Language server on stdio for editors: diagnostics, hover, completion, symbols, go-to-definition, formatting."""
+    from .lsp import serve
+
+    serve()
 
 
 @app.command("schema")

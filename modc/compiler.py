@@ -79,14 +79,15 @@ def check_file(path: str | os.PathLike, library: str | None = None, **options) -
     return check_text(text, p, library, **options)
 
 
-def build(checked: Checked, only: list[str] | None = None) -> dict[str, str | bytes]:
-    """Run the backends over a design without errors. Nothing touches the disk."""
+def build(checked: Checked, only: list[str] | None = None, **options) -> dict[str, str | bytes]:
+    """Run the backends over a design without errors. Nothing touches the disk.
+    options set Build fields (collision_samples=…, seed=…)."""
     from .backends import Build, load_all
 
     assert checked.ok, "build() needs a design without errors"
     backends = load_all()
     names = [n for n in backends if only is None or n in only or n == "report"]
-    b = Build(checked.design, diagnostics=list(checked.diagnostics))
+    b = Build(checked.design, diagnostics=list(checked.diagnostics), **options)
     for name in names:
         for rel, content in backends[name].emit(b).items():
             b.files[rel] = content

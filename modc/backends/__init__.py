@@ -32,7 +32,13 @@ def register(name: str, summary: str, heavy: bool = False):
 
 
 def load_all() -> dict[str, Backend]:
-    from . import meshes, report, urdf  # noqa: F401  (registration happens on import; report last)
+    # Registration happens on import, in run order: later backends may read earlier outputs
+    # (ros reads the SRDF's group names); report runs last so that it lists every output.
+    from . import meshes, urdf  # noqa: F401
+    from . import srdf  # noqa: F401
+    from . import ros  # noqa: F401
+    from . import xacro  # noqa: F401
+    from . import report  # noqa: F401
 
     return BACKENDS
 

@@ -14,6 +14,8 @@ class Build:
     design: Design
     diagnostics: list[Diagnostic] = field(default_factory=list)  # warnings that survived the passes
     files: dict[str, str | bytes] = field(default_factory=dict)  # what earlier backends produced
+    collision_samples: int | None = None  # SRDF collision matrix: samples (None: 10,000 as MoveIt)
+    seed: int | None = None  # and its seed (None: 0)
     _descriptions: dict[str, Description] = field(default_factory=dict)
 
     @property

@@ -1,0 +1,363 @@
+"""`modc render FILE -o OUT.png [--pose NAME]`: a picture of the arm, its environment and its
+targets, in the manner of the paper's Rviz figures.
+
+PyBullet's TinyRenderer (software, so it works headless and gives the same pixels on every run)
+draws the compiled URDF's meshes in their URDF material colours, obstacles in light steel blue,
+targets as small red spheres, on a light ground with a 0.1 m grid at the world's z = 0 (lowered
+under the lowest point of the scene when something reaches below it). Background pixels (the
+segmentation mask says which) become a white-to-light-grey gradient. The frame is rendered at
+SUPERSAMPLE times the size and downsampled (Lanczos), which anti-aliases the edges.
+
+Camera. Looking at the centre of the scene's bounding box (every link, obstacle and target),
+from an elevation of 25-40° and one of eight azimuths; the distance is the smallest at which
+the whole box fits inside 90 % of the frame. With no azimuth given, each candidate view is
+rendered small, with the obstacles, and the one showing the most of the arm wins (ties: the
+first, i.e. the canonical front-left view): the farm cell's walls do not hide the arm.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import scene
+
+WIDTH, HEIGHT = 800, 600
+SUPERSAMPLE = 2
+FOV = 35.0  # degrees, vertical
+FILL = 0.9  # the scene's box fits inside this share of the frame
+GRID = 0.1  # m, ground grid spacing
+GROUND_RGB = (236, 238, 240)
+GRID_RGB = (200, 204, 210)
+BACKGROUND_TOP = (255, 255, 255)
+BACKGROUND_BOTTOM = (222, 226, 232)
+# Candidate views (azimuth from +x towards +y, elevation above the horizon), in degrees; the first
+# is the canonical one: from the front left, above, as Rviz's default orbit camera.
+VIEWS = tuple((az, el) for el in (30.0,) for az in (210.0, 150.0, 240.0, 120.0, 300.0, 60.0, 330.0, 30.0)) + (
+    (210.0, 55.0), (150.0, 55.0))
+LIGHT = dict(lightDirection=[-0.4, -0.6, 1.0], lightColor=[1.0, 1.0, 1.0], lightDistance=4.0,
+             lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.08)
+
+
+@dataclass
+class Camera:
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
+    up: tuple[float, float, float]
+    fov: float
+    aspect: float
+    near: float
+    far: float
+    azimuth: float
+    elevation: float
+
+    def matrices(self, client):
+        view = client.computeViewMatrix(self.eye, self.target, self.up)
+        proj = client.computeProjectionMatrixFOV(self.fov, self.aspect, self.near, self.far)
+        return view, proj
+
+
+def _basis(azimuth: float, elevation: float):
+    """Unit vectors: d from the target towards the eye, right, up (camera frame in the world)."""
+    import numpy as np
+
+    az, el = math.radians(azimuth), math.radians(elevation)
+    d = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    right = np.cross([0.0, 0.0, 1.0], d)
+    right /= np.linalg.norm(right)
+    up = np.cross(d, right)
+    return d, right, up
+
+
+def fit_camera(points, azimuth: float, elevation: float, aspect: float, fov: float = FOV, fill: float = FILL) -> Camera:
+    """The closest camera at this azimuth and elevation that sees every point inside `fill` of
+    the frame, aimed so that the points' projection is centred."""
+    import numpy as np
+
+    pts = np.asarray(points, dtype=float)
+    d, right, up = _basis(azimuth, elevation)
+    ty = math.tan(math.radians(fov) / 2.0) * fill
+    tx = ty * aspect
+    target = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
+    radius = float(np.linalg.norm(pts - target, axis=1).max()) or 0.1
+    dist = radius / math.sin(math.radians(fov) / 2.0)
+    for _ in range(4):  # each round: centre the projection, then the smallest distance that fits
+        rel = pts - target
+        x, y, z = rel @ right, rel @ up, rel @ d  # z towards the eye
+        # a point fits when |x| <= tx (dist - z) and |y| <= ty (dist - z): dist >= z + |x|/tx
+        dist = float(max(np.max(z + np.abs(x) / tx), np.max(z + np.abs(y) / ty)))
+        depth = dist - z
+        u, v = x / depth, y / depth  # normalised screen coordinates (times the tangents)
+        du = (u.max() + u.min()) / 2.0
+        dv = (v.max() + v.min()) / 2.0
+        if abs(du) < 1e-4 and abs(dv) < 1e-4:
+            break
+        # shift the target across the view so that the projection's centre moves to the middle
+        mean_depth = float(np.median(depth))
+        target = target + right * du * mean_depth + up * dv * mean_depth
+    rel = pts - target
+    z = rel @ d
+    dist = float(max(np.max(z + np.abs(rel @ right) / tx), np.max(z + np.abs(rel @ up) / ty)))
+    eye = target + d * dist
+    span = float(np.linalg.norm(pts - eye, axis=1).max())
+    near = max(0.01, float((dist - (rel @ d).max()) * 0.5))
+    return Camera(tuple(map(float, eye)), tuple(map(float, target)), tuple(map(float, up)), fov, aspect,
+                  near, span * 3.0 + 1.0, azimuth, elevation)
+
+
+def grid_texture(path: Path, cells_x: int, cells_y: int, px: int = 64) -> None:
+    from PIL import Image, ImageDraw
+
+    img = Image.new("RGB", (cells_x * px, cells_y * px), GROUND_RGB)
+    draw = ImageDraw.Draw(img)
+    for i in range(cells_x + 1):
+        x = min(i * px, cells_x * px - 1)
+        draw.line([(x - 1, 0), (x - 1, cells_y * px)], fill=GRID_RGB, width=3)
+    for j in range(cells_y + 1):
+        y = min(j * px, cells_y * px - 1)
+        draw.line([(0, y - 1), (cells_x * px, y - 1)], fill=GRID_RGB, width=3)
+    img.save(path)
+
+
+@dataclass
+class Stage:
+    """A PyBullet world holding every robot of a file (at its world placement) with their
+    environments and targets, a ground, and a camera fitted to what is shown."""
+
+    client: object
+    scenes: dict[str, scene.Scene]
+    tmp: Path
+    ground: int | None = None
+    camera: Camera | None = None
+    fade_centre: object = None
+    fade_radii: tuple[float, float] = (1.0, 2.0)
+
+    @classmethod
+    def build(cls, client, robots, urdfs: dict[str, Path], tmp: Path) -> "Stage":
+        placements = scene.world_placements(robots)
+        scenes = {r.name: scene.load_robot(client, r, urdfs[r.name], placements[r.name]) for r in robots}
+        return cls(client, scenes, Path(tmp))
+
+    def set(self, qs: dict[str, object]) -> None:
+        for name, q in qs.items():
+            self.scenes[name].set_q(q)
+
+    def points(self):
+        """Corners of the bounding boxes of everything shown (arm links, obstacles, targets)."""
+        import numpy as np
+
+        boxes = []
+        for s in self.scenes.values():
+            for name, i in s.links.items():
+                if name in s.geometry_links:
+                    boxes.append(self.client.getAABB(s.body, i))
+            for ob in s.obstacles.values():
+                boxes.append(self.client.getAABB(ob))
+            for t in s.targets.values():
+                pos = np.array(self.client.getBasePositionAndOrientation(t)[0])
+                boxes.append((pos - scene.TARGET_RADIUS, pos + scene.TARGET_RADIUS))
+        corners = []
+        for lo, hi in boxes:
+            lo, hi = np.asarray(lo), np.asarray(hi)
+            for k in range(8):
+                corners.append([hi[0] if k & 1 else lo[0], hi[1] if k & 2 else lo[1], hi[2] if k & 4 else lo[2]])
+        return np.array(corners)
+
+    def add_ground(self, points) -> None:
+        """A grid on z = 0 of the world (or just below the scene when it reaches lower), square
+        around the scene's footprint and large enough that its edge lies where it has faded
+        into the background (shoot() fades it from fade_radii[0] to fade_radii[1])."""
+        import numpy as np
+
+        p = scene.pybullet()
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        z = min(0.0, float(lo[2]) - 1e-3)
+        centre = (lo[:2] + hi[:2]) / 2.0
+        footprint = float(np.linalg.norm(hi[:2] - lo[:2])) / 2.0
+        size = float(np.linalg.norm(hi - lo))
+        r0 = footprint + max(0.1, 0.15 * size)
+        r1 = r0 + max(0.3, 0.6 * size)
+        self.fade_centre, self.fade_radii = centre, (r0, r1)
+        x0, x1 = math.floor((centre[0] - r1) / GRID) * GRID, math.ceil((centre[0] + r1) / GRID) * GRID
+        y0, y1 = math.floor((centre[1] - r1) / GRID) * GRID, math.ceil((centre[1] + r1) / GRID) * GRID
+        nx, ny = max(1, round((x1 - x0) / GRID)), max(1, round((y1 - y0) / GRID))
+        tex = self.tmp / "ground.png"
+        grid_texture(tex, nx, ny, px=max(8, min(64, 2048 // max(nx, ny))))
+        verts = [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]]
+        # image rows run downwards: v = 0 at the top edge of the texture
+        vis = self.client.createVisualShape(p.GEOM_MESH, vertices=verts, indices=[0, 1, 2, 0, 2, 3],
+                                            uvs=[[0, 1], [1, 1], [1, 0], [0, 0]], normals=[[0, 0, 1]] * 4,
+                                            rgbaColor=[1, 1, 1, 1])
+        self.ground = self.client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=vis)
+        self.client.changeVisualShape(self.ground, -1, textureUniqueId=self.client.loadTexture(str(tex)))
+
+    def unproject(self, camera: Camera, depth):
+        """World points of every pixel from the depth buffer (OpenGL's non-linear [0, 1] depth)."""
+        import numpy as np
+
+        H, W = depth.shape
+        n, f = camera.near, camera.far
+        lin = 2.0 * n * f / (f + n - (2.0 * depth - 1.0) * (f - n))
+        d, right, up = _basis(camera.azimuth, camera.elevation)
+        eye = np.array(camera.eye)
+        fwd = np.array(camera.target) - eye
+        fwd /= np.linalg.norm(fwd)
+        right = np.cross(fwd, camera.up)
+        right /= np.linalg.norm(right)
+        up = np.cross(right, fwd)
+        ty = math.tan(math.radians(camera.fov) / 2.0)
+        tx = ty * camera.aspect
+        u = ((np.arange(W) + 0.5) / W * 2.0 - 1.0) * tx
+        v = (1.0 - (np.arange(H) + 0.5) / H * 2.0) * ty
+        return (eye + lin[:, :, None] * (fwd + u[None, :, None] * right + v[:, None, None] * up))
+
+    def robot_bodies(self) -> set[int]:
+        return {s.body for s in self.scenes.values()}
+
+    def target_bodies(self) -> set[int]:
+        return {t for s in self.scenes.values() for t in s.targets.values()}
+
+    def choose_camera(self, points, width: int, height: int, azimuth: float | None = None,
+                      elevation: float | None = None) -> Camera:
+        """The given view, or the candidate (VIEWS) that shows the most arm and target pixels."""
+        import numpy as np
+
+        aspect = width / height
+        if azimuth is not None:
+            self.camera = self.refine(fit_camera(points, azimuth, 30.0 if elevation is None else elevation, aspect), aspect)
+            return self.camera
+        views = VIEWS if elevation is None else tuple((az, elevation) for az, _ in VIEWS[:8])
+        robots, targets = self.robot_bodies(), self.target_bodies()
+        best, best_score = None, -1.0
+        for az, el in views:
+            cam = fit_camera(points, az, el, aspect)
+            _, seg = self.shoot(cam, 160, 120, supersample=1, raw=True)
+            obj = np.where(seg >= 0, seg & ((1 << 24) - 1), -1)
+            score = float(np.isin(obj, list(robots)).sum() + 4 * np.isin(obj, list(targets)).sum())
+            if score > best_score * 1.05:  # a clearly better view replaces an earlier (more canonical) one
+                best, best_score = cam, score
+        self.camera = self.refine(best, width / height)
+        return self.camera
+
+    def refine(self, cam: Camera, aspect: float, rounds: int = 3) -> Camera:
+        """Frame the rendered silhouette (arms, obstacles, targets) instead of their bounding
+        boxes: centre it and zoom until it fills FILL of the frame (a few small renders)."""
+        import numpy as np
+
+        shown = self.robot_bodies() | self.target_bodies() | {o for s in self.scenes.values() for o in s.obstacles.values()}
+        for _ in range(rounds):
+            W, H = 240, round(240 / aspect)
+            _, seg = self.shoot(cam, W, H, supersample=1, raw=True)
+            obj = np.where(seg >= 0, seg & ((1 << 24) - 1), -1)
+            mask = np.isin(obj, list(shown))
+            if not mask.any():
+                return cam
+            rows, cols = np.nonzero(mask)
+            u0, u1 = cols.min() / W * 2 - 1, (cols.max() + 1) / W * 2 - 1
+            v0, v1 = 1 - (rows.max() + 1) / H * 2, 1 - rows.min() / H * 2
+            touching = cols.min() == 0 or rows.min() == 0 or cols.max() == W - 1 or rows.max() == H - 1
+            scale = max((u1 - u0) / 2, (v1 - v0) / 2) / FILL
+            if touching:
+                scale = max(scale, 1.25)  # cut off by the frame: back off before measuring again
+            eye, target = np.array(cam.eye), np.array(cam.target)
+            dist = float(np.linalg.norm(eye - target))
+            fwd = (target - eye) / dist
+            right = np.cross(fwd, cam.up)
+            right /= np.linalg.norm(right)
+            up = np.cross(right, fwd)
+            ty = math.tan(math.radians(cam.fov) / 2.0)
+            shift = right * (u0 + u1) / 2 * ty * aspect * dist + up * (v0 + v1) / 2 * ty * dist
+            target = target + shift
+            dist *= scale
+            eye = target - fwd * dist
+            cam = Camera(tuple(map(float, eye)), tuple(map(float, target)), cam.up, cam.fov, cam.aspect,
+                         max(0.01, cam.near * scale), cam.far, cam.azimuth, cam.elevation)
+            if abs(scale - 1.0) < 0.02 and abs(u0 + u1) < 0.02 and abs(v0 + v1) < 0.02:
+                break
+        return cam
+
+    def shoot(self, camera: Camera, width: int, height: int, supersample: int = SUPERSAMPLE, raw: bool = False):
+        """Render. raw: (rgb uint8 array, segmentation array) at the rendered size; else a PIL image
+        of width x height with the background replaced by the gradient."""
+        import numpy as np
+
+        p = scene.pybullet()
+        W, H = width * supersample, height * supersample
+        view, proj = camera.matrices(self.client)
+        _, _, rgba, depth, seg = self.client.getCameraImage(
+            W, H, view, proj, shadow=0, renderer=p.ER_TINY_RENDERER,
+            flags=p.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX, **LIGHT)
+        rgb = np.asarray(rgba, dtype=np.uint8).reshape(H, W, 4)[:, :, :3]
+        seg = np.asarray(seg, dtype=np.int64).reshape(H, W)
+        if raw:
+            return rgb, seg
+        from PIL import Image
+
+        t = np.linspace(0.0, 1.0, H)[:, None, None]
+        bg = (np.array(BACKGROUND_TOP) * (1 - t) + np.array(BACKGROUND_BOTTOM) * t) * np.ones((1, W, 1))
+        out = np.where((seg < 0)[:, :, None], bg, rgb.astype(float))
+        if self.ground is not None:
+            # the ground fades into the background with the distance from the scene's centre
+            depth = np.asarray(depth, dtype=float).reshape(H, W)
+            xy = self.unproject(camera, depth)[:, :, :2]
+            r = np.linalg.norm(xy - self.fade_centre, axis=2)
+            a = np.clip((r - self.fade_radii[0]) / (self.fade_radii[1] - self.fade_radii[0]), 0.0, 1.0)
+            a = a * a * (3.0 - 2.0 * a)  # smoothstep
+            ground = ((seg & ((1 << 24) - 1)) == self.ground)[:, :, None]
+            out = np.where(ground, out * (1.0 - a[:, :, None]) + bg * a[:, :, None], out)
+        out = out.round().astype(np.uint8)
+        img = Image.fromarray(out, "RGB")
+        if supersample != 1:
+            img = img.resize((width, height), Image.LANCZOS)
+        return img
+
+
+def save_png(img, out: str | Path) -> None:
+    """Optimised PNG, no metadata (deterministic bytes)."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    img.save(out, format="PNG", optimize=True)
+
+
+def pose_of(robot, pose: str | None) -> tuple[float, ...]:
+    if pose is None or pose == "home":
+        return tuple(robot.home())
+    p = robot.pose(pose)
+    if p is None:
+        names = ", ".join(["home"] + [x.name for x in robot.poses if x.name != "home"])
+        raise scene.UsageError(f"robot {robot.name} has no pose '{pose}' (poses: {names})")
+    return tuple(p.q)
+
+
+def render(path, out_png, pose: str | None = None, robot: str | None = None, library: str | None = None,
+           width: int = WIDTH, height: int = HEIGHT, azimuth: float | None = None, elevation: float | None = None):
+    """`modc render FILE -o OUT.png`. Returns (ok, report lines, checked).
+
+    Every robot of the file (or the one named) at `pose` (default home), with its obstacles and
+    targets. ok is False only when the file has errors (checked.diagnostics say which; nothing is
+    written). Raises modc.compiler.InputError (unreadable file), scene.UsageError (unknown robot
+    or pose) and OSError (cannot write OUT.png).
+    """
+    import tempfile
+
+    checked = scene.load_checked(path, library)
+    if not checked.ok:
+        return False, [], checked
+    robots = scene.select_robots(checked, robot)
+    qs = {r.name: pose_of(r, pose) for r in robots}
+    with scene.compiled(checked) as urdfs, scene.connect() as client, tempfile.TemporaryDirectory(prefix="modc-render-") as tmp:
+        img, cam = picture(client, robots, urdfs, qs, Path(tmp), width, height, azimuth, elevation)
+    save_png(img, out_png)
+    who = ", ".join(f"{r.name} ({r.sequence}) at {pose or 'home'}" for r in robots)
+    return True, [f"render: wrote {out_png} ({width}x{height}): {who}; camera azimuth {cam.azimuth:g}°, elevation {cam.elevation:g}°"], checked
+
+
+def picture(client, robots, urdfs, qs, tmp: Path, width: int = WIDTH, height: int = HEIGHT,
+            azimuth: float | None = None, elevation: float | None = None):
+    """(PIL image, camera) of the robots at qs in a fresh stage on this client."""
+    stage = Stage.build(client, robots, urdfs, tmp)
+    stage.set(qs)
+    pts = stage.points()
+    stage.add_ground(pts)
+    cam = stage.choose_camera(pts, width, height, azimuth, elevation)
+    return stage.shoot(cam, width, height), cam

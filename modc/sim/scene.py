@@ -1,0 +1,501 @@
+"""A PyBullet world built from a checked robot: the compiled URDF and meshes, the environment and
+the targets. Shared by `modc sim`, `modc render`, `modc play` (and `modc plan`).
+
+    from modc.sim import scene
+    checked = scene.load_checked("examples/farm.mod")          # Checked (errors left to the caller)
+    with scene.compiled(checked) as urdfs, scene.connect() as client:
+        s = scene.load_robot(client, robot, urdfs[robot.name])  # arm + obstacles + target markers
+        s.set_q(q)                                              # kinematic: joints teleported
+        s.self_collisions(), s.environment_collisions()         # link pairs in contact, with depths
+        s.T_base_link("tool0")                                  # 4x4 in base_link
+
+Frames. The world is the cell frame: base_link is placed at robot.base (identity when the file
+has no `base` line), gravity points along -z of the world, so a tilted base is felt by the
+joints exactly as the torque analysis assumes. The file gives obstacles and targets in base_link
+(SPEC section 4); they are carried into the world through the same placement,
+T_world_obstacle = T_world_base · T_base_obstacle. Results are reported in base_link.
+
+Collision geometry. PyBullet turns every <collision> mesh of a moving link into its convex hull
+(one hull per mesh, so a link is a compound of hulls). Hulls contain the meshes, so a pair found
+apart is apart; a pair found in contact may only touch the hull of a concave part (the input
+casings and twist units are concave). Contacts are reported only beyond CONTACT_TOL of
+penetration: surfaces that merely touch (float32 geometry) are not collisions.
+
+Adjacent links (never checked against each other): parent and child of a joint; links without
+collision geometry (tool0, payload) are collapsed first, so their neighbours become adjacent
+(MoveIt's rule, as in the SRDF backend).
+"""
+from __future__ import annotations
+
+import contextlib
+import itertools
+import os
+import sys
+import tempfile
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..model import Robot
+
+CONTACT_TOL = 1e-3  # m of hull penetration below which two bodies only touch
+TARGET_RADIUS = 0.012  # m, the visual-only sphere marking a target
+OBSTACLE_RGBA = (0.62, 0.70, 0.78, 1.0)
+TARGET_RGBA = (0.86, 0.12, 0.22, 1.0)
+GRAVITY = 9.81  # m/s², the value modc.dynamics uses
+
+
+class UsageError(Exception):
+    """A request that cannot be served (unknown robot or pose, unreadable trajectory): exit 2."""
+
+
+# ------------------------------------------------------------------------------------------------
+# Loading and compiling
+
+
+def load_checked(path, library: str | None = None):
+    """check_file without the torque analysis (the simulator finds out for itself).
+    Raises modc.compiler.InputError when the file cannot be read."""
+    from ..compiler import check_file
+
+    return check_file(path, library)
+
+
+def select_robots(checked, robot: str | None = None) -> list[Robot]:
+    robots = list(checked.design.robots)
+    if robot is None:
+        return robots
+    chosen = [r for r in robots if r.name == robot]
+    if not chosen:
+        names = ", ".join(r.name for r in robots) or "none"
+        raise UsageError(f"{checked.design.path} has no robot '{robot}' (robots: {names})")
+    return chosen
+
+
+@contextlib.contextmanager
+def compiled(checked) -> Iterator[dict[str, Path]]:
+    """The urdf and meshes backends' output written into a temporary directory (removed on exit):
+    robot name -> URDF path. The same bytes `modc FILE -o OUT` writes."""
+    from ..compiler import build
+
+    files = build(checked, ["urdf", "meshes"])
+    with tempfile.TemporaryDirectory(prefix="modc-sim-") as tmp:
+        root = Path(tmp)
+        for rel, content in files.items():
+            target = root / rel
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if isinstance(content, bytes):
+                target.write_bytes(content)
+            else:
+                target.write_text(content, encoding="utf-8", newline="\n")
+        yield {r.name: root / "urdf" / f"{r.file_stem}.urdf" for r in checked.design.robots}
+
+
+# ------------------------------------------------------------------------------------------------
+# PyBullet's C-level output
+
+
+@dataclass
+class Captured:
+    text: str = ""
+
+
+@contextlib.contextmanager
+def captured_output() -> Iterator[Captured]:
+    """Redirect the process's stdout and stderr file descriptors (PyBullet prints from C, e.g.
+    "pybullet build time" on import and b3Warning lines while loading) into a buffer."""
+    out = Captured()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    with tempfile.TemporaryFile(mode="w+b") as buf:
+        try:
+            os.dup2(buf.fileno(), 1)
+            os.dup2(buf.fileno(), 2)
+            yield out
+        finally:
+            with contextlib.suppress(Exception):
+                sys.stdout.flush()
+                sys.stderr.flush()
+            _c_flush()
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            os.close(saved[0])
+            os.close(saved[1])
+            buf.seek(0)
+            out.text = buf.read().decode("utf-8", "replace")
+
+
+def _c_flush() -> None:
+    """fflush(NULL): C stdio buffers what it prints into a pipe or file; flush it while the
+    descriptors still point at the buffer."""
+    with contextlib.suppress(Exception):
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+
+
+def pybullet():
+    """The pybullet module, imported quietly."""
+    if "pybullet" not in sys.modules:
+        with captured_output():
+            import pybullet  # noqa: F401
+    return sys.modules["pybullet"]
+
+
+def display_available() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+@contextlib.contextmanager
+def connect(gui: bool = False) -> Iterator:
+    """A PyBullet client (pybullet_utils BulletClient): DIRECT, or GUI when asked for and a
+    display answers (falls back to DIRECT). Disconnected on exit. client.gui says which."""
+    p = pybullet()
+    from pybullet_utils.bullet_client import BulletClient
+
+    client = None
+    with captured_output():
+        if gui and display_available():
+            try:
+                client = BulletClient(connection_mode=p.GUI)
+                client.gui = True
+            except Exception:  # pybullet.error: cannot connect to the display
+                client = None
+        if client is None:
+            client = BulletClient(connection_mode=p.DIRECT)
+            client.gui = False
+    try:
+        client.setGravity(0, 0, -GRAVITY)
+        yield client
+    finally:
+        with contextlib.suppress(Exception):
+            client.disconnect()
+
+
+# ------------------------------------------------------------------------------------------------
+# Transforms
+
+
+def transform(xyz, rpy):
+    from ..kinematics import transform as t
+
+    return t(xyz, rpy)
+
+
+def pose_matrix(pos, quat):
+    """4x4 from a PyBullet position and (x, y, z, w) quaternion."""
+    import numpy as np
+
+    x, y, z, w = quat
+    T = np.eye(4)
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, 3] = pos
+    return T
+
+
+def matrix_pose(T) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """Position and (x, y, z, w) quaternion of a 4x4 (Shepperd's method)."""
+    import numpy as np
+
+    R = np.asarray(T)[:3, :3]
+    tr = np.trace(R)
+    if tr > 0:
+        s = 2.0 * np.sqrt(tr + 1.0)
+        w, x, y, z = 0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s
+    elif R[0, 0] > R[1, 1] and R[0, 0] > R[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + R[0, 0] - R[1, 1] - R[2, 2])
+        w, x, y, z = (R[2, 1] - R[1, 2]) / s, 0.25 * s, (R[0, 1] + R[1, 0]) / s, (R[0, 2] + R[2, 0]) / s
+    elif R[1, 1] > R[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + R[1, 1] - R[0, 0] - R[2, 2])
+        w, x, y, z = (R[0, 2] - R[2, 0]) / s, (R[0, 1] + R[1, 0]) / s, 0.25 * s, (R[1, 2] + R[2, 1]) / s
+    else:
+        s = 2.0 * np.sqrt(1.0 + R[2, 2] - R[0, 0] - R[1, 1])
+        w, x, y, z = (R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, 0.25 * s
+    pos = tuple(float(v) for v in np.asarray(T)[:3, 3])
+    return pos, (float(x), float(y), float(z), float(w))
+
+
+def reach(robot: Robot) -> float:
+    """An upper bound of the distance from base_link to any point of the arm: the sum of the
+    chain's fixed offsets plus a module's radius."""
+    import numpy as np
+
+    from ..kinematics import Chain
+
+    chain = Chain(robot)
+    total = 0.0
+    for i, u in enumerate(chain.units):
+        total += np.hypot(u.x01, u.z01) + u.z12 + u.x23
+    total += float(np.linalg.norm(chain.T_flange_tool[:3, 3]))
+    return total + 0.05
+
+
+def world_placements(robots: list[Robot]) -> dict[str, "object"]:
+    """robot name -> T_world_base. Each robot sits at its `base`; when two robots of one file
+    share a placement (both at the default origin, say), they are lined up along the world's y
+    axis, one reach apart, so that a picture shows them side by side instead of overlapping."""
+    import numpy as np
+
+    T = {r.name: transform(r.base.xyz, r.base.rpy) for r in robots}
+    same = any(np.allclose(T[a.name], T[b.name], atol=1e-9) for a, b in itertools.combinations(robots, 2))
+    if same:
+        spacing = 2.0 * max(reach(r) for r in robots) + 0.1
+        for k, r in enumerate(robots):
+            shift = np.eye(4)
+            shift[1, 3] = k * spacing
+            T[r.name] = shift @ T[r.name]
+    return T
+
+
+# ------------------------------------------------------------------------------------------------
+# The scene
+
+
+@dataclass(frozen=True)
+class Contact:
+    a: str  # link name
+    b: str  # link or obstacle name
+    distance: float  # m, negative = penetration depth
+
+    @property
+    def depth(self) -> float:
+        return -self.distance
+
+
+@dataclass
+class Scene:
+    client: object
+    robot: Robot
+    urdf: Path
+    body: int
+    T_world_base: object  # 4x4 numpy
+    joint_names: list[str]  # joint_1 … joint_n
+    joints: dict[str, int]  # joint name -> PyBullet joint index
+    links: dict[str, int]  # link name -> PyBullet link index (base_link = -1)
+    parents: dict[str, str]  # link -> parent link
+    geometry_links: list[str]  # links with collision shapes, in URDF order
+    limits: dict[str, tuple[float, float, float, float]]  # joint -> (lower, upper, effort, velocity)
+    obstacles: dict[str, int] = field(default_factory=dict)  # obstacle name -> body
+    targets: dict[str, int] = field(default_factory=dict)  # target name -> visual-only body
+    load_log: str = ""  # what PyBullet printed while loading
+
+    # -- joints ----------------------------------------------------------------------------------
+    def set_q(self, q) -> None:
+        """Teleport the joints to q (joint_1 first), zero velocity."""
+        for name, v in zip(self.joint_names, q, strict=True):
+            self.client.resetJointState(self.body, self.joints[name], float(v), 0.0)
+
+    def q(self):
+        import numpy as np
+
+        return np.array([s[0] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+
+    def qd(self):
+        import numpy as np
+
+        return np.array([s[1] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+
+    def applied_torques(self):
+        import numpy as np
+
+        return np.array([s[3] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+
+    def release_motors(self) -> None:
+        """PyBullet starts every joint with a velocity motor (a brake); switch them off."""
+        p = pybullet()
+        idx = [self.joints[n] for n in self.joint_names]
+        self.client.setJointMotorControlArray(self.body, idx, p.VELOCITY_CONTROL, forces=[0.0] * len(idx))
+
+    def hold(self, q, max_velocity: bool = True) -> None:
+        """Position control towards q: force = the URDF effort (the actuator's peak torque),
+        maxVelocity = the URDF velocity (its rated speed); PyBullet's default gains."""
+        p = pybullet()
+        for name, v in zip(self.joint_names, q, strict=True):
+            lo, hi, effort, vel = self.limits[name]
+            kw = {"maxVelocity": vel} if max_velocity else {}
+            self.client.setJointMotorControl2(self.body, self.joints[name], p.POSITION_CONTROL, targetPosition=float(v),
+                                              targetVelocity=0.0, force=effort, **kw)
+
+    def gravity_torques(self, q):
+        """Static joint torques holding the arm at q (PyBullet's inverse dynamics)."""
+        import numpy as np
+
+        n = len(self.joint_names)
+        return np.array(self.client.calculateInverseDynamics(self.body, [float(v) for v in q], [0.0] * n, [0.0] * n))
+
+    # -- frames ----------------------------------------------------------------------------------
+    def T_world_link(self, name: str):
+        import numpy as np
+
+        i = self.links[name]
+        if i == -1:
+            pos, orn = self.client.getBasePositionAndOrientation(self.body)
+            local = self.client.getDynamicsInfo(self.body, -1)
+            return pose_matrix(pos, orn) @ np.linalg.inv(pose_matrix(local[3], local[4]))
+        s = self.client.getLinkState(self.body, i, computeForwardKinematics=True)
+        return pose_matrix(s[4], s[5])  # the URDF link frame (not the inertial frame)
+
+    def T_base_link(self, name: str):
+        import numpy as np
+
+        return np.linalg.inv(self.T_world_base) @ self.T_world_link(name)
+
+    def link_origins_world(self):
+        """Every link frame's origin in the world (for framing a camera)."""
+        import numpy as np
+
+        return np.array([self.T_world_link(n)[:3, 3] for n in self.links])
+
+    # -- collisions ------------------------------------------------------------------------------
+    def adjacent_pairs(self) -> set[frozenset[str]]:
+        """Parent-child pairs, after collapsing links without collision geometry (tool0,
+        payload): their neighbours become adjacent to each other."""
+        nbrs: dict[str, set[str]] = {n: set() for n in self.links}
+        for child, parent in self.parents.items():
+            nbrs[child].add(parent)
+            nbrs[parent].add(child)
+        for bare in [n for n in self.links if n not in self.geometry_links]:
+            around = nbrs.pop(bare)
+            for a in around:
+                nbrs[a].discard(bare)
+                nbrs[a] |= around - {a}
+        return {frozenset((a, b)) for a, bs in nbrs.items() for b in bs}
+
+    def self_collision_pairs(self, allowed: Iterable[Iterable[str]] = ()) -> list[tuple[str, str]]:
+        """Link pairs to check: links with geometry, not adjacent, not in `allowed`."""
+        skip = self.adjacent_pairs() | {frozenset(p) for p in allowed}
+        return [(a, b) for a, b in itertools.combinations(self.geometry_links, 2) if frozenset((a, b)) not in skip]
+
+    def self_collisions(self, allowed: Iterable[Iterable[str]] = (), tol: float = CONTACT_TOL) -> list[Contact]:
+        """Pairs of links (not adjacent, not allowed) whose hulls interpenetrate by more than tol,
+        deepest first."""
+        self.client.performCollisionDetection()
+        out = []
+        for a, b in self.self_collision_pairs(allowed):
+            pts = self.client.getClosestPoints(self.body, self.body, 0.0, self.links[a], self.links[b])
+            if pts:
+                d = min(pt[8] for pt in pts)
+                if d < -tol:
+                    out.append(Contact(a, b, float(d)))
+        return sorted(out, key=lambda c: (c.distance, c.a, c.b))
+
+    def environment_collisions(self, tol: float = CONTACT_TOL) -> list[Contact]:
+        """(link, obstacle) pairs whose shapes interpenetrate by more than tol, deepest first."""
+        out = []
+        for oname, ob in self.obstacles.items():
+            for lname in self.geometry_links:
+                pts = self.client.getClosestPoints(self.body, ob, 0.0, self.links[lname], -1)
+                if pts:
+                    d = min(pt[8] for pt in pts)
+                    if d < -tol:
+                        out.append(Contact(lname, oname, float(d)))
+        return sorted(out, key=lambda c: (c.distance, c.a, c.b))
+
+    def environment_physics(self, enabled: bool) -> None:
+        """Whether obstacles push the arm in the dynamics (off by default: they are checked
+        geometrically, so a pose inside a shelf is reported instead of exploding)."""
+        for ob in self.obstacles.values():
+            for i in self.links.values():
+                self.client.setCollisionFilterPair(self.body, ob, i, -1, int(enabled))
+
+    def remove(self) -> None:
+        for b in [self.body, *self.obstacles.values(), *self.targets.values()]:
+            self.client.removeBody(b)
+
+
+def load_robot(client, robot: Robot, urdf: Path, T_world_base=None, *, environment: bool = True,
+               targets: bool = True) -> Scene:
+    """Load the robot's URDF (fixed base at T_world_base, default robot.base), its obstacles as
+    static bodies (collision + visual) and its targets as visual-only spheres. The arm is loaded
+    with the URDF's inertias, without self-collision in the dynamics (checked geometrically),
+    its motors released, and the obstacles do not push it (Scene.environment_physics)."""
+    import numpy as np
+
+    p = pybullet()
+    T_world_base = transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else np.asarray(T_world_base, dtype=float)
+    pos, orn = matrix_pose(T_world_base)
+    with captured_output() as log:
+        body = client.loadURDF(str(urdf), basePosition=pos, baseOrientation=orn, useFixedBase=True,
+                               flags=p.URDF_USE_INERTIA_FROM_FILE)
+    links = {"base_link": -1}
+    joints, parents, limits = {}, {}, {}
+    names_by_index = {-1: "base_link"}
+    for j in range(client.getNumJoints(body)):
+        info = client.getJointInfo(body, j)
+        link = info[12].decode()
+        links[link] = j
+        names_by_index[j] = link
+        if info[2] == p.JOINT_REVOLUTE:
+            jname = info[1].decode()
+            joints[jname] = j
+            limits[jname] = (float(info[8]), float(info[9]), float(info[10]), float(info[11]))
+    for j in range(client.getNumJoints(body)):
+        info = client.getJointInfo(body, j)
+        parents[names_by_index[j]] = names_by_index[info[16]]
+    joint_names = [f"joint_{i}" for i in range(1, robot.dof + 1)]
+    missing = [n for n in joint_names if n not in joints]
+    if missing:
+        raise RuntimeError(f"{urdf.name}: PyBullet found no revolute joint(s) {', '.join(missing)}")
+    geometry_links = [n for n, i in links.items() if client.getCollisionShapeData(body, i)]
+    s = Scene(client, robot, Path(urdf), body, T_world_base, joint_names, joints, links, parents, geometry_links,
+              limits, load_log=log.text)
+    if environment:
+        for ob in robot.obstacles:
+            s.obstacles[ob.name] = add_obstacle(client, ob, T_world_base)
+        s.environment_physics(False)
+    if targets:
+        for t in robot.targets:
+            s.targets[t.name] = add_marker(client, (T_world_base @ np.array([*t.xyz, 1.0]))[:3])
+    s.release_motors()
+    s.set_q(robot.home())
+    return s
+
+
+def add_obstacle(client, ob, T_world_base, rgba=OBSTACLE_RGBA) -> int:
+    """A static body for a box (full extents), sphere (radius) or cylinder (radius, length along
+    its z), at T_world_base · origin."""
+    p = pybullet()
+    if ob.shape == "box":
+        half = [v / 2.0 for v in ob.size]
+        col = client.createCollisionShape(p.GEOM_BOX, halfExtents=half)
+        vis = client.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=rgba)
+    elif ob.shape == "sphere":
+        col = client.createCollisionShape(p.GEOM_SPHERE, radius=ob.size[0])
+        vis = client.createVisualShape(p.GEOM_SPHERE, radius=ob.size[0], rgbaColor=rgba)
+    elif ob.shape == "cylinder":
+        col = client.createCollisionShape(p.GEOM_CYLINDER, radius=ob.size[0], height=ob.size[1])
+        vis = client.createVisualShape(p.GEOM_CYLINDER, radius=ob.size[0], length=ob.size[1], rgbaColor=rgba)
+    else:  # pragma: no cover - the model admits only these three
+        raise ValueError(f"unknown obstacle shape {ob.shape}")
+    pos, orn = matrix_pose(T_world_base @ transform(ob.origin.xyz, ob.origin.rpy))
+    return client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                                  basePosition=pos, baseOrientation=orn)
+
+
+def add_marker(client, xyz_world, rgba=TARGET_RGBA, radius: float = TARGET_RADIUS) -> int:
+    """A visual-only sphere (no collision shape: nothing ever touches it)."""
+    p = pybullet()
+    vis = client.createVisualShape(p.GEOM_SPHERE, radius=radius, rgbaColor=rgba)
+    return client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=vis,
+                                  basePosition=[float(v) for v in xyz_world])
+
+
+# ------------------------------------------------------------------------------------------------
+# SRDF
+
+
+def srdf_disabled_pairs(srdf: str | Path, include_never: bool = False) -> set[frozenset[str]]:
+    """<disable_collisions> pairs of a MoveIt SRDF. Pairs disabled as "Never" (never seen in
+    contact while sampling: skipped by MoveIt for speed, not because contact is fine) are left
+    out unless include_never: a held pose that brings them into contact is a real collision."""
+    import xml.etree.ElementTree as ET
+
+    out = set()
+    for e in ET.parse(srdf).getroot().iter("disable_collisions"):
+        if e.get("reason") == "Never" and not include_never:
+            continue
+        out.add(frozenset((e.get("link1"), e.get("link2"))))
+    return out

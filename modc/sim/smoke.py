@@ -1,0 +1,267 @@
+"""`modc sim FILE`: a PyBullet smoke test of every robot in a file.
+
+For each robot, its URDF and meshes (exactly what `modc FILE -o OUT` writes) are loaded into a
+headless PyBullet world (scene.py: base_link at `base`, gravity -z of the world, obstacles as
+static bodies), then:
+
+  load      PyBullet prints nothing while loading (any b3Warning / b3Error / "failed" line is a
+            failure, quoted), every URDF link has an <inertial> with positive mass and principal
+            moments, and PyBullet sees one revolute joint per module.
+  per pose  `home` (the pose named home, else all zeros), then every other named pose:
+    FK          PyBullet's tool0 frame equals modc.kinematics (SPEC section 2) to FK_POS_TOL /
+                FK_ROT_TOL: the pip wheel of PyBullet computes in single precision, so 1e-6 m and
+                1e-5 (rotation-matrix entries), not the 1e-9 the double-precision consumers meet.
+    self        no two links collide, except adjacent ones (parent-child, and neighbours of a
+                link without geometry such as tool0) and, when an SRDF is given, the pairs it
+                disables as Adjacent / Default / Always ("Never" pairs are checked: they are
+                disabled for MoveIt's speed, a pose that brings them into contact is a collision).
+    environment no link is inside an obstacle.
+    hold        the joints are put at the pose at rest, every actuator holds its target with
+                POSITION_CONTROL (force = the URDF effort = the actuator's peak torque,
+                maxVelocity = the URDF velocity = its rated speed), and HOLD_TIME of simulated
+                time passes at 1 kHz (the rate of the Kinova actuators' control loop). Then:
+                every joint stays within TRACK_TOL of its target over the last SETTLE_WINDOW,
+                and nothing explodes (finite states, |velocity| < EXPLODE_VELOCITY).
+
+Why TRACK_TOL = 1e-2 rad. PyBullet's POSITION_CONTROL is a velocity servo solved as a
+constraint: it leaves a numerical steady-state error of about tau_gravity · dt² / (kp · inertia),
+which is no property of the arm. At 1 kHz and PyBullet's default gains it is at most 1.5e-4 rad
+over the examples (2.5e-3 rad at PyBullet's default 240 Hz, hence the finer step). A joint whose
+actuator cannot hold the arm saturates at its peak torque and falls: tenths of a radian within
+the first second. 1e-2 rad (0.57°, 2 mm at the end of a 0.22 m link) separates the two by more
+than an order of magnitude on both sides. When a joint fails, the message gives PyBullet's
+static gravity torque at the pose next to the actuator's peak.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import scene
+
+TIME_STEP = 1e-3  # s
+HOLD_TIME = 2.0  # s of simulated time per pose
+SETTLE_WINDOW = 0.5  # s: tracking is judged over the end of the hold
+TRACK_TOL = 1e-2  # rad
+EXPLODE_VELOCITY = 50.0  # rad/s: no falling module comes near this; beyond it the simulation diverged
+FK_POS_TOL = 1e-6  # m
+FK_ROT_TOL = 1e-5
+SATURATION = 0.999  # |applied torque| >= this share of the effort: the motor is at its limit
+WARNING_LINE = re.compile(r"warning|error|failed|cannot|unable", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class Failure:
+    kind: str  # load | fk | self-collision | environment | sag | unstable
+    message: str  # complete sentence, names the robot and pose
+    joint: str | None = None
+    links: tuple[str, ...] = ()
+
+
+@dataclass
+class PoseResult:
+    name: str
+    q: tuple[float, ...]
+    track_error: list[float] = field(default_factory=list)  # rad per joint, worst over the window
+    fk_pos_error: float = 0.0
+    fk_rot_error: float = 0.0
+    max_velocity: float = 0.0
+    failures: list[Failure] = field(default_factory=list)
+
+
+@dataclass
+class RobotResult:
+    robot: str
+    sequence: str
+    poses: list[PoseResult] = field(default_factory=list)
+    failures: list[Failure] = field(default_factory=list)  # load failures
+
+    @property
+    def all_failures(self) -> list[Failure]:
+        return self.failures + [f for p in self.poses for f in p.failures]
+
+    @property
+    def ok(self) -> bool:
+        return not self.all_failures
+
+
+def _deg(x: float) -> str:
+    return f"{math.degrees(x):.1f}°"
+
+
+def check_urdf_inertials(urdf: Path) -> list[str]:
+    """Links of the URDF without a usable <inertial> (PyBullet would silently give them 1 kg)."""
+    import xml.etree.ElementTree as ET
+
+    bad = []
+    for link in ET.parse(urdf).getroot().iter("link"):
+        name = link.get("name")
+        inertial = link.find("inertial")
+        if inertial is None or inertial.find("mass") is None or inertial.find("inertia") is None:
+            bad.append(f"link {name} has no <inertial> with mass and inertia")
+            continue
+        mass = float(inertial.find("mass").get("value", "0"))
+        I = inertial.find("inertia")
+        diag = [float(I.get(k, "0")) for k in ("ixx", "iyy", "izz")]
+        if not mass > 0 or not all(d > 0 for d in diag):
+            bad.append(f"link {name} has mass {mass:g} kg and principal inertia {diag}")
+    return bad
+
+
+def pose_list(robot) -> list[tuple[str, tuple[float, ...]]]:
+    return [("home", tuple(robot.home()))] + [(p.name, tuple(p.q)) for p in robot.poses if p.name != "home"]
+
+
+def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOLD_TIME,
+                   time_step: float = TIME_STEP) -> RobotResult:
+    """Load one robot into an empty client and run every check (see the module docstring)."""
+    import numpy as np
+
+    from ..kinematics import Chain
+
+    res = RobotResult(robot.name, robot.sequence)
+    who = f"robot {robot.name}"
+    client.resetSimulation()
+    client.setGravity(0, 0, -scene.GRAVITY)
+    client.setTimeStep(time_step)
+    s = scene.load_robot(client, robot, urdf)
+    for line in s.load_log.splitlines():
+        if WARNING_LINE.search(line):
+            res.failures.append(Failure("load", f"{who}: PyBullet, loading {urdf.name}: {line.strip()}"))
+    for msg in check_urdf_inertials(urdf):
+        res.failures.append(Failure("load", f"{who}: {msg}"))
+    for name, i in s.links.items():
+        if i == -1:
+            continue  # the fixed base: PyBullet reports mass 0 for it by design
+        mass, _, inertia = client.getDynamicsInfo(s.body, i)[:3]
+        if not mass > 0 or not all(v > 0 for v in inertia):
+            res.failures.append(Failure("load", f"{who}: PyBullet gives link {name} mass {mass:g} kg, inertia {inertia}"))
+    if len(s.joints) != robot.dof:
+        res.failures.append(Failure("load", f"{who}: PyBullet finds {len(s.joints)} revolute joints, the chain has {robot.dof} modules"))
+
+    chain = Chain(robot)
+    steps = max(1, round(hold_time / time_step))
+    window = max(1, round(SETTLE_WINDOW / time_step))
+    for pname, q in pose_list(robot):
+        pr = PoseResult(pname, q)
+        res.poses.append(pr)
+        at = f"{who}, pose {pname}"
+        qv = np.array(q, dtype=float)
+
+        # kinematic checks at the pose itself
+        s.set_q(qv)
+        T_ref = chain.T_base_tool(qv)
+        T_pb = s.T_base_link("tool0")
+        pr.fk_pos_error = float(np.abs(T_pb[:3, 3] - T_ref[:3, 3]).max())
+        pr.fk_rot_error = float(np.abs(T_pb[:3, :3] - T_ref[:3, :3]).max())
+        if pr.fk_pos_error > FK_POS_TOL or pr.fk_rot_error > FK_ROT_TOL:
+            pr.failures.append(Failure("fk", f"{at}: PyBullet puts tool0 {pr.fk_pos_error:.3g} m / {pr.fk_rot_error:.3g} (rotation) "
+                                             f"away from modc's kinematics (tolerance {FK_POS_TOL:g} m, {FK_ROT_TOL:g})"))
+        for c in s.self_collisions(allowed):
+            pr.failures.append(Failure("self-collision", f"{at}: {c.a} and {c.b} collide ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
+        for c in s.environment_collisions():
+            pr.failures.append(Failure("environment", f"{at}: {c.a} is inside obstacle {c.b} ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
+
+        # dynamic hold
+        s.set_q(qv)
+        s.hold(qv)
+        worst = np.zeros(robot.dof)
+        vmax, diverged = 0.0, None
+        for k in range(steps):
+            client.stepSimulation()
+            late = k >= steps - window
+            if late or k % 10 == 0:
+                qk, qdk = s.q(), s.qd()
+                if not (np.all(np.isfinite(qk)) and np.all(np.isfinite(qdk))):
+                    diverged = f"joint states became NaN after {k * time_step:.3f} s"
+                    break
+                vmax = max(vmax, float(np.abs(qdk).max()))
+                if vmax > EXPLODE_VELOCITY:
+                    j = int(np.argmax(np.abs(qdk)))
+                    diverged = f"{s.joint_names[j]} reached {abs(qdk[j]):.0f} rad/s after {k * time_step:.3f} s"
+                    break
+                if late:
+                    worst = np.maximum(worst, np.abs(qk - qv))
+        pr.max_velocity = vmax
+        pr.track_error = [float(e) for e in worst]
+        if diverged:
+            pr.failures.append(Failure("unstable", f"{at}: the simulation diverged: {diverged}"))
+            continue
+        tau_g = s.gravity_torques(qv)
+        applied = s.applied_torques()
+        for j, name in enumerate(s.joint_names):
+            if worst[j] <= TRACK_TOL:
+                continue
+            effort = s.limits[name][2]
+            variant = robot.units[j].variant
+            actuator = robot.library.variants[variant].actuator
+            if abs(tau_g[j]) > effort or abs(applied[j]) >= SATURATION * effort:
+                why = (f"holding the pose needs {abs(tau_g[j]):.2f} N·m, the {variant} actuator ({actuator.model}) peaks at "
+                       f"{effort:g} N·m: it cannot hold the arm")
+            else:
+                why = (f"the motor is below its {effort:g} N·m peak (needs {abs(tau_g[j]):.2f} N·m) yet the joint does not settle")
+            pr.failures.append(Failure(
+                "sag", f"{at}: {name} sags {worst[j]:.2f} rad ({_deg(worst[j])}) from its target {_deg(qv[j])}: {why}", joint=name))
+    s.remove()
+    return res
+
+
+def describe(res: RobotResult) -> list[str]:
+    """Report lines: one for the robot, one per pose, then every failure."""
+    lines = []
+    state = "ok" if res.ok else f"{len(res.all_failures)} failure(s)"
+    lines.append(f"robot {res.robot} ({res.sequence}): {state}")
+    for f in res.failures:
+        lines.append(f"  FAIL {f.message}")
+    for p in res.poses:
+        j = max(range(len(p.track_error)), key=lambda i: p.track_error[i]) if p.track_error else 0
+        err = f"{p.track_error[j]:.1e} rad ({'joint_%d' % (j + 1)})" if p.track_error else "n/a"
+        status = "ok" if not p.failures else "FAILED"
+        lines.append(f"  pose {p.name}: {status}; holds to {err}, tool0 FK within {p.fk_pos_error:.1e} m, "
+                     f"peak joint speed {p.max_velocity:.2g} rad/s")
+        for f in p.failures:
+            lines.append(f"  FAIL {f.message}")
+    return lines
+
+
+def allowed_from_srdf(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
+    if out_dir is None:
+        return set()
+    srdf = Path(out_dir) / "config" / f"{robot.file_stem}.srdf"
+    return scene.srdf_disabled_pairs(srdf) if srdf.is_file() else set()
+
+
+def simulate(checked, robot: str | None = None, out_dir: str | Path | None = None,
+             hold_time: float = HOLD_TIME) -> list[RobotResult]:
+    """Every (or the named) robot of a checked design without errors."""
+    robots = scene.select_robots(checked, robot)
+    results = []
+    with scene.compiled(checked) as urdfs, scene.connect() as client:
+        for r in robots:
+            results.append(simulate_robot(client, r, urdfs[r.name], allowed_from_srdf(out_dir, r), hold_time))
+    return results
+
+
+def run_sim(path, library: str | None = None, robot: str | None = None, out_dir: str | Path | None = None,
+            hold_time: float = HOLD_TIME):
+    """`modc sim FILE`. Returns (ok, report lines, checked).
+
+    checked: the modc.compiler.Checked of the file (its .diagnostics and .sources are for the
+    caller to print). When it has errors nothing is simulated: (False, [], checked).
+    out_dir: a compile output (OUT/) whose config/<stem>.srdf disabled pairs are honoured.
+    Raises modc.compiler.InputError (unreadable file) and scene.UsageError (unknown robot).
+    """
+    checked = scene.load_checked(path, library)
+    if not checked.ok:
+        return False, [], checked
+    results = simulate(checked, robot, out_dir, hold_time)
+    lines = [line for r in results for line in describe(r)]
+    failures = sum(len(r.all_failures) for r in results)
+    poses = sum(len(r.poses) for r in results)
+    if failures:
+        lines.append(f"sim: {failures} failure(s) in {len(results)} robot(s)")
+    else:
+        lines.append(f"sim: {len(results)} robot(s), {poses} pose(s) held, no collisions, FK agrees")
+    return not failures, lines, checked

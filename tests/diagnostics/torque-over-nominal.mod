@@ -1,0 +1,10 @@
+# corpus-analyses: torque
+# Half-metre links on the shoulder: joint 2 holds 15.5 N·m at worst, above the KA-75+'s nominal
+# 12 N·m (within its 30.5 N·m peak): a warning from the torque check (`modc check`, compile).
+robot longreach {
+    chain H1
+        - H4(pivot=-90deg, link=500mm)   # expect: warning[torque-over-nominal]
+        - H3(link=500mm)
+        - L1
+    payload 0.5 kg
+}

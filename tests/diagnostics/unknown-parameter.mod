@@ -1,0 +1,3 @@
+robot farm {
+    chain H1 - H4(twist=45deg) - L4   # expect: error[unknown-parameter]
+}
