@@ -75,6 +75,8 @@ def check_text(text: str, path: str = "<string>", library: str | None = None, **
 
 def check_file(path: str | os.PathLike, library: str | None = None, **options) -> Checked:
     p = str(path)
+    if not p.endswith((".mod", *YAML_SUFFIXES)):
+        raise InputError(codes.UNSUPPORTED_INPUT.at(Span.point(p), path=p))
     text = read_source(p)
     return check_text(text, p, library, **options)
 

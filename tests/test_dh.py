@@ -173,7 +173,7 @@ def test_dh2mod_cli_json_shape(tmp_path):
     ("a,alpha,d,theta\n0,zero,0.1,0\n", "dh-csv-value", 2, 3),
     ("a,alpha,d,theta\n0,nan,0.1,0\n", "dh-csv-value", 2, 3),
     ("a,alpha,d,theta\n0,0,0.1\n", "dh-csv-value", 2, 1),
-    ("a,alpha,d,theta\n", "dh-csv-empty", 1, 1),
+    ("a,alpha,d,theta\n", "dh-empty", 1, 1),
     ("a,alpha,d,theta\n" + "0,0,0.1,0\n" * 7, "too-many-units", 8, 1),
 ])
 def test_bad_tables_get_diagnostics(tmp_path, text, code, line, col):

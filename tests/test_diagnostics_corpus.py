@@ -199,10 +199,7 @@ def test_every_code_is_covered():
 
 # Known bugs in where diagnostics point, by (corpus file suffix, code): the checks below turn into
 # an xfail for these instead of a failure.
-SPAN_BUGS = {
-    (".csv", "dh-approximation"): "dh/convert_file.convert_table builds the Robot without name_span/span, so "
-    "robot-level diagnostics of a CSV table point at the model's NOWHERE span ('<unknown>':1:1)",
-}
+SPAN_BUGS: dict = {}
 
 
 def check_well_formed(d: Diagnostic, text: str, path: str) -> None:
@@ -269,9 +266,7 @@ def test_corpus_diagnostics_render_with_caret(path: Path, request):
 
 
 # Known bugs: codes whose spans carry no character offsets (start = end = 0).
-OFFSET_BUGS = {
-    "yaml-syntax": "yaml_form.parse_yaml builds the yaml-syntax Span without mark.index, so start/end stay 0",
-}
+OFFSET_BUGS: dict = {}
 
 
 @pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES if p.suffix != ".csv"])
@@ -416,8 +411,6 @@ def test_output_not_modc_from_the_command_line(tmp_path):
     assert [x.name for x in out.iterdir()] == ["notes.txt"]
 
 
-@pytest.mark.xfail(strict=False, reason="unsupported-input is registered but never raised: check_file/parse_text "
-                   "parse any suffix other than .yaml/.yml as .mod text")
 def test_unsupported_input(tmp_path, capsys):
     src = tmp_path / "farm.txt"
     src.write_text("robot farm {\n    chain H1 - L4(port=45deg) - L1\n}\n", encoding="utf-8")
@@ -430,14 +423,16 @@ def test_unsupported_input(tmp_path, capsys):
 
 
 def test_input_too_large():
+    from modc.syntax.parser import MAX_BYTES
+
     body = "robot farm {\n    chain H1 - L4(port=45deg) - L1\n}\n"
-    text = body + "#" * (1_000_001 - len(body)) + "\n"
+    text = body + "#" * (MAX_BYTES + 1 - len(body)) + "\n"
     c = check_text(text, "big.mod")
     assert [(d.span.line, d.code) for d in c.diagnostics] == [(1, "input-too-large")]
     check_well_formed(c.diagnostics[0], text, "big.mod")
     # just under the limit is an ordinary file
-    ok = body + "#" * (1_000_000 - len(body) - 1) + "\n"
-    assert len(ok) == 1_000_000
+    ok = body + "#" * (MAX_BYTES - len(body) - 1) + "\n"
+    assert len(ok) == MAX_BYTES
     assert not check_text(ok, "ok.mod").diagnostics
 
 
@@ -488,8 +483,6 @@ def test_utf8_bom_is_accepted(tmp_path):
 # --- rendering details ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize("sep", ["\f", "\v", "\x1c", "\x85", "\u2028", "\u2029"], ids=repr)
-@pytest.mark.xfail(strict=False, reason="render.excerpt splits the source with str.splitlines(), which also breaks at "
-                   "form feed, U+2028 etc.; Lark counts lines by '\\n' only, so the excerpt shows the wrong line")
 def test_excerpt_uses_the_same_lines_as_the_parser(sep):
     text = f"# a comment with a {sep} in it\nrobot farm {{\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 30) deg\n}}\n"
     c = check_text(text, "t.mod")

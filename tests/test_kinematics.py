@@ -109,5 +109,5 @@ def test_python_api_loads_and_computes():
     T = modc.chain(robot).T_base_tool([0, 0, 0])
     assert T.shape == (4, 4) and robot.file_stem == "mod3_farm"
     with pytest.raises(ModcError) as e:
-        modc.load(ROOT / "tests" / "golden")  # a directory is not a file
+        modc.load(ROOT / "examples" / "no-such-arm.mod")
     assert "file-not-found" in str(e.value.diagnostics[0].code)

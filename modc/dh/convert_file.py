@@ -6,7 +6,7 @@ import math
 import re
 from pathlib import Path
 
-from ..diagnostics import Diagnostic
+from ..diagnostics import Diagnostic, Span
 from ..model import Design, Robot
 from ..model.write import robot_text
 from ..passes import Context, run_all
@@ -24,7 +24,8 @@ def convert_table(text: str, path: str, name: str | None = None, fit_links: bool
     rows, diags = read_csv(text, path)
     if any(d.is_error for d in diags):
         return "", diags, False
-    robot = Robot(name=name or _name(path), dh=tuple(rows), dh_fit_links=fit_links)
+    where = Span.point(path)
+    robot = Robot(name=name or _name(path), dh=tuple(rows), dh_fit_links=fit_links, span=where, name_span=where)
     ctx = Context(diagnostics=diags, library_override=library)
     design = run_all(Design(path=path, robots=(robot,)), ctx)
     if ctx.has_errors:

@@ -23,7 +23,7 @@ def read_csv(text: str, path: str) -> tuple[list[DHRow], list[Diagnostic]]:
     diags: list[Diagnostic] = []
     lines = [(i, l) for i, l in enumerate(text.splitlines(), start=1) if l.strip() and not l.lstrip().startswith("#")]
     if not lines:
-        return [], [codes.DH_CSV_EMPTY.at(Span.point(path))]
+        return [], [codes.DH_EMPTY.at(Span.point(path))]
     head_no, head = lines[0]
     names = [c.strip().lower() for c, _ in _cells(head)]
     if sorted(set(names)) != sorted(names) or not set(REQUIRED) <= set(names) or not set(names) <= set(COLUMNS):
@@ -54,5 +54,5 @@ def read_csv(text: str, path: str) -> tuple[list[DHRow], list[Diagnostic]]:
         if ok:
             rows.append(DHRow(span=row_span, **values))
     if not rows and not diags:
-        diags.append(codes.DH_CSV_EMPTY.at(Span(path, head_no, 1, head_no, len(head) + 1)))
+        diags.append(codes.DH_EMPTY.at(Span(path, head_no, 1, head_no, len(head) + 1)))
     return rows, diags

@@ -97,6 +97,8 @@ DH_ROW_INCOMPLETE = _register("dh-row-incomplete", E, "a DH row without a, alpha
     "DH row {row} lacks {missing}", "write rows as: row a=0.3 m, alpha=90deg, d=0 m (theta optional)")
 NOT_FINITE = _register("not-finite", E, "a value that is infinite or not a number",
     "{what} must be a finite number", "write an ordinary decimal number")
+OUT_OF_RANGE = _register("out-of-range", E, "a quantity far beyond anything a modular arm can have",
+    "{what} = {value} is out of range (at most {limit})", "check the number and its unit")
 
 # --- YAML form ---------------------------------------------------------------------------------
 YAML_SYNTAX = _register("yaml-syntax", E, "a YAML file that does not parse",
@@ -148,7 +150,8 @@ DH_CSV_HEADER = _register("dh-csv-header", E, "a DH CSV file whose header is not
     "the header must name the columns a, alpha, d, theta; found {found}", "the first line reads: a,alpha,d,theta (metres and radians)")
 DH_CSV_VALUE = _register("dh-csv-value", E, "a DH CSV cell that is not a finite number",
     "row {row}, column '{column}': {problem}", "cells are plain numbers: metres for a and d, radians for alpha and theta")
-DH_CSV_EMPTY = _register("dh-csv-empty", E, "a DH CSV file without rows", "the DH table has no rows", "add one row per joint, base first")
+DH_EMPTY = _register("dh-empty", E, "a DH table (CSV file or dh block) without complete rows",
+    "the DH table has no rows", "add one row per joint, base first")
 
 # --- torque (paper section 3: epsilon comes from a worst-case torque analysis) -------------------
 TORQUE_OVER_PEAK = _register("torque-over-peak", E, "a joint whose worst static gravity torque exceeds its actuator's peak",
@@ -175,6 +178,8 @@ UNKNOWN_JOINT = _register("unknown-joint", E, "a joint name that does not exist"
     "robot '{robot}' has no joint '{name}'", "joints are named joint_1 … joint_{dof}")
 LIMIT_ORDER = _register("limit-order", E, "a joint limit whose lower bound is not below its upper bound",
     "limit for {joint}: lower {low} is not below upper {high}", "write the limit as (lower, upper)")
+LIMIT_DISJOINT = _register("limit-disjoint", E, "a joint limit that does not overlap the module's range at all",
+    "limit for {joint} ({low}..{high}) lies outside the module's range {hlow}..{hhigh}", "give a range inside {hlow}..{hhigh}")
 LIMIT_EXCEEDS_HARDWARE = _register("limit-exceeds-hardware", W, "a joint limit wider than the module's range",
     "limit for {joint} ({low}..{high}) is wider than the module's range {hlow}..{hhigh}",
     "the library's range is used where yours is wider")

@@ -9,10 +9,10 @@ from .diagnostic import Diagnostic, sort_key
 
 def excerpt(source: str, d: Diagnostic) -> list[str]:
     """The offending source line and a caret line under the span (clipped to that line)."""
-    lines = source.splitlines()
+    lines = source.split("\n")  # as the parser counts lines: \f, \v or U+2028 do not end one
     if not (1 <= d.span.line <= len(lines)):
         return []
-    text = lines[d.span.line - 1].expandtabs(1)
+    text = lines[d.span.line - 1].rstrip("\r").expandtabs(1)
     if len(text) > 200:  # a minified or binary "line": show a window around the column
         lo = max(0, d.span.col - 60)
         text, col = text[lo:lo + 120], d.span.col - lo

@@ -95,6 +95,8 @@ class TwistSet(_Frozen):
     wraps: bool = Field(False, description="angles are taken modulo 360 (ports)")
 
     def nearest(self, deg: float) -> float:
+        if not math.isfinite(deg):
+            return self.max_deg if deg > 0 else self.min_deg
         v = _wrap(deg) if self.wraps else deg
         k = round((v - self.min_deg) / self.step_deg)
         top = math.floor((self.max_deg - self.min_deg) / self.step_deg + 1e-9)
@@ -102,6 +104,8 @@ class TwistSet(_Frozen):
         return _clean(self.min_deg + k * self.step_deg)
 
     def realisable(self, deg: float) -> bool:
+        if not math.isfinite(deg):
+            return False
         v = _wrap(deg) if self.wraps else deg
         return abs(self.nearest(v) - v) < 1e-6
 

@@ -36,15 +36,22 @@ class _Lowerer:
             self.error(codes.UNKNOWN_UNIT_OF_MEASURE.at(span, unit=unit, allowed=", ".join(table)))
         return None
 
-    def _finite(self, values, what, span) -> bool:
-        if all(math.isfinite(v) for v in values):
-            return True
-        self.error(codes.NOT_FINITE.at(span, what=what))
-        return False
+    def _finite(self, values, what, span, kind: str | None = None, scale: float = 1.0) -> bool:
+        if not all(math.isfinite(v) for v in values):
+            self.error(codes.NOT_FINITE.at(span, what=what))
+            return False
+        if kind is not None:
+            limit = Q.LIMIT[kind]
+            worst = max((abs(v * scale) for v in values), default=0.0)
+            if worst > limit:
+                unit = Q.SI[kind]
+                self.error(codes.OUT_OF_RANGE.at(span, what=what, value=f"{worst:g} {unit}", limit=f"{limit:g} {unit}"))
+                return False
+        return True
 
     def quantity(self, q: ast.Quantity, kind: str, what: str) -> float | None:
         s = self._scale(q.unit, kind, what, q.span)
-        if s is None or not self._finite([q.value], what, q.span):
+        if s is None or not self._finite([q.value], what, q.span, kind, s):
             return None
         return q.value * s
 
@@ -54,7 +61,7 @@ class _Lowerer:
             example = "(" + ", ".join(["0"] * n) + ") " + next(iter(Q.KINDS[kind]))
             self.error(codes.VECTOR_ARITY.at(v.span, what=what, expected=n, got=len(v.values), example=example))
             return None
-        if s is None or not self._finite(v.values, what, v.span):
+        if s is None or not self._finite(v.values, what, v.span, kind, s):
             return None
         return tuple(x * s for x in v.values)
 
@@ -83,16 +90,21 @@ class _Lowerer:
         return UnitSpec(name=u.name.text, span=u.span, param_spans=spans, **values)
 
     def dh(self, table: ast.DH) -> tuple[DHRow, ...]:
-        rows = []
+        rows, complete = [], True
         for i, row in enumerate(table.rows, start=1):
             values, spans = self.params(row.params, DH_PARAMS)
             missing = [k for k in ("a", "alpha", "d") if k not in spans]
             if missing:
                 self.error(codes.DH_ROW_INCOMPLETE.at(row.span, row=i, missing=" and ".join(missing)))
-                continue
-            if len(values) == len(spans):
+                complete = False
+            elif len(values) == len(spans):
                 rows.append(DHRow(span=row.span, **values))
-        return tuple(rows)
+            else:
+                complete = False
+        if not table.rows:
+            self.error(codes.DH_EMPTY.at(table.span))
+        # a table with a bad row is not converted: a chain from the other rows would only mislead
+        return tuple(rows) if complete else ()
 
     def placement(self, p: ast.Placement) -> Transform:
         xyz = self.vector(p.at, "a length", f"{p.keyword} position") if p.at else None
@@ -157,7 +169,6 @@ class _Lowerer:
             fields.pop("dh")
         elif "chain" not in seen and "dh" not in seen:
             self.error(codes.MISSING_CHAIN.at(r.name.span, robot=r.name.text))
-        fields.pop("library_span", None)
         return Robot(
             name=r.name.text, poses=tuple(poses), limits=tuple(limits), obstacles=tuple(obstacles),
             targets=tuple(targets), allow=frozenset(allow), span=r.span, name_span=r.name.span, **fields,

@@ -8,4 +8,7 @@ LENGTH = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 MASS = {"kg": 1.0, "g": 0.001}
 KINDS = {"an angle": ANGLE, "a length": LENGTH, "a mass": MASS}
 ALL = {**ANGLE, **LENGTH, **MASS}
+# |SI value| above these is no modular arm (1 km, 1 t, 1e6 rad): reject before arithmetic overflows.
+LIMIT = {"an angle": 1e6, "a length": 1e3, "a mass": 1e3}
+SI = {"an angle": "rad", "a length": "m", "a mass": "kg"}
 EXAMPLE = {"an angle": "45deg or 0.785 rad", "a length": "0.22 m or 220 mm", "a mass": "0.5 kg or 500 g"}

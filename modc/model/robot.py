@@ -101,6 +101,7 @@ class Robot(_M):
     torque: tuple | None = Field(default=None, exclude=True, repr=False)  # set by check_torque
     span: SpanField
     name_span: SpanField
+    library_span: SpanField  # the `library` statement, where library errors point
 
     @property
     def dof(self) -> int:
@@ -136,10 +137,12 @@ class Robot(_M):
         assert self.library is not None
         v = self.library.variants[self.units[i - 1].variant]
         lo, hi = math.radians(v.lower_deg), math.radians(v.upper_deg)
+        hw = (lo, hi)
         for lim in self.limits:
-            if lim.joint == f"joint_{i}":
+            if lim.joint == f"joint_{i}" and lim.lower < lim.upper:
                 lo, hi = max(lo, lim.lower), min(hi, lim.upper)
-        return lo, hi
+        # an inverted or disjoint limit is reported by check_poses; analyses keep the hardware range
+        return (lo, hi) if lo < hi else hw
 
 
 class Design(_M):

@@ -13,7 +13,7 @@ def run(design: Design, ctx: Context) -> Design:
             ctx.report(codes.DUPLICATE_ROBOT.at(r.name_span, name=r.name))
         robots.add(r.name)
         names: set[str] = set()
-        for item in (*r.poses, *r.targets, *r.obstacles):
+        for item in sorted((*r.poses, *r.targets, *r.obstacles), key=lambda x: (x.span.line, x.span.col)):
             if item.name in names:
                 ctx.report(codes.DUPLICATE_NAME.at(item.span, name=item.name, robot=r.name))
             names.add(item.name)

@@ -27,7 +27,10 @@ def run(design: Design, ctx: Context) -> Design:
                 continue
             v = lib.variants[r.units[joints[lim.joint] - 1].variant]
             hlo, hhi = math.radians(v.lower_deg), math.radians(v.upper_deg)
-            if lim.lower < hlo - 1e-12 or lim.upper > hhi + 1e-12:
+            if lim.upper <= hlo or lim.lower >= hhi:
+                ctx.report(codes.LIMIT_DISJOINT.at(
+                    lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper), hlow=_deg(hlo), hhigh=_deg(hhi)), r)
+            elif lim.lower < hlo - 1e-12 or lim.upper > hhi + 1e-12:
                 ctx.report(codes.LIMIT_EXCEEDS_HARDWARE.at(
                     lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper), hlow=_deg(hlo), hhigh=_deg(hhi)), r)
         for pose in r.poses:

@@ -17,6 +17,13 @@ def run(design: Design, ctx: Context) -> Design:
         from ..dh.convert import convert
         from ..dh.report import compare
 
+        max_dof = r.library.rules.max_dof
+        if len(r.dh) > max_dof:  # converting (and rounding) thousands of rows would only bury this
+            limits = ", ".join(f"{v}: {r.library.variants[v].actuator.epsilon}" for v in r.library.variants)
+            ctx.report(codes.TOO_MANY_UNITS.at(r.dh[max_dof].span, n=len(r.dh), max=max_dof, limits=limits), r)
+            robots.append(r)
+            continue
+
         conv = convert(r, r.library)
         for d in conv.diagnostics:
             ctx.report(d, r)

@@ -18,7 +18,8 @@ def run(design: Design, ctx: Context) -> Design:
             library = lib.load(ref, where)
         except lib.LibraryError as e:
             code = codes.LIBRARY_NOT_FOUND if "not found" in str(e) else codes.LIBRARY_INVALID
-            ctx.report(code.at(r.name_span, name=ref, detail=str(e), builtins=", ".join(lib.BUILTIN)))
+            span = r.library_span if r.library_ref == ref and r.library_span.file != "<unknown>" else r.name_span
+            ctx.report(code.at(span, name=ref, detail=str(e), builtins=", ".join(lib.BUILTIN)))
             robots.append(r)
             continue
         units = []

@@ -3,35 +3,17 @@ trajectory playback (`modc play`).
 
     scene.py       build a PyBullet world from a checked robot: its compiled URDF and meshes (in a
                    temporary directory), its obstacles and its target markers (reused by `plan`)
-    smoke.py       run_sim(path, ...)  -> (ok, report lines, checked)
-    render.py      render(path, out_png, pose=None, ...) -> report lines
-    play.py        play(path, traj_json, record=None, ...) -> (ok, report lines)
+    smoke.py       run_sim(path, ...) -> (ok, report lines, checked)
+    render.py      render(path, out_png, pose=None, ...) -> (ok, report lines, checked)
+    play.py        play(path, traj_json, record=None, ...) -> (ok, report lines, checked)
     trajectory.py  the trajectory file of `plan --json` / `play --traj` (SPEC section 6): load, validate
 
 Frames: the world is the cell frame of `base …` (SPEC section 4): each robot's base_link is put at
 robot.base, gravity is -z of the world, and obstacles and targets, which the file gives in
 base_link, are carried into the world through that same placement. With no `base` line the world
 is base_link. Heavy libraries (pybullet, numpy, PIL) are imported inside functions.
+
+Import the entry points from their modules (modc.sim.smoke.run_sim, modc.sim.render.render,
+modc.sim.play.play): this package exports no functions, so that a function never shadows the
+module of the same name.
 """
-from __future__ import annotations
-
-
-def run_sim(*args, **kwargs):
-    from .smoke import run_sim as f
-
-    return f(*args, **kwargs)
-
-
-def render(*args, **kwargs):
-    from .render import render as f
-
-    return f(*args, **kwargs)
-
-
-def play(*args, **kwargs):
-    from .play import play as f
-
-    return f(*args, **kwargs)
-
-
-__all__ = ["run_sim", "render", "play"]

@@ -3,21 +3,25 @@ targets, in the manner of the paper's Rviz figures.
 
 PyBullet's TinyRenderer (software, so it works headless and gives the same pixels on every run)
 draws the compiled URDF's meshes in their URDF material colours, obstacles in light steel blue,
-targets as small red spheres, on a light ground with a 0.1 m grid at the world's z = 0 (lowered
-under the lowest point of the scene when something reaches below it). Background pixels (the
-segmentation mask says which) become a white-to-light-grey gradient. The frame is rendered at
-SUPERSAMPLE times the size and downsampled (Lanczos), which anti-aliases the edges.
+targets as small red spheres and an RGB triad at tool0. Pixels where no body was drawn (the
+segmentation mask says which) show a white-to-light-grey gradient and a light ground with a
+0.1 m grid at the world's z = 0 (lowered under the lowest point of the scene when something
+reaches below it), fading out around the scene: computed per pixel by intersecting its ray with
+the ground plane. The frame is rendered at SUPERSAMPLE times the size and downsampled (Lanczos),
+which anti-aliases the edges.
 
 Camera. Looking at the centre of the scene's bounding box (every link, obstacle and target),
-from an elevation of 25-40° and one of eight azimuths; the distance is the smallest at which
-the whole box fits inside 90 % of the frame. With no azimuth given, each candidate view is
-rendered small, with the obstacles, and the one showing the most of the arm wins (ties: the
-first, i.e. the canonical front-left view): the farm cell's walls do not hide the arm.
+from 30° above the horizon at one of eight azimuths (or 55° at two of them); the distance is the
+smallest at which the whole box fits inside 90 % of the frame. With no azimuth given, each candidate view is
+rendered small, with the obstacles, and the one showing the most of the arm (of the least
+visible arm, when a file has several) and of the targets wins, a later candidate only when
+clearly (5 %) better: the farm cell's walls do not hide the arm. The chosen view is then framed
+on the rendered silhouette (centred, filling 90 % of the frame).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import scene
@@ -27,6 +31,7 @@ SUPERSAMPLE = 2
 FOV = 35.0  # degrees, vertical
 FILL = 0.9  # the scene's box fits inside this share of the frame
 GRID = 0.1  # m, ground grid spacing
+GRID_LINE = 0.004  # m, width of a grid line
 GROUND_RGB = (236, 238, 240)
 GRID_RGB = (200, 204, 210)
 BACKGROUND_TOP = (255, 255, 255)
@@ -35,6 +40,8 @@ BACKGROUND_BOTTOM = (222, 226, 232)
 # is the canonical one: from the front left, above, as Rviz's default orbit camera.
 VIEWS = tuple((az, el) for el in (30.0,) for az in (210.0, 150.0, 240.0, 120.0, 300.0, 60.0, 330.0, 30.0)) + (
     (210.0, 55.0), (150.0, 55.0))
+AXIS_LENGTH, AXIS_RADIUS = 0.06, 0.003  # m, the tool0 triad
+AXIS_RGBA = ((0.85, 0.1, 0.1, 1.0), (0.1, 0.7, 0.1, 1.0), (0.1, 0.25, 0.9, 1.0))
 LIGHT = dict(lightDirection=[-0.4, -0.6, 1.0], lightColor=[1.0, 1.0, 1.0], lightDistance=4.0,
              lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.08)
 
@@ -105,20 +112,6 @@ def fit_camera(points, azimuth: float, elevation: float, aspect: float, fov: flo
                   near, span * 3.0 + 1.0, azimuth, elevation)
 
 
-def grid_texture(path: Path, cells_x: int, cells_y: int, px: int = 64) -> None:
-    from PIL import Image, ImageDraw
-
-    img = Image.new("RGB", (cells_x * px, cells_y * px), GROUND_RGB)
-    draw = ImageDraw.Draw(img)
-    for i in range(cells_x + 1):
-        x = min(i * px, cells_x * px - 1)
-        draw.line([(x - 1, 0), (x - 1, cells_y * px)], fill=GRID_RGB, width=3)
-    for j in range(cells_y + 1):
-        y = min(j * px, cells_y * px - 1)
-        draw.line([(0, y - 1), (cells_x * px, y - 1)], fill=GRID_RGB, width=3)
-    img.save(path)
-
-
 @dataclass
 class Stage:
     """A PyBullet world holding every robot of a file (at its world placement) with their
@@ -126,21 +119,49 @@ class Stage:
 
     client: object
     scenes: dict[str, scene.Scene]
-    tmp: Path
-    ground: int | None = None
+    ground: bool = False  # drawn by backdrop() once add_ground() has placed it
     camera: Camera | None = None
+    axes: dict = field(default_factory=dict)  # robot name -> tool0 triad body
     fade_centre: object = None
     fade_radii: tuple[float, float] = (1.0, 2.0)
+    ground_z: float = 0.0
+    _backdrop: dict = field(default_factory=dict)
 
     @classmethod
-    def build(cls, client, robots, urdfs: dict[str, Path], tmp: Path) -> "Stage":
-        placements = scene.world_placements(robots)
+    def build(cls, client, robots, urdfs: dict[str, Path], qs: dict | None = None) -> "Stage":
+        placements = scene.world_placements(robots, qs)
         scenes = {r.name: scene.load_robot(client, r, urdfs[r.name], placements[r.name]) for r in robots}
-        return cls(client, scenes, Path(tmp))
+        return cls(client, scenes)
 
     def set(self, qs: dict[str, object]) -> None:
         for name, q in qs.items():
             self.scenes[name].set_q(q)
+        self.place_axes()
+
+    def add_tool_axes(self, length: float = AXIS_LENGTH, radius: float = AXIS_RADIUS) -> None:
+        """An RGB triad (x red, y green, z blue) at every tool0, as Rviz draws frames."""
+        p = scene.pybullet()
+        for name in self.scenes:
+            shapes = []
+            for k, (rpy, rgba) in enumerate((((0, math.pi / 2, 0), AXIS_RGBA[0]), ((-math.pi / 2, 0, 0), AXIS_RGBA[1]),
+                                             ((0, 0, 0), AXIS_RGBA[2]))):
+                pos = [length / 2 if k == j else 0.0 for j in range(3)]
+                orn = self.client.getQuaternionFromEuler(rpy)
+                shapes.append(self.client.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=length, rgbaColor=rgba,
+                                                            visualFramePosition=pos, visualFrameOrientation=orn))
+            body = self.client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=shapes[0],
+                                               linkMasses=[0.0, 0.0], linkCollisionShapeIndices=[-1, -1],
+                                               linkVisualShapeIndices=shapes[1:], linkPositions=[[0, 0, 0]] * 2,
+                                               linkOrientations=[[0, 0, 0, 1]] * 2, linkInertialFramePositions=[[0, 0, 0]] * 2,
+                                               linkInertialFrameOrientations=[[0, 0, 0, 1]] * 2, linkParentIndices=[0, 0],
+                                               linkJointTypes=[p.JOINT_FIXED] * 2, linkJointAxis=[[0, 0, 1]] * 2)
+            self.axes[name] = body
+        self.place_axes()
+
+    def place_axes(self) -> None:
+        for name, body in self.axes.items():
+            pos, orn = scene.matrix_pose(self.scenes[name].T_world_link("tool0"))
+            self.client.resetBasePositionAndOrientation(body, pos, orn)
 
     def points(self):
         """Corners of the bounding boxes of everything shown (arm links, obstacles, targets)."""
@@ -164,52 +185,58 @@ class Stage:
         return np.array(corners)
 
     def add_ground(self, points) -> None:
-        """A grid on z = 0 of the world (or just below the scene when it reaches lower), square
-        around the scene's footprint and large enough that its edge lies where it has faded
-        into the background (shoot() fades it from fade_radii[0] to fade_radii[1])."""
+        """A grid on z = 0 of the world (or just below the scene when it reaches lower), fading
+        into the background from fade_radii[0] to fade_radii[1] around the scene's footprint.
+        The ground is drawn behind the rendered bodies (backdrop()), not by PyBullet: nothing
+        of the scene is below it, and a textured plane would double the TinyRenderer's time."""
         import numpy as np
 
-        p = scene.pybullet()
         lo, hi = points.min(axis=0), points.max(axis=0)
-        z = min(0.0, float(lo[2]) - 1e-3)
         centre = (lo[:2] + hi[:2]) / 2.0
         footprint = float(np.linalg.norm(hi[:2] - lo[:2])) / 2.0
         size = float(np.linalg.norm(hi - lo))
         r0 = footprint + max(0.1, 0.15 * size)
-        r1 = r0 + max(0.3, 0.6 * size)
-        self.fade_centre, self.fade_radii = centre, (r0, r1)
-        x0, x1 = math.floor((centre[0] - r1) / GRID) * GRID, math.ceil((centre[0] + r1) / GRID) * GRID
-        y0, y1 = math.floor((centre[1] - r1) / GRID) * GRID, math.ceil((centre[1] + r1) / GRID) * GRID
-        nx, ny = max(1, round((x1 - x0) / GRID)), max(1, round((y1 - y0) / GRID))
-        tex = self.tmp / "ground.png"
-        grid_texture(tex, nx, ny, px=max(8, min(64, 2048 // max(nx, ny))))
-        verts = [[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]]
-        # image rows run downwards: v = 0 at the top edge of the texture
-        vis = self.client.createVisualShape(p.GEOM_MESH, vertices=verts, indices=[0, 1, 2, 0, 2, 3],
-                                            uvs=[[0, 1], [1, 1], [1, 0], [0, 0]], normals=[[0, 0, 1]] * 4,
-                                            rgbaColor=[1, 1, 1, 1])
-        self.ground = self.client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=vis)
-        self.client.changeVisualShape(self.ground, -1, textureUniqueId=self.client.loadTexture(str(tex)))
+        self.fade_centre, self.fade_radii = centre, (r0, r0 + max(0.3, 0.6 * size))
+        self.ground_z = min(0.0, float(lo[2]) - 1e-3)
+        self.ground = True
+        self._backdrop = {}
 
-    def unproject(self, camera: Camera, depth):
-        """World points of every pixel from the depth buffer (OpenGL's non-linear [0, 1] depth)."""
+    def backdrop(self, camera: Camera, W: int, H: int):
+        """What is behind the bodies, per pixel (float RGB, H x W x 3): a white-to-light-grey
+        gradient, and the ground where a pixel's ray meets it: GROUND_RGB with GRID_RGB lines
+        every GRID metres, blended into the gradient with the distance r from the scene's
+        centre (smoothstep between fade_radii). Cached per camera and size."""
         import numpy as np
 
-        H, W = depth.shape
-        n, f = camera.near, camera.far
-        lin = 2.0 * n * f / (f + n - (2.0 * depth - 1.0) * (f - n))
-        d, right, up = _basis(camera.azimuth, camera.elevation)
-        eye = np.array(camera.eye)
-        fwd = np.array(camera.target) - eye
-        fwd /= np.linalg.norm(fwd)
-        right = np.cross(fwd, camera.up)
-        right /= np.linalg.norm(right)
-        up = np.cross(right, fwd)
-        ty = math.tan(math.radians(camera.fov) / 2.0)
-        tx = ty * camera.aspect
-        u = ((np.arange(W) + 0.5) / W * 2.0 - 1.0) * tx
-        v = (1.0 - (np.arange(H) + 0.5) / H * 2.0) * ty
-        return (eye + lin[:, :, None] * (fwd + u[None, :, None] * right + v[:, None, None] * up))
+        key = (camera.eye, camera.target, camera.up, camera.fov, W, H)
+        if self._backdrop.get("key") == key:
+            return self._backdrop["image"]
+        t = np.linspace(0.0, 1.0, H)[:, None, None]
+        bg = (np.array(BACKGROUND_TOP) * (1 - t) + np.array(BACKGROUND_BOTTOM) * t) * np.ones((1, W, 1))
+        if self.ground:
+            eye = np.array(camera.eye)
+            fwd = np.array(camera.target) - eye
+            fwd /= np.linalg.norm(fwd)
+            right = np.cross(fwd, camera.up)
+            right /= np.linalg.norm(right)
+            up = np.cross(right, fwd)
+            ty = math.tan(math.radians(camera.fov) / 2.0)
+            tx = ty * W / H
+            u = ((np.arange(W) + 0.5) / W * 2.0 - 1.0) * tx
+            v = (1.0 - (np.arange(H) + 0.5) / H * 2.0) * ty
+            ray = fwd + u[None, :, None] * right + v[:, None, None] * up
+            down = ray[:, :, 2] < -1e-9
+            s = np.where(down, (self.ground_z - eye[2]) / np.where(down, ray[:, :, 2], -1.0), 0.0)
+            xy = eye[:2] + s[:, :, None] * ray[:, :, :2]
+            off = np.abs(xy / GRID - np.round(xy / GRID)) * GRID  # m to the nearest grid line, per axis
+            line = (off < GRID_LINE / 2).any(axis=2)
+            ground = np.where(line[:, :, None], np.array(GRID_RGB, float), np.array(GROUND_RGB, float))
+            r = np.linalg.norm(xy - self.fade_centre, axis=2)
+            a = np.clip((r - self.fade_radii[0]) / (self.fade_radii[1] - self.fade_radii[0]), 0.0, 1.0)
+            a = np.where(down, a * a * (3.0 - 2.0 * a), 1.0)[:, :, None]
+            bg = ground * (1.0 - a) + bg * a
+        self._backdrop = {"key": key, "image": bg}
+        return bg
 
     def robot_bodies(self) -> set[int]:
         return {s.body for s in self.scenes.values()}
@@ -217,39 +244,56 @@ class Stage:
     def target_bodies(self) -> set[int]:
         return {t for s in self.scenes.values() for t in s.targets.values()}
 
+    def _objects(self, cam: Camera, W: int, H: int, poses) -> list:
+        """Object-id images (-1 = background) of a small render per pose (None: as it stands)."""
+        import numpy as np
+
+        out = []
+        for qs in poses or [None]:
+            if qs is not None:
+                self.set(qs)
+            _, seg = self.shoot(cam, W, H, supersample=1, raw=True)
+            out.append(np.where(seg >= 0, seg & ((1 << 24) - 1), -1))
+        return out
+
     def choose_camera(self, points, width: int, height: int, azimuth: float | None = None,
-                      elevation: float | None = None) -> Camera:
-        """The given view, or the candidate (VIEWS) that shows the most arm and target pixels."""
+                      elevation: float | None = None, poses=None) -> Camera:
+        """The given view, or the candidate (VIEWS) that shows the most arm and target pixels;
+        then framed on the silhouette. poses: configurations ({robot: q}) the camera must show
+        (a trajectory's); default: the current one. Leaves the stage in the last pose given."""
         import numpy as np
 
         aspect = width / height
         if azimuth is not None:
-            self.camera = self.refine(fit_camera(points, azimuth, 30.0 if elevation is None else elevation, aspect), aspect)
-            return self.camera
-        views = VIEWS if elevation is None else tuple((az, elevation) for az, _ in VIEWS[:8])
-        robots, targets = self.robot_bodies(), self.target_bodies()
-        best, best_score = None, -1.0
-        for az, el in views:
-            cam = fit_camera(points, az, el, aspect)
-            _, seg = self.shoot(cam, 160, 120, supersample=1, raw=True)
-            obj = np.where(seg >= 0, seg & ((1 << 24) - 1), -1)
-            score = float(np.isin(obj, list(robots)).sum() + 4 * np.isin(obj, list(targets)).sum())
-            if score > best_score * 1.05:  # a clearly better view replaces an earlier (more canonical) one
-                best, best_score = cam, score
-        self.camera = self.refine(best, width / height)
+            best = fit_camera(points, azimuth, 30.0 if elevation is None else elevation, aspect)
+        else:
+            views = VIEWS if elevation is None else tuple((az, elevation) for az, _ in VIEWS[:8])
+            robots, targets = sorted(self.robot_bodies()), list(self.target_bodies())
+            best, best_score = None, -1.0
+            for az, el in views:
+                cam = fit_camera(points, az, el, aspect)
+                score = 0.0
+                for obj in self._objects(cam, 160, round(160 / aspect), poses):
+                    # every arm must show: the least visible one counts (for each of them)
+                    least = min(float((obj == b).sum()) for b in robots)
+                    score += len(robots) * least + 4 * float(np.isin(obj, targets).sum())
+                if score > best_score * 1.05:  # a clearly better view replaces an earlier (more canonical) one
+                    best, best_score = cam, score
+        self.camera = self.refine(best, aspect, poses)
         return self.camera
 
-    def refine(self, cam: Camera, aspect: float, rounds: int = 3) -> Camera:
-        """Frame the rendered silhouette (arms, obstacles, targets) instead of their bounding
-        boxes: centre it and zoom until it fills FILL of the frame (a few small renders)."""
+    def refine(self, cam: Camera, aspect: float, poses=None, rounds: int = 3) -> Camera:
+        """Frame the rendered silhouette (arms, obstacles, targets; over every pose given)
+        instead of their bounding boxes: centre it and zoom until it fills FILL of the frame."""
         import numpy as np
 
-        shown = self.robot_bodies() | self.target_bodies() | {o for s in self.scenes.values() for o in s.obstacles.values()}
+        shown = list(self.robot_bodies() | self.target_bodies() | set(self.axes.values())
+                     | {o for s in self.scenes.values() for o in s.obstacles.values()})
         for _ in range(rounds):
             W, H = 240, round(240 / aspect)
-            _, seg = self.shoot(cam, W, H, supersample=1, raw=True)
-            obj = np.where(seg >= 0, seg & ((1 << 24) - 1), -1)
-            mask = np.isin(obj, list(shown))
+            mask = np.zeros((H, W), dtype=bool)
+            for obj in self._objects(cam, W, H, poses):
+                mask |= np.isin(obj, shown)
             if not mask.any():
                 return cam
             rows, cols = np.nonzero(mask)
@@ -276,15 +320,15 @@ class Stage:
                 break
         return cam
 
-    def shoot(self, camera: Camera, width: int, height: int, supersample: int = SUPERSAMPLE, raw: bool = False):
+    def shoot(self, camera: Camera, width: int, height: int, supersample: float = SUPERSAMPLE, raw: bool = False):
         """Render. raw: (rgb uint8 array, segmentation array) at the rendered size; else a PIL image
         of width x height with the background replaced by the gradient."""
         import numpy as np
 
         p = scene.pybullet()
-        W, H = width * supersample, height * supersample
+        W, H = round(width * supersample), round(height * supersample)
         view, proj = camera.matrices(self.client)
-        _, _, rgba, depth, seg = self.client.getCameraImage(
+        _, _, rgba, _, seg = self.client.getCameraImage(
             W, H, view, proj, shadow=0, renderer=p.ER_TINY_RENDERER,
             flags=p.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX, **LIGHT)
         rgb = np.asarray(rgba, dtype=np.uint8).reshape(H, W, 4)[:, :, :3]
@@ -293,18 +337,7 @@ class Stage:
             return rgb, seg
         from PIL import Image
 
-        t = np.linspace(0.0, 1.0, H)[:, None, None]
-        bg = (np.array(BACKGROUND_TOP) * (1 - t) + np.array(BACKGROUND_BOTTOM) * t) * np.ones((1, W, 1))
-        out = np.where((seg < 0)[:, :, None], bg, rgb.astype(float))
-        if self.ground is not None:
-            # the ground fades into the background with the distance from the scene's centre
-            depth = np.asarray(depth, dtype=float).reshape(H, W)
-            xy = self.unproject(camera, depth)[:, :, :2]
-            r = np.linalg.norm(xy - self.fade_centre, axis=2)
-            a = np.clip((r - self.fade_radii[0]) / (self.fade_radii[1] - self.fade_radii[0]), 0.0, 1.0)
-            a = a * a * (3.0 - 2.0 * a)  # smoothstep
-            ground = ((seg & ((1 << 24) - 1)) == self.ground)[:, :, None]
-            out = np.where(ground, out * (1.0 - a[:, :, None]) + bg * a[:, :, None], out)
+        out = np.where((seg < 0)[:, :, None], self.backdrop(camera, W, H), rgb.astype(float))
         out = out.round().astype(np.uint8)
         img = Image.fromarray(out, "RGB")
         if supersample != 1:
@@ -312,16 +345,21 @@ class Stage:
         return img
 
 
-def save_png(img, out: str | Path) -> None:
-    """Optimised PNG, no metadata (deterministic bytes)."""
+def save_png(img, out: str | Path, colors: int | None = None) -> None:
+    """Optimised PNG, no metadata (deterministic bytes); colors: quantise to an adaptive
+    palette of that many colours first (no dithering), for small files such as the README's."""
+    from PIL import Image
+
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
+    if colors is not None:
+        img = img.quantize(colors=colors, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
     img.save(out, format="PNG", optimize=True)
 
 
 def pose_of(robot, pose: str | None) -> tuple[float, ...]:
     if pose is None or pose == "home":
-        return tuple(robot.home())
+        return scene.home_q(robot)
     p = robot.pose(pose)
     if p is None:
         names = ", ".join(["home"] + [x.name for x in robot.poses if x.name != "home"])
@@ -330,7 +368,8 @@ def pose_of(robot, pose: str | None) -> tuple[float, ...]:
 
 
 def render(path, out_png, pose: str | None = None, robot: str | None = None, library: str | None = None,
-           width: int = WIDTH, height: int = HEIGHT, azimuth: float | None = None, elevation: float | None = None):
+           width: int = WIDTH, height: int = HEIGHT, azimuth: float | None = None, elevation: float | None = None,
+           colors: int | None = None):
     """`modc render FILE -o OUT.png`. Returns (ok, report lines, checked).
 
     Every robot of the file (or the one named) at `pose` (default home), with its obstacles and
@@ -338,24 +377,23 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
     written). Raises modc.compiler.InputError (unreadable file), scene.UsageError (unknown robot
     or pose) and OSError (cannot write OUT.png).
     """
-    import tempfile
-
     checked = scene.load_checked(path, library)
     if not checked.ok:
         return False, [], checked
     robots = scene.select_robots(checked, robot)
     qs = {r.name: pose_of(r, pose) for r in robots}
-    with scene.compiled(checked) as urdfs, scene.connect() as client, tempfile.TemporaryDirectory(prefix="modc-render-") as tmp:
-        img, cam = picture(client, robots, urdfs, qs, Path(tmp), width, height, azimuth, elevation)
-    save_png(img, out_png)
+    with scene.compiled(checked) as urdfs, scene.connect() as client:
+        img, cam = picture(client, robots, urdfs, qs, width, height, azimuth, elevation)
+    save_png(img, out_png, colors)
     who = ", ".join(f"{r.name} ({r.sequence}) at {pose or 'home'}" for r in robots)
     return True, [f"render: wrote {out_png} ({width}x{height}): {who}; camera azimuth {cam.azimuth:g}°, elevation {cam.elevation:g}°"], checked
 
 
-def picture(client, robots, urdfs, qs, tmp: Path, width: int = WIDTH, height: int = HEIGHT,
+def picture(client, robots, urdfs, qs, width: int = WIDTH, height: int = HEIGHT,
             azimuth: float | None = None, elevation: float | None = None):
     """(PIL image, camera) of the robots at qs in a fresh stage on this client."""
-    stage = Stage.build(client, robots, urdfs, tmp)
+    stage = Stage.build(client, robots, urdfs, qs)
+    stage.add_tool_axes()
     stage.set(qs)
     pts = stage.points()
     stage.add_ground(pts)

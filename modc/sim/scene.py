@@ -91,6 +91,18 @@ def compiled(checked) -> Iterator[dict[str, Path]]:
         yield {r.name: root / "urdf" / f"{r.file_stem}.urdf" for r in checked.design.robots}
 
 
+def home_q(robot: Robot) -> tuple[float, ...]:
+    """The pose named home; else zeros, except that a joint whose range (narrowed by `limit`)
+    excludes 0 sits in the middle of its range (MoveIt's default joint values)."""
+    if robot.pose("home") is not None:
+        return tuple(robot.home())
+    q = []
+    for i in range(1, robot.dof + 1):
+        lo, hi = robot.joint_range(i)
+        q.append(0.0 if lo <= 0.0 <= hi else (lo + hi) / 2.0)
+    return tuple(q)
+
+
 # ------------------------------------------------------------------------------------------------
 # PyBullet's C-level output
 
@@ -147,16 +159,33 @@ def display_available() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+_GUI_PROBE = "import pybullet as p, sys; sys.exit(0 if p.connect(p.GUI) >= 0 else 1)"
+
+
+def gui_works(timeout: float = 20.0) -> bool:
+    """A display is set and PyBullet's GUI opens on it. Probed in a child process: with an
+    unreachable X server PyBullet may abort the whole process instead of failing."""
+    import subprocess
+
+    if not display_available():
+        return False
+    try:
+        r = subprocess.run([sys.executable, "-c", _GUI_PROBE], capture_output=True, timeout=timeout)
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return r.returncode == 0
+
+
 @contextlib.contextmanager
 def connect(gui: bool = False) -> Iterator:
-    """A PyBullet client (pybullet_utils BulletClient): DIRECT, or GUI when asked for and a
-    display answers (falls back to DIRECT). Disconnected on exit. client.gui says which."""
+    """A PyBullet client (pybullet_utils BulletClient): DIRECT, or GUI when asked for and
+    gui_works() (else DIRECT). Disconnected on exit. client.gui says which."""
     p = pybullet()
     from pybullet_utils.bullet_client import BulletClient
 
     client = None
     with captured_output():
-        if gui and display_available():
+        if gui and gui_works():
             try:
                 client = BulletClient(connection_mode=p.GUI)
                 client.gui = True
@@ -218,35 +247,62 @@ def matrix_pose(T) -> tuple[tuple[float, float, float], tuple[float, float, floa
     return pos, (float(x), float(y), float(z), float(w))
 
 
-def reach(robot: Robot) -> float:
-    """An upper bound of the distance from base_link to any point of the arm: the sum of the
-    chain's fixed offsets plus a module's radius."""
+MODULE_RADIUS = 0.06  # m: a joint module reaches about this far from its frames
+
+
+def extent_points(robot: Robot, q=None, T_world_base=None):
+    """Points (world) that bound what a picture of the robot shows at q: every frame of the
+    chain widened by a module's radius, each obstacle's bounding sphere, each target."""
     import numpy as np
 
     from ..kinematics import Chain
 
+    T = transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else T_world_base
     chain = Chain(robot)
-    total = 0.0
-    for i, u in enumerate(chain.units):
-        total += np.hypot(u.x01, u.z01) + u.z12 + u.x23
-    total += float(np.linalg.norm(chain.T_flange_tool[:3, 3]))
-    return total + 0.05
+    q = home_q(robot) if q is None else q
+    pts, radii = [np.zeros(3)], [MODULE_RADIUS]
+    for f in chain.frames(q):
+        for k in ("T_base_twist1", "T_base_joint", "T_base_end"):
+            pts.append(f[k][:3, 3])
+            radii.append(MODULE_RADIUS)
+    pts.append(chain.T_base_tool(q)[:3, 3])
+    radii.append(MODULE_RADIUS)
+    for ob in robot.obstacles:
+        half = {"box": lambda s: float(np.linalg.norm(s)) / 2.0, "sphere": lambda s: s[0],
+                "cylinder": lambda s: float(np.hypot(s[0], s[1] / 2.0))}[ob.shape](ob.size)
+        pts.append(np.array(ob.origin.xyz))
+        radii.append(half)
+    for t in robot.targets:
+        pts.append(np.array(t.xyz))
+        radii.append(TARGET_RADIUS)
+    out = []
+    for p, r in zip(pts, radii):
+        w = (T @ np.array([*p, 1.0]))[:3]
+        out += [w - r, w + r]
+    return np.array(out)
 
 
-def world_placements(robots: list[Robot]) -> dict[str, "object"]:
+LAYOUT_GAP = 0.15  # m between robots laid out side by side
+
+
+def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, "object"]:
     """robot name -> T_world_base. Each robot sits at its `base`; when two robots of one file
-    share a placement (both at the default origin, say), they are lined up along the world's y
-    axis, one reach apart, so that a picture shows them side by side instead of overlapping."""
+    share a placement (both at the default origin, say), they are laid out along the world's y
+    axis instead, LAYOUT_GAP apart at the pose shown (qs: name -> q, default home), so that a
+    picture shows them side by side rather than inside each other."""
     import numpy as np
 
     T = {r.name: transform(r.base.xyz, r.base.rpy) for r in robots}
     same = any(np.allclose(T[a.name], T[b.name], atol=1e-9) for a, b in itertools.combinations(robots, 2))
     if same:
-        spacing = 2.0 * max(reach(r) for r in robots) + 0.1
-        for k, r in enumerate(robots):
+        edge = None
+        for r in robots:
+            ext = extent_points(r, (qs or {}).get(r.name), T[r.name])
+            lo, hi = float(ext[:, 1].min()), float(ext[:, 1].max())
             shift = np.eye(4)
-            shift[1, 3] = k * spacing
+            shift[1, 3] = 0.0 if edge is None else edge + LAYOUT_GAP - lo
             T[r.name] = shift @ T[r.name]
+            edge = hi + shift[1, 3]
     return T
 
 
@@ -309,22 +365,16 @@ class Scene:
         idx = [self.joints[n] for n in self.joint_names]
         self.client.setJointMotorControlArray(self.body, idx, p.VELOCITY_CONTROL, forces=[0.0] * len(idx))
 
-    def hold(self, q, max_velocity: bool = True) -> None:
-        """Position control towards q: force = the URDF effort (the actuator's peak torque),
-        maxVelocity = the URDF velocity (its rated speed); PyBullet's default gains."""
+    def hold(self, q, qd=None) -> None:
+        """Position control towards q (with feed-forward velocity qd, default 0): force = the
+        URDF effort (the actuator's peak torque), maxVelocity = the URDF velocity (its rated
+        speed); PyBullet's default gains."""
         p = pybullet()
-        for name, v in zip(self.joint_names, q, strict=True):
+        qd = [0.0] * len(self.joint_names) if qd is None else qd
+        for name, v, w in zip(self.joint_names, q, qd, strict=True):
             lo, hi, effort, vel = self.limits[name]
-            kw = {"maxVelocity": vel} if max_velocity else {}
             self.client.setJointMotorControl2(self.body, self.joints[name], p.POSITION_CONTROL, targetPosition=float(v),
-                                              targetVelocity=0.0, force=effort, **kw)
-
-    def gravity_torques(self, q):
-        """Static joint torques holding the arm at q (PyBullet's inverse dynamics)."""
-        import numpy as np
-
-        n = len(self.joint_names)
-        return np.array(self.client.calculateInverseDynamics(self.body, [float(v) for v in q], [0.0] * n, [0.0] * n))
+                                              targetVelocity=float(w), force=effort, maxVelocity=vel)
 
     # -- frames ----------------------------------------------------------------------------------
     def T_world_link(self, name: str):
@@ -450,7 +500,7 @@ def load_robot(client, robot: Robot, urdf: Path, T_world_base=None, *, environme
         for t in robot.targets:
             s.targets[t.name] = add_marker(client, (T_world_base @ np.array([*t.xyz, 1.0]))[:3])
     s.release_motors()
-    s.set_q(robot.home())
+    s.set_q(home_q(robot))
     return s
 
 

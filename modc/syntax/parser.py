@@ -8,7 +8,7 @@ from ..resources import data_dir
 from . import ast
 from .errors import EXAMPLES, HINTS, TERMINAL_NAMES
 
-MAX_BYTES = 1_000_000
+MAX_BYTES = 256_000  # a real .mod file is a few kB; beyond this, checking would take seconds
 
 
 @cache
@@ -68,7 +68,8 @@ def _expected(names) -> str:
 
 def _label(e, text: str) -> str | None:
     try:
-        return e.match_examples(lambda t: _lark().parse(t, start="start"), EXAMPLES, use_accepts=True)
+        return e.match_examples(lambda t: _lark().parse(t, start="start"), EXAMPLES, use_accepts=True,
+                                token_type_match_fallback=True)
     except Exception:  # a label is a nicety; the generic message is still right
         return None
 
@@ -96,7 +97,7 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
     assert isinstance(e, UnexpectedToken)
     found = f"'{token}'" if token.type not in ("$END",) else "end of file"
     span = Span(file, line, col, token.end_line or line, token.end_column or col + 1, token.start_pos or 0, token.end_pos or 0)
-    label = _label(e, text)
+    label = _rule_label(e) or _label(e, text)
     if label == "missing-dash":
         return codes.MISSING_DASH.at(span, found=found)
     if label == "missing-equals":
@@ -110,14 +111,31 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
     return codes.SYNTAX_ERROR.at(span, found=found, expected=_expected(expected), hint=hint)
 
 
+STATEMENT_KEYWORDS = {"CHAIN", "DH", "LIBRARY", "BASE", "TOOL", "PAYLOAD", "POSE", "LIMIT", "BOX", "SPHERE", "CYLINDER", "TARGET", "ALLOW"}
+WORDS = {"NAME", "CODE_NAME", "UNIT_NAME", "MEASURE", "LIBRARY_REF"}
+
+
+def _rule_label(e) -> str | None:
+    """The two commonest mistakes, decided from what the parser expected (examples cover the rest)."""
+    import re
+
+    accepts = set(e.accepts or e.expected)
+    # token types are the lexer's fallback guess here, so look at the text itself
+    if "MINUS" in accepts and re.fullmatch(r"[A-Za-z]+[0-9]+", str(e.token)):
+        return "missing-dash"
+    if e.token.type in WORDS and accepts & STATEMENT_KEYWORDS:
+        return "expected-statement"
+    return None
+
+
 def _open_robot(text: str) -> str | None:
     """Name of the robot block left open at end of file, if any (comments ignored)."""
     import re
 
     depth, name = 0, None
-    for m in re.finditer(r"#[^\n]*|\brobot\s+([A-Za-z_]\w*)|[{}]", text):
+    for m in re.finditer(r"#[^\n]*|\"[^\"\n]*\"|\brobot\s+([A-Za-z_]\w*)|[{}]", text):
         s = m.group(0)
-        if s.startswith("#"):
+        if s.startswith(("#", '"')):
             continue
         if m.group(1):
             name = m.group(1)

@@ -11,20 +11,34 @@ def _span(file: str, node) -> Span:
     return Span(file, s.line + 1, s.column + 1, e.line + 1, max(e.column + 1, s.column + 2), s.index, e.index)
 
 
-def _plain(node, path: tuple, spans: dict, file: str):
-    """YAML node -> Python data, recording each value's span by its path."""
+class _Unsupported(Exception):
+    def __init__(self, node, detail: str):
+        super().__init__(detail)
+        self.node, self.detail = node, detail
+
+
+def _plain(node, path: tuple, spans: dict, file: str, seen: set | None = None):
+    """YAML node -> Python data, recording each value's span by its path. Anchors/aliases are
+    refused (a recursive alias never ends, nested ones grow exponentially), as are non-scalar keys."""
     import yaml
 
+    seen = set() if seen is None else seen
+    if isinstance(node, (yaml.MappingNode, yaml.SequenceNode)):
+        if id(node) in seen:
+            raise _Unsupported(node, "anchors and aliases (&name, *name) are not supported; write the value out")
+        seen.add(id(node))
     spans[path] = _span(file, node)
     if isinstance(node, yaml.MappingNode):
         out = {}
         for k, v in node.value:
+            if not isinstance(k, yaml.ScalarNode):
+                raise _Unsupported(k, "mapping keys must be plain names")
             key = k.value
             spans[path + (key, "__key__")] = _span(file, k)
-            out[key] = _plain(v, path + (key,), spans, file)
+            out[key] = _plain(v, path + (key,), spans, file, seen)
         return out
     if isinstance(node, yaml.SequenceNode):
-        return [_plain(v, path + (i,), spans, file) for i, v in enumerate(node.value)]
+        return [_plain(v, path + (i,), spans, file, seen) for i, v in enumerate(node.value)]
     value = node.value
     if node.tag.endswith(":int") or node.tag.endswith(":float"):
         try:
@@ -175,13 +189,18 @@ def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
         mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         detail = getattr(e, "problem", None) or str(e).splitlines()[0]
-        diags.append(codes.YAML_SYNTAX.at(Span(file, line, col, line, col + 1), detail=detail))
+        index = mark.index if mark else 0
+        diags.append(codes.YAML_SYNTAX.at(Span(file, line, col, line, col + 1, index, index + 1), detail=detail))
         return ast.File(file, ()), diags
     if node is None:
         diags.append(codes.EMPTY_FILE.at(Span.point(file)))
         return ast.File(file, ()), diags
     spans: dict = {}
-    data = _plain(node, (), spans, file)
+    try:
+        data = _plain(node, (), spans, file)
+    except _Unsupported as e:
+        diags.append(codes.YAML_SCHEMA.at(_span(file, e.node), detail=e.detail))
+        return ast.File(file, ()), diags
     try:
         doc = Document.model_validate(data)
     except ValidationError as e:

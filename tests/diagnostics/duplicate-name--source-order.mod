@@ -1,4 +1,3 @@
-# corpus-xfail: check_names walks poses, then targets, then obstacles, so it flags the box (written first) instead of the target written after it
 robot cellarm {
     chain H1 - H4(pivot=-90deg) - L3(port=45deg)
     box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.25) m

@@ -1,0 +1,145 @@
+"""The trajectory file (SPEC section 6): what `modc plan --json` prints and `modc play --traj`
+reads.
+
+    {"joint_names": ["joint_1", …, "joint_n"],
+     "points": [{"t": 0.0, "q": [rad, …]}, {"t": 0.1, "q": [...]}, …],
+     "robot": "farm"}                       optional: which robot of the file (for multi-robot files)
+
+Rules (validate / validate_for): joint_names are the robot's joints, each once, in any order; at
+least one point; every t a finite number >= 0, strictly increasing; every q a list of finite
+numbers, one per joint name, inside the joint's range (the library's, narrowed by `limit`).
+Between points the motion is linear in joint space (Trajectory.at). Errors are plain strings
+naming the place in the file ("points[3].t: …"); nothing here raises on bad content.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+RANGE_TOL = 1e-9  # rad: q on a joint limit, written with rounding, is still inside
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    joint_names: tuple[str, ...]
+    t: tuple[float, ...]
+    q: tuple[tuple[float, ...], ...]
+    robot: str | None = None
+
+    @property
+    def duration(self) -> float:
+        return self.t[-1] - self.t[0]
+
+    def in_order(self, names) -> "Trajectory":
+        """The same motion with columns in the order of `names` (e.g. joint_1 … joint_n)."""
+        idx = [self.joint_names.index(n) for n in names]
+        return Trajectory(tuple(names), self.t, tuple(tuple(row[i] for i in idx) for row in self.q), self.robot)
+
+    def at(self, time: float) -> tuple[float, ...]:
+        """Joint values at `time`, linear between points, held before the first and after the last."""
+        import bisect
+
+        if time <= self.t[0]:
+            return self.q[0]
+        if time >= self.t[-1]:
+            return self.q[-1]
+        k = bisect.bisect_right(self.t, time)
+        t0, t1 = self.t[k - 1], self.t[k]
+        a = (time - t0) / (t1 - t0)
+        return tuple(x0 + a * (x1 - x0) for x0, x1 in zip(self.q[k - 1], self.q[k]))
+
+    def to_json(self) -> dict:
+        doc = {"joint_names": list(self.joint_names), "points": [{"t": t, "q": list(q)} for t, q in zip(self.t, self.q)]}
+        if self.robot is not None:
+            doc["robot"] = self.robot
+        return doc
+
+    def dumps(self) -> str:
+        return json.dumps(self.to_json(), indent=2) + "\n"
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def parse(doc) -> tuple[Trajectory | None, list[str]]:
+    """Structure of a loaded JSON document -> (trajectory or None, errors)."""
+    errors: list[str] = []
+    if not isinstance(doc, dict):
+        return None, [f"the top level must be an object with joint_names and points, not {type(doc).__name__}"]
+    names = doc.get("joint_names")
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+        errors.append("joint_names: expected a non-empty list of joint names")
+        names = None
+    else:
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            errors.append(f"joint_names: {', '.join(dup)} listed more than once")
+    robot = doc.get("robot")
+    if robot is not None and not isinstance(robot, str):
+        errors.append("robot: expected a robot name")
+        robot = None
+    points = doc.get("points")
+    if not isinstance(points, list) or not points:
+        errors.append("points: expected a non-empty list of {\"t\": seconds, \"q\": [radians…]}")
+        return None, errors
+    ts, qs = [], []
+    for k, pt in enumerate(points):
+        where = f"points[{k}]"
+        if not isinstance(pt, dict):
+            errors.append(f"{where}: expected an object {{\"t\": …, \"q\": […]}}")
+            continue
+        t, q = pt.get("t"), pt.get("q")
+        if not _number(t):
+            errors.append(f"{where}.t: expected a finite number of seconds, got {json.dumps(t)}")
+        elif t < 0:
+            errors.append(f"{where}.t: {t:g} s is negative")
+        elif ts and ts[-1] is not None and t <= ts[-1]:
+            errors.append(f"{where}.t: {t:g} s does not come after points[{k - 1}].t = {ts[-1]:g} s (times must increase)")
+        ts.append(t if _number(t) else None)
+        if not isinstance(q, list) or not all(_number(x) for x in q):
+            errors.append(f"{where}.q: expected a list of finite numbers (radians)")
+            qs.append(None)
+            continue
+        if names is not None and len(q) != len(names):
+            errors.append(f"{where}.q: {len(q)} value(s) for {len(names)} joint name(s)")
+        qs.append(tuple(float(x) for x in q))
+    if errors or names is None:
+        return None, errors
+    return Trajectory(tuple(names), tuple(float(t) for t in ts), tuple(qs), robot), []
+
+
+def validate_for(traj: Trajectory, robot) -> list[str]:
+    """The trajectory fits this robot: its joints, inside their ranges."""
+    want = [f"joint_{i}" for i in range(1, robot.dof + 1)]
+    errors = []
+    unknown = [n for n in traj.joint_names if n not in want]
+    missing = [n for n in want if n not in traj.joint_names]
+    if unknown:
+        errors.append(f"joint_names: robot {robot.name} has no joint(s) {', '.join(unknown)} (its joints: {', '.join(want)})")
+    if missing:
+        errors.append(f"joint_names: joint(s) {', '.join(missing)} of robot {robot.name} missing")
+    if errors:
+        return errors
+    ordered = traj.in_order(want)
+    for i, name in enumerate(want):
+        lo, hi = robot.joint_range(i + 1)
+        for k, row in enumerate(ordered.q):
+            v = row[i]
+            if v < lo - RANGE_TOL or v > hi + RANGE_TOL:
+                errors.append(f"points[{k}].q: {name} = {v:.6g} rad ({math.degrees(v):.1f}°) is outside its range "
+                              f"[{math.degrees(lo):.1f}°, {math.degrees(hi):.1f}°]")
+                break  # one message per joint is enough
+    return errors
+
+
+def load(path: str | Path) -> tuple[Trajectory | None, list[str]]:
+    """Read and check the structure. Raises OSError when the file cannot be read."""
+    text = Path(path).read_text(encoding="utf-8-sig")
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as e:
+        return None, [f"not JSON: {e.msg} at line {e.lineno}, column {e.colno}"]
+    return parse(doc)

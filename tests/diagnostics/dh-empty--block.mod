@@ -1,0 +1,4 @@
+robot planar {
+    dh {   # expect: error[dh-empty]
+    }
+}

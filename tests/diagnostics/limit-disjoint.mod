@@ -1,0 +1,4 @@
+robot farm {
+    chain H1 - L4(port=45deg) - L1
+    limit joint_2 (171, 175) deg   # expect: error[limit-disjoint]
+}

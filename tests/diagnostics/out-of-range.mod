@@ -1,0 +1,3 @@
+robot farm {
+    chain H1 - H4(pivot=1e307rad) - L4   # expect: error[out-of-range]
+}
