@@ -54,6 +54,7 @@ def compile_cmd(
     force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
     collision_samples: Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")] = 10_000,
     seed: Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")] = 0,
+    smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
     torque: Annotated[Optional[TorqueLevel], typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
@@ -82,6 +83,15 @@ def compile_cmd(
         if unknown:
             _err(f"modc: unknown backend(s) {', '.join(unknown)}; available: {', '.join(load_all())}")
             raise typer.Exit(EXIT_USAGE)
+    if smoke:  # before anything is written: a failed smoke test leaves OUT as it was
+        from .sim.smoke import run_sim
+
+        ok, lines, _ = run_sim(file, library=library)
+        for line in lines:
+            _err(line)
+        if not ok:
+            _err(f"modc: smoke test failed; nothing written to {out}")
+            raise typer.Exit(EXIT_ERRORS)
     files = build(checked, selected, collision_samples=collision_samples, seed=seed)
     try:
         write_tree(files, out, force=force)
@@ -323,6 +333,115 @@ def lsp_cmd() -> None:
     from .lsp import serve
 
     serve()
+
+
+@app.command("sim")
+def sim_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    robot: Annotated[Optional[str], typer.Option(help="simulate only this robot of the file")] = None,
+    srdf_from: Annotated[Optional[str], typer.Option("--srdf-from", help="a compile output OUT/ whose config/*.srdf disabled collision pairs are honoured")] = None,
+    library: LibraryOpt = None,
+):
+    """PyBullet smoke test: load every robot, hold home and every named pose with the actuators'
+    peak torque, check tracking, self-collision, the environment, FK and holding torques.
+    Exit 1 on any failure, saying what failed."""
+    from .compiler import InputError
+    from .sim.scene import UsageError
+    from .sim.smoke import run_sim
+
+    try:
+        ok, lines, checked = run_sim(file, library=library, robot=robot, out_dir=srdf_from)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    except UsageError as e:
+        _err(f"modc sim: {e}")
+        raise typer.Exit(EXIT_USAGE)
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    for line in lines:
+        print(line)
+    raise typer.Exit(EXIT_OK if ok else EXIT_ERRORS)
+
+
+@app.command("render")
+def render_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    out: Annotated[str, typer.Option("-o", "--out", help="PNG file to write")],
+    pose: Annotated[Optional[str], typer.Option(help="named pose (default: home)")] = None,
+    robot: Annotated[Optional[str], typer.Option(help="render only this robot of the file")] = None,
+    size: Annotated[str, typer.Option(help="WIDTHxHEIGHT in pixels")] = "800x600",
+    azimuth: Annotated[Optional[float], typer.Option(help="camera azimuth in degrees from +x towards +y (default: chosen)")] = None,
+    elevation: Annotated[Optional[float], typer.Option(help="camera elevation in degrees (default 30)")] = None,
+    colors: Annotated[Optional[int], typer.Option(help="quantise to a palette of this many colours (<= 256) for small files")] = None,
+    library: LibraryOpt = None,
+):
+    """A picture of the arm, its environment and its targets (PyBullet TinyRenderer, headless)."""
+    from .compiler import InputError
+    from .sim.render import render
+    from .sim.scene import UsageError
+
+    try:
+        width, height = (int(v) for v in size.lower().split("x"))
+        assert width > 0 and height > 0
+    except (ValueError, AssertionError):
+        _err(f"modc render: --size {size!r}: expected WIDTHxHEIGHT, e.g. 800x600")
+        raise typer.Exit(EXIT_USAGE)
+    if colors is not None and not 2 <= colors <= 256:
+        _err(f"modc render: --colors {colors}: expected 2 to 256")
+        raise typer.Exit(EXIT_USAGE)
+    try:
+        ok, lines, checked = render(file, out, pose=pose, robot=robot, library=library, width=width, height=height,
+                                    azimuth=azimuth, elevation=elevation, colors=colors)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    except UsageError as e:
+        _err(f"modc render: {e}")
+        raise typer.Exit(EXIT_USAGE)
+    except OSError as e:
+        _err(f"modc render: cannot write {out}: {e.strerror or e}")
+        raise typer.Exit(EXIT_USAGE)
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    for line in lines:
+        _err(line)
+    raise typer.Exit(EXIT_OK if ok else EXIT_ERRORS)
+
+
+@app.command("play")
+def play_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    traj: Annotated[str, typer.Option("--traj", help="trajectory JSON, as `modc plan --json` prints")],
+    record: Annotated[Optional[str], typer.Option(help="write a GIF of the motion (headless TinyRenderer)")] = None,
+    robot: Annotated[Optional[str], typer.Option(help="the robot the trajectory is for (files with several robots)")] = None,
+    headless: Annotated[bool, typer.Option("--headless", help="never open the PyBullet GUI")] = False,
+    library: LibraryOpt = None,
+):
+    """Play a trajectory in PyBullet: in the GUI when a display works, else headless; report
+    tracking and collisions; --record OUT.gif."""
+    from .compiler import InputError
+    from .sim.play import play
+    from .sim.scene import UsageError
+
+    try:
+        ok, lines, checked = play(file, traj, record=record, robot=robot, library=library, gui=False if headless else None)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    except UsageError as e:
+        _err(f"modc play: {e}")
+        raise typer.Exit(EXIT_USAGE)
+    except OSError as e:
+        _err(f"modc play: cannot write {record}: {e.strerror or e}")
+        raise typer.Exit(EXIT_USAGE)
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    if not ok:
+        from .diagnostics import Span, codes
+
+        _print_diagnostics([codes.TRAJ_INVALID.at(Span.point(traj), detail=line) for line in lines], {})
+        raise typer.Exit(EXIT_ERRORS)
+    for line in lines:
+        print(line)
+    raise typer.Exit(EXIT_OK)
 
 
 @app.command("schema")

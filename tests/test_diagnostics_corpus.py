@@ -66,6 +66,7 @@ FUNCTION_CASES = {
     "unsupported-input": "test_unsupported_input",
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
+    "traj-invalid": "test_traj_invalid",
 }
 
 YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
@@ -251,17 +252,8 @@ def test_corpus_diagnostics_are_well_formed(path: Path):
     _check_each(path, check_well_formed)
 
 
-def _eof_after_newline(path: Path) -> bool:
-    text = source_text(path)
-    return any(d.span.line > len(text.splitlines()) for d in diagnostics_of(path))
-
-
 @pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES])
-def test_corpus_diagnostics_render_with_caret(path: Path, request):
-    if _eof_after_newline(path):
-        request.applymarker(pytest.mark.xfail(
-            reason="a diagnostic at end of file after a final newline (line = last line + 1) renders without "
-            "an excerpt: render.excerpt drops lines past str.splitlines()", strict=False))
+def test_corpus_diagnostics_render_with_caret(path: Path):
     _check_each(path, check_rendered)
 
 
@@ -495,3 +487,14 @@ def test_excerpt_with_crlf_line_endings():
     c = check_text(text, "t.mod")
     assert [(d.span.line, d.code) for d in c.diagnostics] == [(3, "pose-arity")]
     check_rendered(c.diagnostics[0], text, "t.mod")
+
+
+def test_traj_invalid(tmp_path):
+    """`modc play` with a trajectory for other joints: a diagnostic at the trajectory file, exit 1."""
+    traj = tmp_path / "t.json"
+    traj.write_text(json.dumps({"joint_names": ["joint_1", "joint_9"], "points": [{"t": 0, "q": [0, 0]}]}))
+    src = HERE.parent / "examples" / "quickstart.mod"
+    r = subprocess.run([sys.executable, "-m", "modc", "play", str(src), "--traj", str(traj), "--headless"],
+                       capture_output=True, text=True)
+    assert r.returncode == 1, r.stderr
+    assert f"{traj}:1:1: error[traj-invalid]:" in r.stderr and "= hint:" in r.stderr and "Traceback" not in r.stderr

@@ -385,3 +385,23 @@ def test_trajectory_roundtrip_and_interpolation():
     assert t.at(-1.0) == t.q[0] and t.at(5.0) == t.q[-1]
     assert np.allclose(t.at(0.3), [0.45, -0.25, 0.4])
     assert json.loads(t.dumps()) == SWEEP
+
+
+def test_compile_smoke_option(tmp_path):
+    """`modc FILE -o OUT --smoke` runs the PyBullet smoke test first; a failure writes nothing."""
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parent.parent
+    r = subprocess.run([sys.executable, "-m", "modc", str(root / "examples" / "farm.mod"), "-o", str(tmp_path / "ok"), "--smoke"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0 and "robot farm (H1-L4-L3): ok" in r.stderr
+    bad = tmp_path / "heavy.mod"
+    bad.write_text("robot heavy {\n    chain H1 - L4(pivot=-90deg, link=450mm) - L4(link=450mm)\n    payload 1 kg\n"
+                   "    pose out (0, -90, 0) deg\n}\n")
+    # --torque off lets the static check pass, so the simulation is what refuses the arm
+    r = subprocess.run([sys.executable, "-m", "modc", str(bad), "-o", str(tmp_path / "out"), "--smoke", "--torque", "off"],
+                       capture_output=True, text=True)
+    assert r.returncode == 1, r.stderr
+    assert "joint_2 sags" in r.stderr and "smoke test failed; nothing written" in r.stderr
+    assert not (tmp_path / "out").exists()

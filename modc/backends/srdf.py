@@ -65,8 +65,7 @@ def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
     key = (robot.name, samples, seed)
     if key not in cache:
         files = robot_files(build, robot)
-        geo = collisions.load(files, f"urdf/{robot.file_stem}.urdf")
-        cache[key] = collisions.compute(geo, samples=samples, seed=seed)
+        cache[key] = collisions.cached_compute(files, f"urdf/{robot.file_stem}.urdf", samples, seed)
     return cache[key]
 
 

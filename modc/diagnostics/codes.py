@@ -165,6 +165,9 @@ EPSILON_DISAGREES = _register("epsilon-disagrees", N, "the paper's ε rule and t
 BAD_PAYLOAD = _register("bad-payload", E, "a --payload value that is not a mass",
     "--payload {value!r} is not a mass", "write e.g. --payload 0.5kg or --payload 500g (a plain number means kg)")
 
+TRAJ_INVALID = _register("traj-invalid", E, "a trajectory file that does not fit the format or the robot",
+    "{detail}", "a trajectory is {{\"joint_names\": [...], \"points\": [{{\"t\": s, \"q\": [rad, ...]}}, ...]}}, as `modc plan --json` prints")
+
 # --- names, poses, limits, environment ---------------------------------------------------------
 DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",
     "robot '{name}' is defined twice", "rename one of them; output files are named after robots")

@@ -390,6 +390,37 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
     return CollisionMatrix(links, glinks, disabled, enabled, samples, seed, tuple(float(x) for x in q0), counts, stats)
 
 
+ALGORITHM = "1"  # bump when compute() could classify any pair differently
+
+
+def cached_compute(files: Mapping[str, str | bytes], urdf_path: str, samples: int = DEFAULT_SAMPLES,
+                   seed: int = DEFAULT_SEED) -> CollisionMatrix:
+    """compute() on the emitted files, through the disk cache: the matrix is a pure function of
+    the URDF, its meshes, the sample count and the seed, so a hit equals a fresh computation
+    (per-pair counts and stats are not kept)."""
+    import json
+
+    from .. import cache
+
+    parts = [ALGORITHM, str(samples), str(seed), urdf_path]
+    for rel in sorted(files):
+        parts += [rel, files[rel]]
+    name = cache.key(*parts) + ".json"
+    hit = cache.get("collisions", name)
+    if hit is not None:
+        d = json.loads(hit)
+        return CollisionMatrix(
+            links=tuple(d["links"]), geometry_links=tuple(d["geometry_links"]),
+            disabled=tuple(Pair(*p) for p in d["disabled"]), enabled=tuple(tuple(p) for p in d["enabled"]),
+            samples=d["samples"], seed=d["seed"], default_q=tuple(d["default_q"]))
+    matrix = compute(load(files, urdf_path), samples=samples, seed=seed)
+    doc = {"links": matrix.links, "geometry_links": matrix.geometry_links,
+           "disabled": [[p.link1, p.link2, p.reason] for p in matrix.disabled], "enabled": matrix.enabled,
+           "samples": matrix.samples, "seed": matrix.seed, "default_q": matrix.default_q}
+    cache.put("collisions", name, json.dumps(doc).encode())
+    return matrix
+
+
 def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_SEED) -> CollisionMatrix:
     """The anchor for the benchmark and a cross-check in the tests: every mesh pair of every
     non-adjacent link pair, in every sample, every result read back. Same classification."""

@@ -5,27 +5,17 @@ trimesh takes most of a second to import, so generated files are kept in the use
 """
 from __future__ import annotations
 
-import hashlib
-import os
-from pathlib import Path
-
 import numpy as np
 
+from .. import cache
 from .parts import Part, mesh_primitives
 
 SECTIONS = 48
 _VERSION = "1"
 
 
-def _cache_dir() -> Path | None:
-    root = os.environ.get("MODC_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "modc")
-    return Path(root) / "meshes"
-
-
 def _key(part: Part) -> str:
-    text = repr((_VERSION, SECTIONS, mesh_primitives(part)))
-    return hashlib.sha256(text.encode()).hexdigest()[:24]
+    return cache.key(_VERSION, str(SECTIONS), repr(mesh_primitives(part)))
 
 
 def build(part: Part) -> bytes:
@@ -48,17 +38,9 @@ def build(part: Part) -> bytes:
 
 
 def stl_bytes(part: Part) -> bytes:
-    cache = _cache_dir()
-    path = cache / f"{part.mesh}-{_key(part)}.stl" if cache else None
-    if path is not None and path.is_file():
-        return path.read_bytes()
-    data = build(part)
-    if path is not None:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_suffix(f".{os.getpid()}.tmp")
-            tmp.write_bytes(data)
-            os.replace(tmp, path)
-        except OSError:
-            pass  # a read-only home is fine: we just regenerate next time
+    name = f"{part.mesh}-{_key(part)}.stl"
+    data = cache.get("meshes", name)
+    if data is None:
+        data = build(part)
+        cache.put("meshes", name, data)
     return data

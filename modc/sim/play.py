@@ -44,12 +44,22 @@ def pick_robot(checked, traj: trajectory.Trajectory, robot: str | None):
 
 
 def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
-    """A looping GIF, every frame on the first frame's adaptive palette (deterministic)."""
+    """A looping GIF, every frame on one adaptive palette (deterministic)."""
     from PIL import Image
 
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    palette = frames[0].quantize(colors=255, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+    # one palette for the whole animation, from up to 8 frames spread over it (stacked): 200
+    # median-cut colours for the large smooth areas (background, ground, links; no banding) and
+    # 55 octree colours, which keep the saturated hues of small parts (tool0 triad, targets)
+    picks = [frames[round(k * (len(frames) - 1) / 7)] for k in range(8)] if len(frames) > 8 else frames
+    sheet = Image.new("RGB", (picks[0].width, picks[0].height * len(picks)))
+    for k, f in enumerate(picks):
+        sheet.paste(f, (0, k * f.height))
+    smooth = sheet.quantize(colors=200, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).getpalette()[:600]
+    vivid = sheet.quantize(colors=55, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE).getpalette()[:165]
+    palette = Image.new("P", (1, 1))
+    palette.putpalette(smooth + vivid + [0, 0, 0] * (256 - (len(smooth) + len(vivid)) // 3))
     pal = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
     ms = round(1000.0 / fps)
     durations = [ms] * len(pal)

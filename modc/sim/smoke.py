@@ -19,14 +19,15 @@ static bodies), then:
     hold        the joints are put at the pose at rest, every actuator holds its target with
                 POSITION_CONTROL (force = the URDF effort = the actuator's peak torque,
                 maxVelocity = the URDF velocity = its rated speed), and HOLD_TIME of simulated
-                time passes at 1 kHz (the rate of the Kinova actuators' control loop). Then:
+                time passes at 1 kHz (TIME_STEP). Then:
                 every joint stays within TRACK_TOL of its target over the last SETTLE_WINDOW,
                 and nothing explodes (finite states, |velocity| < EXPLODE_VELOCITY).
     torque      when every joint holds: the torque PyBullet's motors apply (averaged over the
-                settle window) equals the static
-                gravity torque of modc.dynamics (pinocchio on the same URDF, gravity turned by the
-                base placement, what `modc check` uses) to TORQUE_TOL + TORQUE_REL · |tau|: the two
-                engines agree on masses, centres of mass and the direction of gravity.
+                settle window) equals the static gravity torque of modc.dynamics (pinocchio on
+                the same URDF, gravity turned by the base placement: what `modc check` uses) at
+                the resting configuration, to TORQUE_TOL + TORQUE_REL · |tau|: the two engines
+                agree on masses, centres of mass and the direction of gravity (measured over
+                the examples: within 1e-8 N·m).
 
 Why TRACK_TOL = 1e-2 rad. PyBullet's POSITION_CONTROL is a velocity servo solved as a
 constraint: it leaves a numerical steady-state error of about tau_gravity · dt² / (kp · inertia),
@@ -34,9 +35,9 @@ which is no property of the arm. At 1 kHz and PyBullet's default gains it is at 
 over the examples (2.5e-3 rad at PyBullet's default 240 Hz, hence the finer step). A joint whose
 actuator cannot hold the arm saturates at its peak torque and falls: tenths of a radian within
 the first second. 1e-2 rad (0.57°, 2 mm at the end of a 0.22 m link) separates the two by more
-than an order of magnitude on both sides. When a joint fails, the message gives PyBullet's
-static gravity torque at the pose (modc.dynamics; PyBullet's own calculateInverseDynamics
-ignores a fixed base's orientation, so it is not used) next to the actuator's peak.
+than an order of magnitude on both sides. When a joint fails, the message gives the static
+gravity torque at the pose (modc.dynamics; PyBullet's own calculateInverseDynamics ignores a
+fixed base's orientation, so it is not used) next to the actuator's peak.
 """
 from __future__ import annotations
 

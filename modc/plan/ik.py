@@ -1,0 +1,136 @@
+"""Position inverse kinematics of tool0 with pinocchio: Levenberg-Marquardt, projected onto the
+joint limits, from many deterministic seeds.
+
+    solve(model, data, frame, target, lower, upper, seeds) -> [Solution]
+
+One run: minimise |p(q) - target|² over lower <= q <= upper. Each step solves the damped normal
+equations (J Jᵀ + λ I) y = e, dq = Jᵀ y with J the 3 x n position Jacobian of tool0 in
+base_link axes, then clamps q + dq to the limits (projection); a step is kept only if it
+lowers the error (then λ shrinks), otherwise λ grows and the step is tried again: LM's
+trust-region behaviour, which converges quadratically near a solution and does not blow up
+near singular poses. Runs that converge are polished to TOLERANCE (1e-9 m) and, for arms with
+more joints than the 3 the position needs, slid along their self-motion towards the start pose
+(null-space steps that keep the position) so that "the closest solution" is well defined.
+
+A run that does not reach the target stops at a local minimum of the distance: the smallest
+of those over all seeds is what "how far out of reach" reports.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+TOLERANCE = 1e-9  # m: a converged run is within this of the target
+MAX_ITERATIONS = 200
+LAMBDA0 = 1e-3
+LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e8
+NULL_STEPS = 60  # redundant arms: steps towards the start pose along the self-motion
+
+
+@dataclass(frozen=True)
+class Solution:
+    q: np.ndarray
+    error: float  # m, |p(q) - target|
+    seed_index: int
+
+
+class PositionIK:
+    def __init__(self, model, data, frame: int, lower, upper):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.model, self.data, self.frame = model, data, frame
+        self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
+
+    def position(self, q) -> np.ndarray:
+        pin = self.pin
+        pin.forwardKinematics(self.model, self.data, q)
+        return np.array(pin.updateFramePlacement(self.model, self.data, self.frame).translation)
+
+    def jacobian(self, q) -> np.ndarray:
+        pin = self.pin
+        J = pin.computeFrameJacobian(self.model, self.data, q, self.frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        return np.array(J[:3])
+
+    def run(self, q0, target) -> tuple[np.ndarray, float]:
+        """One projected LM descent from q0: (q, final error)."""
+        q = np.clip(np.asarray(q0, float), self.lower, self.upper)
+        e = target - self.position(q)
+        err = float(np.linalg.norm(e))
+        lam = LAMBDA0
+        for _ in range(MAX_ITERATIONS):
+            if err <= TOLERANCE:
+                break
+            J = self.jacobian(q)
+            JJt = J @ J.T
+            improved = False
+            while lam <= LAMBDA_MAX:
+                y = np.linalg.solve(JJt + lam * np.eye(3), e)
+                qn = np.clip(q + J.T @ y, self.lower, self.upper)
+                en = target - self.position(qn)
+                errn = float(np.linalg.norm(en))
+                if errn < err:
+                    q, e, err = qn, en, errn
+                    lam = max(lam / 10.0, LAMBDA_MIN)
+                    improved = True
+                    break
+                lam *= 10.0
+            if not improved:  # a local minimum (the target is out of reach from here) or stuck on a limit
+                break
+        return q, err
+
+    def towards(self, q, q_ref, target) -> np.ndarray:
+        """Redundant arms: move a converged q towards q_ref without leaving the target (projected
+        gradient steps in the Jacobian's null space, each re-converged; a step that leaves the
+        limits or the target is dropped)."""
+        n = q.size
+        if n <= 3:
+            return q
+        for _ in range(NULL_STEPS):
+            J = self.jacobian(q)
+            Jp = np.linalg.pinv(J, rcond=1e-6)
+            N = np.eye(n) - Jp @ J
+            step = N @ (q_ref - q) * 0.5
+            if np.linalg.norm(step) < 1e-9:
+                break
+            qn = np.clip(q + step, self.lower, self.upper)
+            qn, err = self.run(qn, target)
+            if err > TOLERANCE or np.linalg.norm(qn - q_ref) >= np.linalg.norm(q - q_ref) - 1e-12:
+                break
+            q = qn
+        return q
+
+
+def seeds(start, lower, upper, count: int, seed: int) -> list[np.ndarray]:
+    """The start pose first, then uniform samples in the joint limits from default_rng(seed)."""
+    rng = np.random.default_rng(seed)
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    out = [np.clip(np.asarray(start, float), lower, upper)]
+    out += list(lower + (upper - lower) * rng.random((count - 1, lower.size)))
+    return out
+
+
+def solve(ik: PositionIK, target, start, count: int, seed: int) -> tuple[list[Solution], Solution]:
+    """Converged solutions (duplicates within 1e-6 rad dropped), in order of joint-space
+    distance to start, and the best run overall (the closest approach, for error messages)."""
+    target = np.asarray(target, float)
+    start = np.asarray(start, float)
+    found: list[Solution] = []
+    best: Solution | None = None
+    for k, q0 in enumerate(seeds(start, ik.lower, ik.upper, count, seed)):
+        q, err = ik.run(q0, target)
+        if best is None or err < best.error:
+            best = Solution(q, err, k)
+        if err > TOLERANCE:
+            continue
+        q = ik.towards(q, start, target)
+        if any(np.max(np.abs(s.q - q)) < 1e-6 for s in found):
+            continue
+        found.append(Solution(q, float(np.linalg.norm(target - ik.position(q))), k))
+    found.sort(key=lambda s: (float(np.linalg.norm(s.q - start)), s.seed_index))
+    assert best is not None
+    return found, best
+
+
+__all__ = ["MAX_ITERATIONS", "TOLERANCE", "PositionIK", "Solution", "seeds", "solve"]
