@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -15,16 +16,19 @@ class Inertial:
     inertia: np.ndarray  # (3, 3) about com, link frame axes
 
 
-def part_inertial(part: Part, T_link_part: np.ndarray) -> Inertial:
-    """A part's inertial in the link frame; its mass is spread over its primitives by volume."""
+@lru_cache(maxsize=512)
+def _local(part: Part) -> Inertial:
+    """The part's inertial in its own frame: constant, so computed once per part."""
     vols = np.array([p.volume for p in part.primitives])
     masses = part.mass * vols / vols.sum()
+    return combine([Inertial(m, np.array(prim.center), prim.inertia(m)) for prim, m in zip(part.primitives, masses)])
+
+
+def part_inertial(part: Part, T_link_part: np.ndarray) -> Inertial:
+    """A part's inertial in the link frame; its mass is spread over its primitives by volume."""
+    local = _local(part)
     R, p = T_link_part[:3, :3], T_link_part[:3, 3]
-    items = [
-        Inertial(m, R @ np.array(prim.center) + p, R @ prim.inertia(m) @ R.T)
-        for prim, m in zip(part.primitives, masses)
-    ]
-    return combine(items)
+    return Inertial(local.mass, R @ local.com + p, R @ local.inertia @ R.T)
 
 
 def combine(items: list[Inertial]) -> Inertial:
