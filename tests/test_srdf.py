@@ -283,7 +283,8 @@ def test_batch_forward_kinematics_matches_pinocchio():
 # determinism and options
 
 
-def test_srdf_is_deterministic_and_seeded(example_srdfs):
+def test_srdf_is_deterministic_and_seeded(example_srdfs, monkeypatch):
+    monkeypatch.setenv("MODC_NO_CACHE", "1")  # really recompute: a cache hit would only compare with itself
     for stem in ("example_a", "example_b", "farm"):
         b, files = example_srdfs[stem]
         c = check_file(ROOT / "examples" / f"{stem}.mod")
@@ -450,3 +451,16 @@ def test_pinocchio_reads_the_srdf(example_srdfs, compiled_examples, tmp_path):
             assert left.isdisjoint(disabled)
             m = srdf.collision_matrix(b, r)
             assert {p for p in left if len(p) == 2} == {frozenset(p) for p in m.enabled}
+
+
+def test_disk_cache_hit_equals_a_fresh_computation(tmp_path, monkeypatch):
+    """The collision matrix is cached by content hash; what comes back is what compute() gives."""
+    monkeypatch.setenv("MODC_CACHE_DIR", str(tmp_path))
+    c = check_file(ROOT / "examples" / "example_b.mod")
+    (r,) = c.design.robots
+    fresh = srdf.collision_matrix(_build(c, samples=2000, seed=3), r)
+    assert list((tmp_path / "collisions").glob("*.json")), "the first computation is stored"
+    hit = srdf.collision_matrix(_build(c, samples=2000, seed=3), r)
+    assert hit == fresh and hit.counts == {}  # counts are not kept: they only explain a fresh run
+    other_seed = srdf.collision_matrix(_build(c, samples=2000, seed=4), r)
+    assert len(list((tmp_path / "collisions").glob("*.json"))) == 2 and other_seed.seed == 4

@@ -107,15 +107,11 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
     directory so that pinocchio resolves relative mesh paths exactly as a user's tools do."""
     import pinocchio as pin
 
+    from ..files import write_files
+
     with tempfile.TemporaryDirectory(prefix="modc-collisions-") as tmp:
         root = Path(tmp)
-        for rel, content in files.items():
-            target = root / rel
-            target.parent.mkdir(parents=True, exist_ok=True)
-            if isinstance(content, bytes):
-                target.write_bytes(content)
-            else:
-                target.write_text(content, encoding="utf-8")
+        write_files(files, root)
         urdf_file = root / urdf_path
         model = pin.buildModelFromUrdf(str(urdf_file))
         geom_model = pin.buildGeomFromUrdf(model, str(urdf_file), pin.GeometryType.COLLISION,

@@ -83,6 +83,13 @@ def obstacle_geometry(obstacle):
     return g, M
 
 
+def _box_corners(geometry) -> np.ndarray:
+    """The 8 corners of a geometry's bounding box in its own frame."""
+    v = _vertices(geometry)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+
+
 def _vertices(geometry) -> np.ndarray:
     if hasattr(geometry, "vertices"):
         return np.asarray(geometry.vertices(), float)
@@ -150,6 +157,7 @@ class CollisionChecker:
         for i, j in pairs:
             gm.addCollisionPair(pin.CollisionPair(i, j))
         self.gd = gm.createData()
+        self._corners = [_box_corners(go.geometry) for go in gm.geometryObjects]
         self.margin = float(margin)
         self.set_margin(margin)
         # a model with the static pairs only (tested once per start pose)
@@ -218,13 +226,28 @@ class CollisionChecker:
         return out
 
     def clearance(self, q) -> tuple[float, Contact | None]:
-        """Smallest distance over the checked pairs at q (m; negative inside), and that pair."""
+        """Smallest distance over the checked pairs at q (m; a negative value means in collision,
+        not necessarily the deepest penetration), and that pair. Pairs are visited in order of a lower bound (the distance between their world
+        axis-aligned boxes) and the search stops once the bound exceeds the best distance."""
         pin = self.pin
-        pin.computeDistances(self.model, self.data, self.gm, self.gd, np.asarray(q, float))
+        pin.updateGeometryPlacements(self.model, self.data, self.gm, self.gd, np.asarray(q, float))
+        lo = np.empty((len(self.owner), 3))
+        hi = np.empty((len(self.owner), 3))
+        for k, corners in enumerate(self._corners):
+            M = self.gd.oMg[k]
+            w = corners @ np.asarray(M.rotation).T + np.asarray(M.translation)
+            lo[k], hi[k] = w.min(axis=0), w.max(axis=0)
+        I = np.array([p[0] for p in self.pairs])
+        J = np.array([p[1] for p in self.pairs])
+        gap = np.maximum(0.0, np.maximum(lo[J] - hi[I], lo[I] - hi[J]))
+        bound = np.sqrt((gap ** 2).sum(axis=1))
         best, which = math.inf, None
-        for p, r in zip(self.gm.collisionPairs, self.gd.distanceResults):
-            if r.min_distance < best:
-                best, which = float(r.min_distance), p
+        for k in np.argsort(bound, kind="stable"):
+            if bound[k] >= best:
+                break
+            d = float(pin.computeDistance(self.gm, self.gd, int(k)).min_distance)
+            if d < best:
+                best, which = d, self.gm.collisionPairs[int(k)]
         if which is None:
             return math.inf, None
         return best, self._named([which])[0]

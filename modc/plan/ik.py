@@ -25,6 +25,7 @@ TOLERANCE = 1e-9  # m: a converged run is within this of the target
 MAX_ITERATIONS = 200
 LAMBDA0 = 1e-3
 LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e8
+STALL = 1e-6  # a step that lowers the error by less than this fraction ends the run
 NULL_STEPS = 60  # redundant arms: steps towards the start pose along the self-motion
 
 
@@ -71,12 +72,13 @@ class PositionIK:
                 en = target - self.position(qn)
                 errn = float(np.linalg.norm(en))
                 if errn < err:
+                    stalled = err - errn < STALL * err
                     q, e, err = qn, en, errn
                     lam = max(lam / 10.0, LAMBDA_MIN)
                     improved = True
                     break
                 lam *= 10.0
-            if not improved:  # a local minimum (the target is out of reach from here) or stuck on a limit
+            if not improved or stalled:  # a local minimum (out of reach from here), or crawling along a limit
                 break
         return q, err
 

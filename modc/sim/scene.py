@@ -77,17 +77,12 @@ def compiled(checked) -> Iterator[dict[str, Path]]:
     """The urdf and meshes backends' output written into a temporary directory (removed on exit):
     robot name -> URDF path. The same bytes `modc FILE -o OUT` writes."""
     from ..compiler import build
+    from ..files import write_files
 
     files = build(checked, ["urdf", "meshes"])
     with tempfile.TemporaryDirectory(prefix="modc-sim-") as tmp:
         root = Path(tmp)
-        for rel, content in files.items():
-            target = root / rel
-            target.parent.mkdir(parents=True, exist_ok=True)
-            if isinstance(content, bytes):
-                target.write_bytes(content)
-            else:
-                target.write_text(content, encoding="utf-8", newline="\n")
+        write_files(files, root)
         yield {r.name: root / "urdf" / f"{r.file_stem}.urdf" for r in checked.design.robots}
 
 

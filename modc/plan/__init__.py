@@ -1,0 +1,299 @@
+"""`modc plan FILE --to TARGET`: a collision-free motion of the arm from a pose (home) to a named
+target (SPEC section 6).
+
+    from modc.plan import plan, PlanError
+    result = plan("examples/farm.mod", "plant", seed=0)     # -> Plan, or raises PlanError
+    sys.stdout.write(result.dumps())                         # {"joint_names": …, "points": …}
+    print(result.summary())
+
+Steps (modules of this package):
+    collision.py  the compiled URDF's collision meshes + the file's obstacles, pinocchio + coal;
+                  self-collision pairs from the SRDF's matrix; certified straight motions
+    ik.py         position IK of tool0 (projected Levenberg-Marquardt, many seeded starts);
+                  the collision-free solution closest to the start pose is the goal
+    planner.py    OMPL RRT-Connect in joint space, then shortcutting
+    timing.py     stop-at-every-vertex trapezoidal timing within the velocity limits
+    errors.py     PlanError and its diagnostic codes
+
+Everything is deterministic for a given file, target, start pose and seed: numpy's
+default_rng(seed) for IK seeds and shortcuts, OMPL's RNG seeded from it, and a planner budget
+counted in validity checks. Output numbers are rounded (t to 1e-9 s, q to 1e-12 rad) and
+written in a fixed layout, so the JSON is byte-for-byte reproducible.
+"""
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+
+from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
+
+IK_SEEDS_PER_JOINT = 16  # IK runs: 16 per joint (48 for a 3-joint arm), the start pose first
+MAX_GOALS = 3  # collision-free IK solutions tried as goals, closest first
+MIN_MARGIN = 5e-4  # m: a start or goal closer than 2 x this to an obstacle counts as colliding
+
+
+@dataclass(frozen=True)
+class Plan:
+    robot: str
+    target: str
+    start: str  # name of the start pose
+    target_xyz: tuple[float, float, float]
+    joint_names: tuple[str, ...]
+    t: tuple[float, ...]
+    q: tuple[tuple[float, ...], ...]
+    waypoints: tuple[tuple[float, ...], ...]  # the polyline the motion follows (stops at each)
+    tool_error: float  # m, |tool0(q_final) - target|
+    min_clearance: float | None  # m, smallest distance of a checked pair over the output points
+    margin: float  # m, the clearance the planner kept
+    seed: int
+    velocity_limits: tuple[float, ...]  # rad/s
+    with_robot_name: bool = False  # files with several robots: say which one in the JSON
+    stats: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def duration(self) -> float:
+        return self.t[-1] - self.t[0]
+
+    def to_json(self) -> dict:
+        doc = {"joint_names": list(self.joint_names),
+               "points": [{"t": t, "q": list(q)} for t, q in zip(self.t, self.q)]}
+        if self.with_robot_name:
+            doc["robot"] = self.robot
+        return doc
+
+    def dumps(self) -> str:
+        """SPEC section 6 JSON, one point per line, fixed number formatting."""
+        lines = ["{", f'  "joint_names": {json.dumps(list(self.joint_names))},']
+        if self.with_robot_name:
+            lines.append(f'  "robot": {json.dumps(self.robot)},')
+        lines.append('  "points": [')
+        pts = [f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}' for t, q in zip(self.t, self.q)]
+        lines.append(",\n".join(pts))
+        lines += ["  ]", "}"]
+        return "\n".join(lines) + "\n"
+
+    def summary(self) -> str:
+        deg = lambda q: "(" + ", ".join(f"{math.degrees(x):.1f}" for x in q) + ") deg"  # noqa: E731
+        out = [f"robot {self.robot}: '{self.start}' -> target '{self.target}' "
+               f"({', '.join(f'{v:g}' for v in self.target_xyz)}) m",
+               f"  duration        {self.duration:.3f} s, {len(self.t)} points, "
+               f"{len(self.waypoints) - 1} straight segment(s) in joint space",
+               f"  start           {deg(self.q[0])}",
+               f"  goal            {deg(self.q[-1])}",
+               f"  tool0 error     {self.tool_error:.2e} m"]
+        if self.min_clearance is not None:
+            out.append(f"  min clearance   {self.min_clearance * 1000:.1f} mm (at the output points; "
+                       f"planned with a {self.margin * 1000:.1f} mm margin)")
+        s = self.stats
+        if s:
+            out.append(f"  planning        {s.get('time', 0.0):.2f} s, {s.get('checks', 0)} collision checks, "
+                       f"{s.get('ik_solutions', 0)} IK solution(s), seed {self.seed}")
+        return "\n".join(out)
+
+
+def _num(x: float) -> str:
+    v = round(float(x), 12)
+    return "0.0" if v == 0 else repr(v)
+
+
+def start_pose(robot, name: str | None):
+    """(name, q) of the start pose: the pose named `name`, else home (the pose named home, or
+    zeros, with a joint whose range excludes 0 at the middle of its range)."""
+    if name is not None:
+        p = robot.pose(name)
+        return (p.name, tuple(p.q), p.span) if p is not None else None
+    p = robot.pose("home")
+    if p is not None:
+        return ("home", tuple(p.q), p.span)
+    q = []
+    for i in range(1, robot.dof + 1):
+        lo, hi = robot.joint_range(i)
+        q.append(0.0 if lo <= 0.0 <= hi else (lo + hi) / 2.0)
+    return ("home", tuple(q), robot.name_span)
+
+
+def _known(kind: str, names) -> str:
+    names = list(names)
+    if not names:
+        return {"targets": "the robot declares no targets: add `target NAME at (x, y, z) m` to its block",
+                "poses": "the robot declares no poses: add `pose NAME (…) deg` to its block"}[kind]
+    return f"{kind}: {', '.join(names)}"
+
+
+def _contacts_text(contacts) -> str:
+    return "; ".join(c.describe() for c in contacts)
+
+
+def plan(path, target: str, robot: str | None = None, seed: int = 0, start: str | None = None,
+         library: str | None = None, **options) -> Plan:
+    """Read a .mod (or YAML) file and plan robot's motion from `start` (default home) to
+    `target`. robot may be omitted when exactly one robot of the file declares the target.
+    options go to plan_robot (margin, timeout, max_checks). Raises PlanError."""
+    from ..compiler import InputError, check_file
+
+    try:
+        checked = check_file(path, library)
+    except InputError as e:
+        raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
+    if not checked.ok:
+        raise PlanError([d for d in checked.diagnostics if d.is_error], checked.sources, EXIT_FAILED)
+    robots = list(checked.design.robots)
+    from ..diagnostics import Span
+
+    here = Span.point("<command line>")
+    if robot is not None:
+        chosen = [r for r in robots if r.name == robot]
+        if not chosen:
+            raise PlanError.of("robot-unknown", here, detail=f"{checked.design.path} has no robot '{robot}'",
+                               known="robots: " + (", ".join(r.name for r in robots) or "none"))
+    else:
+        chosen = [r for r in robots if any(t.name == target for t in r.targets)] if len(robots) > 1 else robots
+        if len(chosen) > 1:
+            raise PlanError.of("robot-unknown", here,
+                               detail=f"robots {', '.join(r.name for r in chosen)} all have a target '{target}'",
+                               known="choose one with --robot NAME")
+        if not chosen:
+            if not robots:
+                raise PlanError.of("robot-unknown", here, detail=f"{checked.design.path} defines no robot",
+                                   known="add a block such as: robot arm { chain H1 - L1 }")
+            known = "; ".join(f"{r.name}: {', '.join(t.name for t in r.targets) or 'none'}" for r in robots)
+            raise PlanError.of("target-unknown", here, robot=" or ".join(r.name for r in robots), target=target,
+                               known=f"targets per robot: {known}")
+    return plan_robot(chosen[0], target, seed=seed, start=start, sources=checked.sources,
+                      with_robot_name=len(robots) > 1, **options)
+
+
+def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, margin: float | None = None,
+               timeout: float | None = None, max_checks: int | None = None, files=None, sources=None,
+               with_robot_name: bool = False) -> Plan:
+    """Plan for one checked robot (modc.model.Robot). files: its URDF and meshes as the compiler
+    emits them ({relative path: content}); generated when omitted. Raises PlanError."""
+    import numpy as np
+
+    from ..diagnostics import Span
+    from . import ik, planner, timing
+    from .collision import DEFAULT_MARGIN, CollisionChecker
+
+    t_begin = time.perf_counter()
+    sources = sources or {}
+    here = Span.point("<command line>")
+    if seed < 0:
+        raise ValueError("seed must be >= 0")
+    tgt = next((t for t in robot.targets if t.name == target), None)
+    if tgt is None:
+        raise PlanError.of("target-unknown", here, sources, robot=robot.name, target=target,
+                           known=_known("targets", (t.name for t in robot.targets)))
+    sp = start_pose(robot, start)
+    if sp is None:
+        raise PlanError.of("pose-unknown", here, sources, robot=robot.name, pose=start,
+                           known=_known("poses", (p.name for p in robot.poses)))
+    start_name, q_start, start_span = sp
+    margin = DEFAULT_MARGIN if margin is None else float(margin)
+    timeout = planner.DEFAULT_TIMEOUT if timeout is None else float(timeout)
+    max_checks = planner.DEFAULT_MAX_CHECKS if max_checks is None else int(max_checks)
+
+    checker = CollisionChecker(robot, files, margin)
+    q_start = np.clip(np.array(q_start, float), checker.lower, checker.upper)
+
+    # --- the start pose ------------------------------------------------------------------------
+    fixed = checker.static_contacts()
+    hit = fixed + checker.contacts(q_start, 0.0)
+    if hit:
+        hint = ("base_link never moves: move or shrink the obstacle so that it does not reach into the arm's base "
+                "(a floor may touch it)" if fixed else
+                f"choose another start pose with --start, or move the obstacle")
+        raise PlanError.of("start-in-collision", start_span, sources, pose=start_name, contacts=_contacts_text(hit), hint=hint)
+    if not checker.valid(q_start):
+        clearance, pair = checker.clearance(q_start)
+        if clearance / 2 < MIN_MARGIN:
+            raise PlanError.of("start-in-collision", start_span, sources, pose=start_name,
+                               contacts=f"{pair.describe()} are {clearance * 1000:.2f} mm apart",
+                               hint=f"the planner needs {2 * MIN_MARGIN * 1000:.1f} mm of clearance at the start")
+        checker.set_margin(clearance / 2)
+
+    # --- the goal: IK ----------------------------------------------------------------------------
+    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper)
+    solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * robot.dof, seed)
+    if not solutions:
+        tool = solver.position(best.q)
+        raise PlanError.of(
+            "target-unreachable", tgt.span, sources, target=target, distance=f"{best.error:.3f}",
+            hint=(f"the closest tool0 gets is ({', '.join(f'{v:.3f}' for v in tool)}) m, at joint angles "
+                  f"({', '.join(f'{math.degrees(v):.1f}' for v in best.q)}) deg; move the target towards the arm, "
+                  "or lengthen the arm (link=…, more units)"))
+    goals, near, colliding = [], [], []
+    for s in solutions:
+        if checker.valid(s.q):
+            goals.append(s.q)
+        else:
+            contacts = checker.contacts(s.q, 0.0)
+            (colliding if contacts else near).append((s.q, contacts))
+    if not goals and near:  # reachable, but closer to an obstacle than the margin: plan with less
+        scored = []
+        for q, _ in near:
+            c, _pair = checker.clearance(q)
+            if c / 2 >= MIN_MARGIN:
+                scored.append((q, c))
+        if scored:
+            q, c = scored[0]
+            checker.set_margin(min(checker.margin, c / 2))
+            goals = [q]
+    if not goals:
+        names: list[str] = []
+        for _q, contacts in colliding + near:
+            for c in contacts:
+                if c.describe() not in names:
+                    names.append(c.describe())
+        what = "; ".join(names) if names else f"closer than {2 * MIN_MARGIN * 1000:.1f} mm to an obstacle"
+        raise PlanError.of("target-in-collision", tgt.span, sources, target=target, contacts=what,
+                           hint=f"all {len(solutions)} arm pose(s) that put tool0 on the target collide; "
+                                "move the target or the obstacle")
+
+    # --- the path --------------------------------------------------------------------------------
+    vmax = np.array([_velocity(robot, i) for i in range(1, robot.dof + 1)])
+    amax = vmax / timing.ACCEL_RAMP_TIME
+    cost = lambda p: timing.path_duration(p, vmax, amax)  # noqa: E731
+    path = None
+    tried = 0
+    for q_goal in goals[:MAX_GOALS]:
+        tried += 1
+        path = planner.find_path(checker, q_start, q_goal, seed, cost, timeout=timeout, max_checks=max_checks)
+        if path is not None:
+            break
+    if path is None:
+        raise PlanError.of(
+            "no-path", tgt.span, sources, pose=start_name, target=target,
+            detail=f"RRT-Connect, {tried} goal pose(s), {timeout:g} s or {max_checks} collision checks each",
+            hint="try another --seed or --start pose; the target may be enclosed by obstacles")
+    # an independent pass over the final polyline (every edge certified again)
+    for a, b in zip(path[:-1], path[1:]):
+        if not checker.motion_valid(a, b, check_ends=True):  # pragma: no cover - the planner certified it
+            raise PlanError.of("no-path", tgt.span, sources, pose=start_name, target=target,
+                               detail="the simplified path failed its final collision check",
+                               hint="try another --seed")
+
+    # --- timing and output -------------------------------------------------------------------------
+    ts, qs = timing.parameterise(path, vmax, amax)
+    q_rows = tuple(tuple(round(float(v), 12) + 0.0 for v in q) for q in qs)
+    t_rows = tuple(round(float(t), 9) for t in ts)
+    final = np.array(q_rows[-1])
+    tool_error = float(np.linalg.norm(solver.position(final) - np.asarray(tgt.xyz)))
+    clear = min(checker.clearance(np.array(q))[0] for q in q_rows)
+    return Plan(
+        robot=robot.name, target=target, start=start_name, target_xyz=tuple(tgt.xyz),
+        joint_names=tuple(f"joint_{i}" for i in range(1, robot.dof + 1)), t=t_rows, q=q_rows,
+        waypoints=tuple(tuple(float(v) for v in p) for p in path), tool_error=tool_error,
+        min_clearance=float(clear), margin=checker.margin, seed=seed, velocity_limits=tuple(float(v) for v in vmax),
+        with_robot_name=with_robot_name,
+        stats={"time": time.perf_counter() - t_begin, "checks": checker.checks, "ik_solutions": len(solutions),
+               "goals_tried": tried})
+
+
+def _velocity(robot, i: int) -> float:
+    """The URDF velocity limit of joint i (1-based): the actuator's rated speed, rad/s."""
+    return float(robot.library.variants[robot.units[i - 1].variant].actuator.velocity)
+
+
+__all__ = ["EXIT_FAILED", "EXIT_USAGE", "Plan", "PlanError", "plan", "plan_robot", "start_pose"]
