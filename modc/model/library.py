@@ -221,7 +221,15 @@ def resolve(ref: str, relative_to: Path | None = None) -> Path | None:
     return p if p.is_file() else None
 
 
+@cache
+def _builtin(ref: str) -> Library:
+    path = resolve(ref)
+    return _load_path(str(path.resolve()), path.stat().st_mtime)
+
+
 def load(ref: str = "mark2", relative_to: Path | None = None) -> Library:
+    if ref in BUILTIN:  # shipped files do not change while modc runs: no path work per robot
+        return _builtin(ref)
     path = resolve(ref, relative_to)
     if path is None:
         raise LibraryError(f"library '{ref}' not found")

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
 
 IK_SEEDS_PER_JOINT = 16  # IK runs: 16 per joint (48 for a 3-joint arm), the start pose first
+IK_BATCHES = 4  # more batches of seeds while every solution found collides
 MAX_GOALS = 3  # collision-free IK solutions tried as goals, closest first
 MIN_MARGIN = 5e-4  # m: a start or goal closer than 2 x this to an obstacle counts as colliding
 
@@ -215,7 +216,16 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
 
     # --- the goal: IK ----------------------------------------------------------------------------
     solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper)
-    solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * robot.dof, seed)
+    verdict: dict[bytes, bool] = {}
+
+    def free(q) -> bool:
+        key = np.asarray(q, float).tobytes()
+        if key not in verdict:
+            verdict[key] = checker.valid(q)
+        return verdict[key]
+
+    solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * robot.dof, seed,
+                               batches=IK_BATCHES, enough=free)
     if not solutions:
         tool = solver.position(best.q)
         raise PlanError.of(
@@ -225,7 +235,7 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
                   "or lengthen the arm (link=…, more units)"))
     goals, near, colliding = [], [], []
     for s in solutions:
-        if checker.valid(s.q):
+        if free(s.q):
             goals.append(s.q)
         else:
             contacts = checker.contacts(s.q, 0.0)

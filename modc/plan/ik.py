@@ -17,6 +17,7 @@ of those over all seeds is what "how far out of reach" reports.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -113,23 +114,33 @@ def seeds(start, lower, upper, count: int, seed: int) -> list[np.ndarray]:
     return out
 
 
-def solve(ik: PositionIK, target, start, count: int, seed: int) -> tuple[list[Solution], Solution]:
+def solve(ik: PositionIK, target, start, count: int, seed: int, batches: int = 1,
+          enough: Callable[[np.ndarray], bool] | None = None) -> tuple[list[Solution], Solution]:
     """Converged solutions (duplicates within 1e-6 rad dropped), in order of joint-space
-    distance to start, and the best run overall (the closest approach, for error messages)."""
+    distance to start, and the best run overall (the closest approach, for error messages).
+    Up to `batches` batches of `count` seeds; after a batch, stop if some solution is
+    `enough` (e.g. collision-free: redundant arms have a continuum of solutions, and a few
+    more seeds find a free one where the first batch's all collide)."""
     target = np.asarray(target, float)
     start = np.asarray(start, float)
     found: list[Solution] = []
     best: Solution | None = None
-    for k, q0 in enumerate(seeds(start, ik.lower, ik.upper, count, seed)):
-        q, err = ik.run(q0, target)
-        if best is None or err < best.error:
-            best = Solution(q, err, k)
-        if err > TOLERANCE:
-            continue
-        q = ik.towards(q, start, target)
-        if any(np.max(np.abs(s.q - q)) < 1e-6 for s in found):
-            continue
-        found.append(Solution(q, float(np.linalg.norm(target - ik.position(q))), k))
+    all_seeds = seeds(start, ik.lower, ik.upper, count * batches, seed)
+    for b in range(batches):
+        for k in range(b * count, (b + 1) * count):
+            q, err = ik.run(all_seeds[k], target)
+            if best is None or err < best.error:
+                best = Solution(q, err, k)
+            if err > TOLERANCE:
+                continue
+            q = ik.towards(q, start, target)
+            if any(np.max(np.abs(s.q - q)) < 1e-6 for s in found):
+                continue
+            found.append(Solution(q, float(np.linalg.norm(target - ik.position(q))), k))
+        if not found and b == 0:
+            break  # nothing converged from count seeds: out of reach, more seeds will not help
+        if enough is None or any(enough(s.q) for s in found):
+            break
     found.sort(key=lambda s: (float(np.linalg.norm(s.q - start)), s.seed_index))
     assert best is not None
     return found, best

@@ -3,10 +3,12 @@
     find_path(checker, q_start, q_goal, seed, timeout, max_checks) -> [q, …] or None
 
 State space: RealVectorStateSpace(n) bounded by the joint limits. Validity: the collision
-checker (every checked pair more than the margin apart). Motions: OMPL's discrete motion
-validator at a resolution fine enough to be certified (no point of the arm moves more than
-margin / 2 between two checked states; see modc.plan.collision), so every edge OMPL accepts is
-collision-free between its states too. The direct motion start -> goal is tried first.
+checker (every checked pair more than the margin apart). Motions: the search uses OMPL's
+discrete motion validator at SEARCH_COARSENESS times the certified step (a point of the arm
+moves up to 2 x margin between checked states), which is fast; then every edge of the path
+found is certified (no point of the arm moves more than margin / 2 between two checked states;
+see modc.plan.collision) and an edge that fails is re-planned by RRT-Connect at the certified
+resolution. The direct motion start -> goal is tried first.
 
 Determinism: OMPL's RNG is seeded (RNG.setSeed(seed + 1), OMPL seeds being > 0) before the
 planner and its samplers are made; the planner stops on a count of validity checks (max_checks)
@@ -28,6 +30,7 @@ import numpy as np
 from .collision import CollisionChecker
 
 SHORTCUT_TRIES = 60
+SEARCH_COARSENESS = 4.0  # RRT-Connect checks motions 4x coarser than certified; edges are certified after
 DEFAULT_TIMEOUT = 10.0  # s of planning per goal
 DEFAULT_MAX_CHECKS = 400_000  # validity checks per goal
 
@@ -42,8 +45,11 @@ class _Budget:
         return self.checker.checks >= self.limit or time.monotonic() >= self.deadline
 
 
-def rrt_connect(checker: CollisionChecker, q_start, q_goal, seed: int, budget: _Budget) -> list[np.ndarray] | None:
-    """OMPL RRT-Connect from q_start to q_goal: its path's vertices, or None."""
+def rrt_connect(checker: CollisionChecker, q_start, q_goal, seed: int, budget: _Budget,
+                coarseness: float = 1.0) -> list[np.ndarray] | None:
+    """OMPL RRT-Connect from q_start to q_goal: its path's vertices, or None. coarseness
+    scales the motion-check resolution: 1 = certified, > 1 = faster search whose edges must be
+    certified afterwards."""
     from ompl import base as ob
     from ompl import geometric as og
     from ompl import util as ou
@@ -68,7 +74,7 @@ def rrt_connect(checker: CollisionChecker, q_start, q_goal, seed: int, budget: _
         ss.setStateValidityChecker(is_valid)
         si = ss.getSpaceInformation()
         # certified resolution: an L2 step d moves no point more than d * |R|_2 (Cauchy-Schwarz)
-        step = checker.margin / 2.0 / float(np.linalg.norm(checker.radii))
+        step = coarseness * checker.margin / 2.0 / float(np.linalg.norm(checker.radii))
         si.setStateValidityCheckingResolution(min(0.01, step / space.getMaximumExtent()))
         start, goal = space.allocState(), space.allocState()
         for i in range(n):
@@ -144,12 +150,32 @@ def find_path(checker: CollisionChecker, q_start, q_goal, seed: int, cost: Calla
     if checker.motion_valid(q_start, q_goal):
         return [q_start, q_goal]
     budget = _Budget(checker, timeout, max_checks)
-    path = rrt_connect(checker, q_start, q_goal, seed, budget)
+    path = rrt_connect(checker, q_start, q_goal, seed, budget, SEARCH_COARSENESS)
     if path is None:
         return None
     path[0], path[-1] = q_start, q_goal  # exactly (OMPL copies them; keep the same floats)
+    path = certify(checker, path, seed, budget)
+    if path is None:
+        return None
     return shortcut(checker, path, np.random.default_rng(seed), cost)
 
 
+def certify(checker: CollisionChecker, path: list[np.ndarray], seed: int, budget: _Budget) -> list[np.ndarray] | None:
+    """Every edge of a coarsely checked path certified; an edge that fails is replaced by a
+    certified RRT-Connect path between its ends (its ends are valid states)."""
+    out = [path[0]]
+    for k, (a, b) in enumerate(zip(path[:-1], path[1:])):
+        if checker.motion_valid(a, b):
+            out.append(b)
+            continue
+        if budget.spent():
+            return None
+        detour = rrt_connect(checker, a, b, seed + 7919 * (k + 1), budget, 1.0)
+        if detour is None:
+            return None
+        out += detour[1:-1] + [b]
+    return out
+
+
 __all__ = ["DEFAULT_MAX_CHECKS", "DEFAULT_TIMEOUT", "SHORTCUT_TRIES", "find_path", "reduce_vertices", "rrt_connect",
-           "shortcut"]
+           "shortcut", "certify"]
