@@ -11,7 +11,13 @@ import pytest
 
 from modc.compiler import check_text
 from modc.diagnostics import REGISTRY
-from modc.lsp import convert, features
+from modc.lsp import convert
+from modc.lsp.completion import complete
+from modc.lsp.document import Analysis
+from modc.lsp.formatting import formatting
+from modc.lsp.hover import hover
+from modc.lsp.language import KEYWORDS, STATEMENTS
+from modc.lsp.symbols import definition, symbols
 from modc.lsp.client import Client
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -230,8 +236,8 @@ def test_hover_on_h4_anywhere(server):
 def test_every_keyword_has_a_hover():
     from modc.syntax import grammar_keywords
 
-    assert grammar_keywords() <= set(features.KEYWORDS)
-    assert set(features.STATEMENTS) <= grammar_keywords()
+    assert grammar_keywords() <= set(KEYWORDS)
+    assert set(STATEMENTS) <= grammar_keywords()
 
 
 # --- completion -------------------------------------------------------------------------------------
@@ -280,7 +286,7 @@ def test_completion_of_parameters_and_measures(server):
 
 def test_completion_of_statements_and_clauses(server):
     got = labels(complete_at_end(server, "robot a {\n    chain H1 - L1\n    "))
-    assert got == list(features.STATEMENTS)
+    assert got == list(STATEMENTS)
     assert "chain" in labels(complete_at_end(server, "robot a {\n    cha"))
     assert labels(complete_at_end(server, "")) == ["robot"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf ")) == ["size"]
@@ -386,15 +392,15 @@ def test_formatting_calls_format_text(monkeypatch):
     fake = pytypes.ModuleType("modc.syntax.format")
     fake.format_text = lambda text, path: (text.replace("-   ", "- "), [])
     monkeypatch.setitem(sys.modules, "modc.syntax.format", fake)
-    an = features.Analysis("robot a {\n    chain H1 -   L1\n}", "/x/a.mod")
-    [edit] = features.formatting(an)
+    an = Analysis("robot a {\n    chain H1 -   L1\n}", "/x/a.mod")
+    [edit] = formatting(an)
     assert edit.new_text == "robot a {\n    chain H1 - L1\n}"
     assert (edit.range.end.line, edit.range.end.character) == (2, 1)
     fake.format_text = lambda text, path: (None, ["a syntax error"])  # does not parse: no edits
-    assert features.formatting(an) == []
-    assert features.formatting(features.Analysis("robots: []", "/x/a.yaml")) == []  # YAML: not formatted
+    assert formatting(an) == []
+    assert formatting(Analysis("robots: []", "/x/a.yaml")) == []  # YAML: not formatted
     monkeypatch.setitem(sys.modules, "modc.syntax.format", None)  # no formatter: no edits
-    assert features.formatting(an) == []
+    assert formatting(an) == []
 
 
 # --- robustness -------------------------------------------------------------------------------------
@@ -555,9 +561,9 @@ def test_uri_paths():
 
 def test_lexer_and_outline_survive_anything():
     for text in HALF_TYPED + ["", "robot a { robot b { chain H1 }", "((((((((", "robot { { } } }"]:
-        an = features.Analysis(text, "/x/a.mod")
-        features.symbols(an)
+        an = Analysis(text, "/x/a.mod")
+        symbols(an)
         for off in range(len(text) + 1):
-            features.complete(an, off)
-            features.hover(an, off)
-            features.definition(an, off, "file:///x/a.mod")
+            complete(an, off)
+            hover(an, off)
+            definition(an, off, "file:///x/a.mod")

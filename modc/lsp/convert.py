@@ -124,14 +124,17 @@ class LineIndex:
         return types.Range(start=start, end=end)
 
 
+def top() -> types.Range:
+    """The empty range at the top of a file."""
+    zero = types.Position(line=0, character=0)
+    return types.Range(start=zero, end=zero)
+
+
 def diagnostic(d: Diagnostic, index: LineIndex, path: str) -> types.Diagnostic:
     """A modc Diagnostic as an LSP one: same code, severity and message; the hint follows the
     message on its own line ("hint: …") and is also in data.hint for code actions.
     A diagnostic that points into another file (or nowhere) is shown at the top of this one."""
-    if d.span.file == path:
-        rng = index.span(d.span)
-    else:
-        rng = types.Range(start=types.Position(line=0, character=0), end=types.Position(line=0, character=0))
+    rng = index.span(d.span) if d.span.file == path else top()
     message = d.message if not d.hint else f"{d.message}\nhint: {d.hint}"
     if d.span.file != path and d.span.file not in ("<unknown>", ""):
         message = f"{d.span.file}:{d.span.line}:{d.span.col}: {message}"
@@ -147,9 +150,8 @@ def diagnostic(d: Diagnostic, index: LineIndex, path: str) -> types.Diagnostic:
 
 def internal_error(e: Exception) -> types.Diagnostic:
     """What the editor shows when the compiler itself fails on a text (a bug in modc)."""
-    zero = types.Position(line=0, character=0)
     return types.Diagnostic(
-        range=types.Range(start=zero, end=zero),
+        range=top(),
         message=f"modc failed while checking this file (internal error: {type(e).__name__}: {e}); please report it",
         severity=types.DiagnosticSeverity.Error,
         source=SOURCE,

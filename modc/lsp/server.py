@@ -1,5 +1,6 @@
 """`modc lsp`: the language server, on pygls. Handlers are thin: they find the document's
-Analysis (features.py), turn the LSP position into a character offset and back (convert.py).
+Analysis (document.py), turn the LSP position into a character offset and back (convert.py)
+and ask the feature's module (hover.py, completion.py, symbols.py, formatting.py).
 
 Diagnostics are published on open and on every change, computed right away (the lint-level
 check of a 6-DoF file takes about 2 ms; no torque analysis); changes that arrive in a burst
@@ -24,7 +25,13 @@ from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol
 
 from .. import __version__
-from . import convert, features
+from . import convert
+from .completion import complete
+from .document import Analysis
+from .formatting import formatting as format_document
+from .hover import hover as hover_at
+from .symbols import definition as definition_at
+from .symbols import symbols
 
 log = logging.getLogger("modc.lsp")
 
@@ -59,13 +66,13 @@ class ModcServer(LanguageServer):
     def __init__(self) -> None:
         super().__init__("modc", __version__, protocol_cls=ModcProtocol,
                          text_document_sync_kind=types.TextDocumentSyncKind.Incremental)
-        self.analyses: dict[str, tuple[int | None, str, features.Analysis]] = {}
+        self.analyses: dict[str, tuple[int | None, str, Analysis]] = {}
         self.pending: set[str] = set()
         self.shut_down = False
         self.exit_code = 0
 
     # --- documents -----------------------------------------------------------------------------
-    def analysis(self, uri: str) -> features.Analysis | None:
+    def analysis(self, uri: str) -> Analysis | None:
         # Only open documents: a request about any other URI must not read arbitrary files.
         doc = self.workspace.text_documents.get(unquote(uri)) if isinstance(uri, str) else None
         if doc is None:
@@ -76,7 +83,7 @@ class ModcServer(LanguageServer):
             return cached[2]
         enc = self.workspace.position_encoding
         encoding = getattr(enc, "value", enc) or convert.UTF16
-        an = features.Analysis(text, convert.uri_to_path(uri), encoding)
+        an = Analysis(text, convert.uri_to_path(uri), encoding)
         self.analyses[uri] = (doc.version, text, an)
         return an
 
@@ -143,7 +150,7 @@ def on_exit(ls: ModcServer, params) -> None:
     ls.exit_code = 0 if ls.shut_down else 1
 
 
-def _at(ls: ModcServer, params) -> tuple[features.Analysis | None, int]:
+def _at(ls: ModcServer, params) -> tuple[Analysis | None, int]:
     an = ls.analysis(params.text_document.uri)
     if an is None:
         return None, 0
@@ -181,7 +188,7 @@ def did_close(ls: ModcServer, params: types.DidCloseTextDocumentParams):
 @guarded(None)
 def hover(ls: ModcServer, params: types.HoverParams):
     an, offset = _at(ls, params)
-    return features.hover(an, offset) if an is not None else None
+    return hover_at(an, offset) if an is not None else None
 
 
 @server.feature(types.TEXT_DOCUMENT_COMPLETION, types.CompletionOptions(trigger_characters=["(", ",", "-", "="]))
@@ -193,28 +200,28 @@ def completion(ls: ModcServer, params: types.CompletionParams):
     snippets = bool(ls.client_capabilities.text_document and ls.client_capabilities.text_document.completion
                     and ls.client_capabilities.text_document.completion.completion_item
                     and ls.client_capabilities.text_document.completion.completion_item.snippet_support)
-    return features.complete(an, offset, snippets)
+    return complete(an, offset, snippets)
 
 
 @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
 @guarded([])
 def document_symbol(ls: ModcServer, params: types.DocumentSymbolParams):
     an = ls.analysis(params.text_document.uri)
-    return features.symbols(an) if an is not None else []
+    return symbols(an) if an is not None else []
 
 
 @server.feature(types.TEXT_DOCUMENT_DEFINITION)
 @guarded([])
 def definition(ls: ModcServer, params: types.DefinitionParams):
     an, offset = _at(ls, params)
-    return features.definition(an, offset, params.text_document.uri) if an is not None else []
+    return definition_at(an, offset, params.text_document.uri) if an is not None else []
 
 
 @server.feature(types.TEXT_DOCUMENT_FORMATTING)
 @guarded([])
 def formatting(ls: ModcServer, params: types.DocumentFormattingParams):
     an = ls.analysis(params.text_document.uri)
-    return features.formatting(an) if an is not None else []
+    return format_document(an) if an is not None else []
 
 
 def serve() -> None:
