@@ -444,6 +444,31 @@ def play_cmd(
     raise typer.Exit(EXIT_OK)
 
 
+@app.command("plan")
+def plan_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    to: Annotated[str, typer.Option("--to", help="target to move tool0 to (a `target` of the robot)")],
+    json_out: Annotated[bool, typer.Option("--json", help="print the trajectory as JSON on stdout (SPEC section 6)")] = False,
+    robot: Annotated[Optional[str], typer.Option(help="robot of the file (default: the one that has the target)")] = None,
+    seed: Annotated[int, typer.Option(min=0, help="seed of IK starts, RRT-Connect and shortcuts: same file and seed, same motion")] = 0,
+    start: Annotated[Optional[str], typer.Option(help="pose to start from (default: home)")] = None,
+    timeout: Annotated[float, typer.Option(min=0.1, help="seconds of path search at most")] = 20.0,
+    library: LibraryOpt = None,
+):
+    """Plan a collision-free motion from the home pose (or --start) to a named target (exit 1 if none)."""
+    from .plan import PlanError, plan
+
+    try:
+        result = plan(file, to, robot=robot, seed=seed, start=start, library=library, timeout=timeout)
+    except PlanError as e:
+        _print_diagnostics(e.diagnostics, e.sources)
+        raise typer.Exit(e.exit_code)
+    if json_out:
+        sys.stdout.write(result.dumps())
+    else:
+        print(result.summary())
+
+
 @app.command("schema")
 def schema_cmd():
     """Print the JSON Schema of the YAML form of .mod files."""

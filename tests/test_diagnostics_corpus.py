@@ -67,6 +67,8 @@ FUNCTION_CASES = {
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
     "traj-invalid": "test_traj_invalid",
+    **{code: "test_plan_errors" for code in ("target-unknown", "pose-unknown", "robot-unknown", "start-in-collision",
+                                             "target-unreachable", "target-in-collision", "no-path")},
 }
 
 YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
@@ -498,3 +500,51 @@ def test_traj_invalid(tmp_path):
                        capture_output=True, text=True)
     assert r.returncode == 1, r.stderr
     assert f"{traj}:1:1: error[traj-invalid]:" in r.stderr and "= hint:" in r.stderr and "Traceback" not in r.stderr
+
+
+PLAN_CELL = """robot farm {
+    chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)
+    tool at (0.06, 0, 0) m
+    pose home (0, 0, 0) deg
+    box crate size (0.25, 0.25, 0.25) m at (0.3, 0, 0.3) m
+    target inside at (0.3, 0, 0.3) m
+    target far at (1.2, 0, 0.3) m
+    target open at (0.3, 0.3, 0.3) m
+}
+robot other {
+    chain H1 - L1
+    target open at (0.3, 0.3, 0.3) m
+}
+"""
+
+
+def test_plan_errors(tmp_path, capsys):
+    """`modc plan`: every way planning can fail is a diagnostic with a hint and no traceback; exit 1,
+    or 2 for names given on the command line (target, start pose, robot)."""
+    from modc.plan import PlanError, plan
+
+    cell = tmp_path / "cell.mod"
+    cell.write_text(PLAN_CELL, encoding="utf-8")
+    blocked = tmp_path / "blocked.mod"
+    blocked.write_text(PLAN_CELL.replace("    pose home (0, 0, 0) deg\n",
+                                         "    pose home (0, 0, 0) deg\n    box shelf size (0.3, 0.3, 0.02) m at (-0.1, 0, 0.33) m\n"),
+                       encoding="utf-8")
+    cases = [  # (arguments, exit code, code, where it points)
+        (["plan", str(cell), "--to", "tomato", "--robot", "farm"], 2, "target-unknown", "<command line>:1:1"),
+        (["plan", str(cell), "--to", "inside", "--start", "nowhere"], 2, "pose-unknown", "<command line>:1:1"),
+        (["plan", str(cell), "--to", "open"], 2, "robot-unknown", "<command line>:1:1"),
+        (["plan", str(cell), "--to", "far"], 1, "target-unreachable", f"{cell}:7:5"),
+        (["plan", str(cell), "--to", "inside"], 1, "target-in-collision", f"{cell}:6:5"),
+        (["plan", str(blocked), "--to", "inside", "--robot", "farm"], 1, "start-in-collision", f"{blocked}:4:5"),
+    ]
+    for args, rc_want, code, where in cases:
+        rc, out, err = run_cli(capsys, *args)
+        assert rc == rc_want, (args, err)
+        assert f"{where}: error[{code}]" in err, err
+        assert "= hint:" in err and "Traceback" not in err and out == ""
+    # no-path: a search budget too small to go round the crate (not a command-line option)
+    with pytest.raises(PlanError) as e:
+        plan(HERE.parent / "examples" / "farm.mod", "plant", max_checks=20)
+    d = e.value.diagnostics[0]
+    assert d.code == "no-path" and e.value.exit_code == 1 and d.hint
+    assert d.code in REGISTRY and d.severity == REGISTRY[d.code].severity

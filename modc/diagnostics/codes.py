@@ -168,6 +168,22 @@ BAD_PAYLOAD = _register("bad-payload", E, "a --payload value that is not a mass"
 TRAJ_INVALID = _register("traj-invalid", E, "a trajectory file that does not fit the format or the robot",
     "{detail}", "a trajectory is {{\"joint_names\": [...], \"points\": [{{\"t\": s, \"q\": [rad, ...]}}, ...]}}, as `modc plan --json` prints")
 
+# --- planning: `modc plan` (exit 1; 2 for names given on the command line) ----------------------
+TARGET_UNKNOWN = _register("target-unknown", E, "`plan --to` naming a target the robot does not declare",
+    "robot {robot} has no target '{target}'", "{known}")
+POSE_UNKNOWN = _register("pose-unknown", E, "`plan --start` naming a pose the robot does not declare",
+    "robot {robot} has no pose '{pose}'", "{known}")
+ROBOT_UNKNOWN = _register("robot-unknown", E, "`--robot` naming no robot of the file, or a target several robots have",
+    "{detail}", "{known}")
+START_IN_COLLISION = _register("start-in-collision", E, "the pose a plan starts from is in collision",
+    "the start pose '{pose}' collides: {contacts}", "{hint}")
+TARGET_UNREACHABLE = _register("target-unreachable", E, "a target tool0 cannot reach within the joint limits",
+    "target '{target}' is out of reach: tool0 gets no closer than {distance} m", "{hint}")
+TARGET_IN_COLLISION = _register("target-in-collision", E, "a target the arm reaches only in collision",
+    "target '{target}' is reachable only in collision: {contacts}", "{hint}")
+NO_PATH = _register("no-path", E, "no collision-free motion to a target was found",
+    "no collision-free path from '{pose}' to target '{target}' found ({detail})", "{hint}")
+
 # --- names, poses, limits, environment ---------------------------------------------------------
 DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",
     "robot '{name}' is defined twice", "rename one of them; output files are named after robots")

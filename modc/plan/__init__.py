@@ -85,8 +85,8 @@ class Plan:
                f"  goal            {deg(self.q[-1])}",
                f"  tool0 error     {self.tool_error:.2e} m"]
         if self.min_clearance is not None:
-            out.append(f"  min clearance   {self.min_clearance * 1000:.1f} mm (at the output points; "
-                       f"planned with a {self.margin * 1000:.1f} mm margin)")
+            out.append(f"  clearance       >= {self.margin * 1000:.1f} mm along the whole motion (certified), "
+                       f"{self.min_clearance * 1000:.1f} mm at the closest output point")
         s = self.stats
         if s:
             out.append(f"  planning        {s.get('time', 0.0):.2f} s, {s.get('checks', 0)} collision checks, "
@@ -204,7 +204,9 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     if hit:
         hint = ("base_link never moves: move or shrink the obstacle so that it does not reach into the arm's base "
                 "(a floor may touch it)" if fixed else
-                f"choose another start pose with --start, or move the obstacle")
+                "choose another start pose with --start, or move the obstacle")
+        if robot.pose(start_name) is None:  # the implicit home pose
+            hint += "; the file declares no `pose home`, so the start is every joint at 0"
         raise PlanError.of("start-in-collision", start_span, sources, pose=start_name, contacts=_contacts_text(hit), hint=hint)
     if not checker.valid(q_start):
         clearance, pair = checker.clearance(q_start)
@@ -267,15 +269,25 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     cost = lambda p: timing.path_duration(p, vmax, amax)  # noqa: E731
     path = None
     tried = 0
+    deadline = time.monotonic() + timeout
     for q_goal in goals[:MAX_GOALS]:
+        if time.monotonic() >= deadline:
+            break
         tried += 1
-        path = planner.find_path(checker, q_start, q_goal, seed, cost, timeout=timeout, max_checks=max_checks)
+        try:
+            path = planner.find_path(checker, q_start, q_goal, seed, cost, timeout=timeout, max_checks=max_checks,
+                                     deadline=deadline)
+        except planner.PlannerUnavailable as e:
+            raise PlanError.of("no-path", tgt.span, sources, pose=start_name, target=target,
+                               detail=f"the straight motion collides and {e}",
+                               hint="install OMPL 2: pip install 'ompl>=2.0'") from None
         if path is not None:
             break
     if path is None:
         raise PlanError.of(
             "no-path", tgt.span, sources, pose=start_name, target=target,
-            detail=f"RRT-Connect, {tried} goal pose(s), {timeout:g} s or {max_checks} collision checks each",
+            detail=f"RRT-Connect towards {tried} of the {len(goals)} collision-free goal pose(s), "
+                   f"{max_checks} collision checks each, {timeout:g} s in all",
             hint="try another --seed or --start pose; the target may be enclosed by obstacles")
     # an independent pass over the final polyline (every edge certified again)
     for a, b in zip(path[:-1], path[1:]):

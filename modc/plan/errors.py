@@ -23,7 +23,7 @@ CODES: dict[str, tuple[str, str, str]] = {
         "robot {robot} has no pose '{pose}'",
         "{known}"),
     "robot-unknown": (
-        "`--robot` naming a robot the file does not define, or a file whose robots all have the target",
+        "`--robot` naming no robot of the file, or a target several robots have",
         "{detail}",
         "{known}"),
     "start-in-collision": (

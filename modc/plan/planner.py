@@ -31,8 +31,12 @@ from .collision import CollisionChecker
 
 SHORTCUT_TRIES = 60
 SEARCH_COARSENESS = 4.0  # RRT-Connect checks motions 4x coarser than certified; edges are certified after
-DEFAULT_TIMEOUT = 10.0  # s of planning per goal
-DEFAULT_MAX_CHECKS = 400_000  # validity checks per goal
+DEFAULT_TIMEOUT = 20.0  # s of planning in all (every goal tried shares it)
+DEFAULT_MAX_CHECKS = 200_000  # validity checks per goal tried (the deterministic budget)
+
+
+class PlannerUnavailable(RuntimeError):
+    """OMPL is not installed (or not importable)."""
 
 
 class _Budget:
@@ -50,15 +54,18 @@ def rrt_connect(checker: CollisionChecker, q_start, q_goal, seed: int, budget: _
     """OMPL RRT-Connect from q_start to q_goal: its path's vertices, or None. coarseness
     scales the motion-check resolution: 1 = certified, > 1 = faster search whose edges must be
     certified afterwards."""
-    from ompl import base as ob
-    from ompl import geometric as og
-    from ompl import util as ou
+    try:
+        from ompl import base as ob
+        from ompl import geometric as og
+        from ompl import util as ou
+    except ImportError as e:
+        raise PlannerUnavailable(f"OMPL's Python bindings cannot be imported ({e})") from None
 
     n = len(q_start)
     level = ou.getLogLevel()
     ou.setLogLevel(ou.LOG_NONE)  # OMPL's own chatter (seed warnings, planner info) stays quiet
     try:
-        ou.RNG.setSeed(int(seed) + 1)
+        ou.RNG.setSeed(int(seed) % 0x7FFFFFFF + 1)
         space = ob.RealVectorStateSpace(n)
         bounds = ob.RealVectorBounds(n)
         for i in range(n):
@@ -83,10 +90,9 @@ def rrt_connect(checker: CollisionChecker, q_start, q_goal, seed: int, budget: _
         ss.setStartAndGoalStates(start, goal)
         ss.setPlanner(og.RRTConnect(si))
         ss.setup()
-        status = ss.solve(ob.PlannerTerminationCondition(budget.spent))
+        ss.solve(ob.PlannerTerminationCondition(budget.spent))
         if not ss.haveExactSolutionPath():
             return None
-        del status
         path = ss.getSolutionPath()
         out = [np.array([path.getState(k)[i] for i in range(n)]) for k in range(path.getStateCount())]
         ss.clear()
@@ -144,12 +150,17 @@ def shortcut(checker: CollisionChecker, path: list[np.ndarray], rng: np.random.G
 
 
 def find_path(checker: CollisionChecker, q_start, q_goal, seed: int, cost: Callable[[list[np.ndarray]], float],
-              timeout: float = DEFAULT_TIMEOUT, max_checks: int = DEFAULT_MAX_CHECKS) -> list[np.ndarray] | None:
-    """A certified collision-free polyline q_start -> q_goal (both assumed valid), or None."""
+              timeout: float = DEFAULT_TIMEOUT, max_checks: int = DEFAULT_MAX_CHECKS,
+              deadline: float | None = None) -> list[np.ndarray] | None:
+    """A certified collision-free polyline q_start -> q_goal (both assumed valid), or None.
+    The search stops after max_checks validity checks, or timeout seconds, or at deadline
+    (time.monotonic()), whichever comes first."""
     q_start, q_goal = np.asarray(q_start, float), np.asarray(q_goal, float)
     if checker.motion_valid(q_start, q_goal):
         return [q_start, q_goal]
     budget = _Budget(checker, timeout, max_checks)
+    if deadline is not None:
+        budget.deadline = min(budget.deadline, deadline)
     path = rrt_connect(checker, q_start, q_goal, seed, budget, SEARCH_COARSENESS)
     if path is None:
         return None
@@ -177,5 +188,5 @@ def certify(checker: CollisionChecker, path: list[np.ndarray], seed: int, budget
     return out
 
 
-__all__ = ["DEFAULT_MAX_CHECKS", "DEFAULT_TIMEOUT", "SHORTCUT_TRIES", "find_path", "reduce_vertices", "rrt_connect",
+__all__ = ["DEFAULT_MAX_CHECKS", "DEFAULT_TIMEOUT", "PlannerUnavailable", "SHORTCUT_TRIES", "find_path", "reduce_vertices", "rrt_connect",
            "shortcut", "certify"]

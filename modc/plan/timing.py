@@ -22,6 +22,7 @@ import numpy as np
 
 ACCEL_RAMP_TIME = 0.5  # s: acceleration limit = velocity limit / this (modc.backends.ros uses the same)
 SAMPLE_PERIOD = 0.05  # s between output points (at most)
+MIN_MOTION = 1e-9  # rad: a segment whose joints all move less than this is skipped (a repeated vertex)
 
 
 def segment_limits(dq, vmax, amax) -> tuple[float, float]:
@@ -74,7 +75,7 @@ def parameterise(path, vmax, amax, period: float = SAMPLE_PERIOD) -> tuple[list[
     for a, b in zip(path[:-1], path[1:]):
         dq = b - a
         T = segment_duration(dq, vmax, amax)
-        if T <= 0.0:
+        if T <= 0.0 or float(np.max(np.abs(dq))) < MIN_MOTION:
             continue  # a repeated vertex
         V, A = segment_limits(dq, vmax, amax)
         n = max(1, math.ceil(T / period - 1e-9))
