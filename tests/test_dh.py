@@ -11,7 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from modc.compiler import build, check_text, write_tree
+from modc.compiler import build, check_text
 from modc.dh.convert_file import convert_table
 from modc.dh.extract import axis_angles, realised_dh
 from modc.kinematics import Chain

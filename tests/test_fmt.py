@@ -196,7 +196,7 @@ def test_measure_starting_with_e_keeps_its_space():
 
 
 def test_long_chain_wraps_after_a_dash():
-    units = " - ".join(f"H4(pivot=-90deg, port=135deg, link=180mm)" for _ in range(6))
+    units = " - ".join("H4(pivot=-90deg, port=135deg, link=180mm)" for _ in range(6))
     out = assert_fmt_properties(f"robot a {{ chain {units} }}")
     lines = out.splitlines()[1:-1]
     assert len(lines) > 1

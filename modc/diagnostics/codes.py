@@ -8,8 +8,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
+from typing import TYPE_CHECKING
 
 from .span import Span
+
+if TYPE_CHECKING:
+    from .diagnostic import Diagnostic
 
 
 class Severity(str, Enum):

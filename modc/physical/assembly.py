@@ -6,7 +6,6 @@ bolted to unit i's output). base_link carries unit 1's input side.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np

@@ -1,0 +1,114 @@
+"""Analyses of a design: `check` (torque), `dh2mod` and `dh` (Denavit-Hartenberg)."""
+from __future__ import annotations
+
+import sys
+from typing import Annotated, Optional
+
+import typer
+
+from .app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, LibraryOpt, _print_diagnostics, app
+
+
+def _mass(text: str) -> float | None:
+    import math
+    import re
+
+    m = re.fullmatch(r"\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(kg|g)?\s*", text)
+    if not m:
+        return None
+    value = float(m.group(1)) * (0.001 if m.group(2) == "g" else 1.0)
+    return value if math.isfinite(value) and value >= 0 else None
+
+
+@app.command("check")
+def check_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    payload: Annotated[Optional[str], typer.Option(help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="print the torque table as JSON")] = False,
+    library: LibraryOpt = None,
+):
+    """Torque feasibility: the worst static gravity torque of every joint over its range, against
+    the actuator's nominal and peak torque. Exit 1 if a joint can exceed its peak torque."""
+    import json
+    import math
+
+    from ..compiler import COMPILE_ANALYSES, InputError, check_file
+    from ..diagnostics import Span, codes
+
+    mass = None
+    if payload is not None:
+        mass = _mass(payload)
+        if mass is None:
+            _print_diagnostics([codes.BAD_PAYLOAD.at(Span.point("<command line>"), value=payload)], {})
+            raise typer.Exit(EXIT_USAGE)
+    try:
+        checked = check_file(file, library, analyses=COMPILE_ANALYSES, payload_override=mass)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    robots = [r for r in checked.design.robots if r.torque is not None]
+    if json_out:
+        doc = {"robots": [{"name": r.name, "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
+                           "joints": [j.to_json() for j in r.torque]} for r in robots]}
+        print(json.dumps(doc, indent=2))
+    else:
+        for r in robots:
+            print(f"robot {r.name} ({r.sequence}), payload {mass if mass is not None else (r.payload.mass if r.payload else 0):g} kg")
+            print(f"  {'joint':<9}{'unit':<6}{'worst |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}  worst pose (deg)")
+            for j in r.torque:
+                pose = ", ".join(f"{math.degrees(x):.0f}" for x in j.q)
+                print(f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}  ({pose})  {j.level}")
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    raise typer.Exit(EXIT_OK if checked.ok else EXIT_ERRORS)
+
+
+@app.command("dh2mod")
+def dh2mod_cmd(
+    table: Annotated[str, typer.Argument(help="CSV with header a,alpha,d,theta (metres, radians), one row per joint")],
+    json_out: Annotated[bool, typer.Option("--json", help="print requested vs realised DH as JSON instead of .mod text")] = False,
+    fit_links: Annotated[bool, typer.Option("--fit-links", help="print link modules at the lengths that realise each a exactly")] = False,
+    name: Annotated[Optional[str], typer.Option(help="robot name (default: from the file name)")] = None,
+    library: LibraryOpt = None,
+):
+    """Convert a standard DH table into a module chain (paper section 4.2); .mod text on stdout."""
+    from ..compiler import InputError, read_source
+    from ..dh.convert_file import convert_table
+
+    try:
+        text = read_source(table)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    out, diags, ok = convert_table(text, table, name=name, fit_links=fit_links, library=library, as_json=json_out)
+    _print_diagnostics(diags, {table: text})
+    if not ok:
+        raise typer.Exit(EXIT_ERRORS)
+    sys.stdout.write(out)
+
+
+@app.command("dh")
+def dh_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
+    json_out: Annotated[bool, typer.Option("--json", help="JSON instead of a table")] = False,
+    library: LibraryOpt = None,
+):
+    """Show the realised standard DH table of every robot (and the requested one, for dh tables)."""
+    import json
+
+    from ..compiler import InputError, check_file
+    from ..dh.report import compare, text_table
+
+    try:
+        checked = check_file(file, library)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    if not checked.ok:
+        _print_diagnostics(checked.diagnostics, checked.sources)
+        raise typer.Exit(EXIT_ERRORS)
+    robots = checked.design.robots
+    if json_out:
+        doc = {"robots": [{"name": r.name, "sequence": r.sequence, "joints": compare(r)} for r in robots]}
+        print(json.dumps(doc, indent=2))
+    else:
+        print("\n\n".join(text_table(r) for r in robots))

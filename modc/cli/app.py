@@ -1,0 +1,57 @@
+"""The Typer app and what every command shares: output, exit codes, common options."""
+from __future__ import annotations
+
+import sys
+from enum import Enum
+from typing import Annotated, Optional
+
+import typer
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
+                  help="modc: compile .mod files describing MOIRs Mark-2 modular arms into URDF and friends.")
+
+
+EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
+
+
+class Verbosity:
+    quiet = False
+    verbose = False
+
+
+def _err(text: str) -> None:
+    print(text, file=sys.stderr)
+
+
+def _print_diagnostics(diags, sources) -> None:
+    from ..diagnostics.render import render_text
+
+    shown = [d for d in diags if not (Verbosity.quiet and not d.is_error)]
+    if shown:
+        _err(render_text(shown, sources))
+
+
+class TorqueLevel(str, Enum):
+    error = "error"
+    warning = "warning"
+    off = "off"
+
+
+LibraryOpt = Annotated[Optional[str], typer.Option("--library", help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file")]
+
+
+def _expand(paths: list[str]) -> list[str]:
+    """Files as given; directories searched for *.mod; glob patterns (also '**') expanded here,
+    so quoted patterns work in CI shells. Sorted and de-duplicated, for stable output."""
+    import glob
+    from pathlib import Path
+
+    out: list[str] = []
+    for p in paths:
+        if Path(p).is_dir():
+            out += sorted(str(f) for f in Path(p).rglob("*.mod"))
+        elif glob.has_magic(p):
+            out += sorted(f for f in glob.glob(p, recursive=True) if Path(f).is_file())
+        else:
+            out.append(p)
+    return list(dict.fromkeys(out))

@@ -1,0 +1,107 @@
+"""`modc lint` and `modc fmt`: checking and formatting .mod files, for CI and editors."""
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated
+
+import typer
+
+from .app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, LibraryOpt, Verbosity, _err, _expand, _print_diagnostics, app
+
+from .. import __version__
+
+
+class LintFormat(str, Enum):
+    text = "text"
+    json = "json"
+    github = "github"
+    sarif = "sarif"
+
+
+@app.command("lint")
+def lint_cmd(
+    files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
+    format: Annotated[LintFormat, typer.Option("--format", "-f", help="output format")] = LintFormat.text,
+    library: LibraryOpt = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
+):
+    """Check files without writing anything."""
+    from ..compiler import InputError, check_file
+    from ..diagnostics.render import render_github, render_json, render_sarif, summary
+
+    Verbosity.quiet = quiet
+    diags, sources, io_error = [], {}, False
+    paths = _expand(files)
+    for path in paths:
+        try:
+            c = check_file(path, library)
+        except InputError as e:
+            diags.append(e.diagnostic)
+            io_error = True
+            continue
+        diags += c.diagnostics
+        sources.update(c.sources)
+    shown = [d for d in diags if not (quiet and not d.is_error)]
+    if format is LintFormat.json:
+        print(render_json(shown))
+    elif format is LintFormat.github:
+        if shown:
+            print(render_github(shown))
+    elif format is LintFormat.sarif:
+        print(render_sarif(shown, __version__))
+    else:
+        _print_diagnostics(diags, sources)
+        if not quiet:
+            _err(f"modc lint: {len(paths)} file{'s' * (len(paths) != 1)}, {summary(diags)}")
+    if io_error:
+        raise typer.Exit(EXIT_USAGE)
+    raise typer.Exit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
+
+
+@app.command("fmt")
+def fmt_cmd(
+    files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
+    check: Annotated[bool, typer.Option("--check", help="write nothing; list the files that would change and exit 1 if any")] = False,
+):
+    """Rewrite .mod files in the canonical layout (comments kept, meaning unchanged)."""
+    from ..compiler import YAML_SUFFIXES, InputError, read_source
+    from ..syntax.format import FormatterBug, format_text, rewrite_file
+
+    diags, sources, io_error, changed = [], {}, False, []
+    for path in _expand(files):
+        if path.endswith(YAML_SUFFIXES):
+            _err(f"modc fmt: {path}: only .mod files are formatted")
+            io_error = True
+            continue
+        try:
+            text = read_source(path)
+        except InputError as e:
+            diags.append(e.diagnostic)
+            io_error = True
+            continue
+        try:
+            out, errors = format_text(text, path)
+        except FormatterBug as e:
+            _err(f"modc fmt: internal error: {e}")
+            io_error = True
+            continue
+        if out is None:  # does not parse: reported, never touched
+            diags += errors
+            sources[path] = text
+            continue
+        with open(path, "rb") as f:  # a BOM or CRLF line ends count as a change
+            if f.read() == out.encode("utf-8"):
+                continue
+        changed.append(path)
+        if not check:
+            try:
+                rewrite_file(path, out)
+            except OSError as e:
+                _err(f"modc fmt: {path}: {e.strerror or e}")
+                io_error = True
+                continue
+        print(path)
+    _print_diagnostics(diags, sources)
+    if io_error:
+        raise typer.Exit(EXIT_USAGE)
+    raise typer.Exit(EXIT_ERRORS if diags or (check and changed) else EXIT_OK)
