@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from contextlib import contextmanager
 from enum import Enum
 from typing import Annotated, Optional
 
@@ -55,3 +56,24 @@ def _expand(paths: list[str]) -> list[str]:
         else:
             out.append(p)
     return list(dict.fromkeys(out))
+
+
+@contextmanager
+def usage_errors(prog: str, usage: tuple[type[Exception], ...] = (), writing: str | None = None):
+    """Unreadable input, a bad name on the command line (`usage`) or a failed write (`writing`)
+    end the command with exit 2 and one plain line — never a traceback."""
+    from ..compiler import InputError
+
+    try:
+        yield
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE)
+    except usage as e:
+        _err(f"modc {prog}: {e}")
+        raise typer.Exit(EXIT_USAGE)
+    except OSError as e:
+        if writing is None:
+            raise
+        _err(f"modc {prog}: cannot write {writing}: {e.strerror or e}")
+        raise typer.Exit(EXIT_USAGE)

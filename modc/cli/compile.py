@@ -5,7 +5,17 @@ from typing import Annotated, Optional
 
 import typer
 
-from .app import EXIT_ERRORS, EXIT_USAGE, LibraryOpt, TorqueLevel, Verbosity, _err, _print_diagnostics, app
+from .app import (
+    EXIT_ERRORS,
+    EXIT_USAGE,
+    LibraryOpt,
+    TorqueLevel,
+    Verbosity,
+    _err,
+    _print_diagnostics,
+    app,
+    usage_errors,
+)
 
 
 @app.command("compile")
@@ -56,14 +66,8 @@ def compile_cmd(
             _err(f"modc: smoke test failed; nothing written to {out}")
             raise typer.Exit(EXIT_ERRORS)
     files = build(checked, selected, collision_samples=collision_samples, seed=seed)
-    try:
+    with usage_errors("compile", writing=out):
         write_tree(files, out, force=force)
-    except InputError as e:
-        _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
-    except OSError as e:
-        _err(f"modc: cannot write {out}: {e}")
-        raise typer.Exit(EXIT_USAGE)
     if verbose:
         for rel in files:
             _err(f"  wrote {out.rstrip('/')}/{rel}")

@@ -1,8 +1,6 @@
 """`lsp`, `schema`, `codes`, `backends`."""
 from __future__ import annotations
 
-
-
 from .app import app
 
 

@@ -6,9 +6,18 @@ from typing import Annotated
 
 import typer
 
-from .app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, LibraryOpt, Verbosity, _err, _expand, _print_diagnostics, app
-
 from .. import __version__
+from .app import (
+    EXIT_ERRORS,
+    EXIT_OK,
+    EXIT_USAGE,
+    LibraryOpt,
+    Verbosity,
+    _err,
+    _expand,
+    _print_diagnostics,
+    app,
+)
 
 
 class LintFormat(str, Enum):

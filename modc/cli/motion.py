@@ -6,7 +6,16 @@ from typing import Annotated, Optional
 
 import typer
 
-from .app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, LibraryOpt, _err, _print_diagnostics, app
+from .app import (
+    EXIT_ERRORS,
+    EXIT_OK,
+    EXIT_USAGE,
+    LibraryOpt,
+    _err,
+    _print_diagnostics,
+    app,
+    usage_errors,
+)
 
 
 @app.command("sim")
@@ -19,18 +28,11 @@ def sim_cmd(
     """PyBullet smoke test: load every robot, hold home and every named pose with the actuators'
     peak torque, check tracking, self-collision, the environment, FK and holding torques.
     Exit 1 on any failure, saying what failed."""
-    from ..compiler import InputError
     from ..sim.scene import UsageError
     from ..sim.smoke import run_sim
 
-    try:
+    with usage_errors("sim", (UsageError,)):
         ok, lines, checked = run_sim(file, library=library, robot=robot, out_dir=srdf_from)
-    except InputError as e:
-        _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
-    except UsageError as e:
-        _err(f"modc sim: {e}")
-        raise typer.Exit(EXIT_USAGE)
     _print_diagnostics(checked.diagnostics, checked.sources)
     for line in lines:
         print(line)
@@ -50,7 +52,6 @@ def render_cmd(
     library: LibraryOpt = None,
 ):
     """A picture of the arm, its environment and its targets (PyBullet TinyRenderer, headless)."""
-    from ..compiler import InputError
     from ..sim.render import render
     from ..sim.scene import UsageError
 
@@ -63,18 +64,9 @@ def render_cmd(
     if colors is not None and not 2 <= colors <= 256:
         _err(f"modc render: --colors {colors}: expected 2 to 256")
         raise typer.Exit(EXIT_USAGE)
-    try:
+    with usage_errors("render", (UsageError,), writing=out):
         ok, lines, checked = render(file, out, pose=pose, robot=robot, library=library, width=width, height=height,
                                     azimuth=azimuth, elevation=elevation, colors=colors)
-    except InputError as e:
-        _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
-    except UsageError as e:
-        _err(f"modc render: {e}")
-        raise typer.Exit(EXIT_USAGE)
-    except OSError as e:
-        _err(f"modc render: cannot write {out}: {e.strerror or e}")
-        raise typer.Exit(EXIT_USAGE)
     _print_diagnostics(checked.diagnostics, checked.sources)
     for line in lines:
         _err(line)
@@ -92,21 +84,11 @@ def play_cmd(
 ):
     """Play a trajectory in PyBullet: in the GUI when a display works, else headless; report
     tracking and collisions; --record OUT.gif."""
-    from ..compiler import InputError
     from ..sim.play import play
     from ..sim.scene import UsageError
 
-    try:
+    with usage_errors("play", (UsageError,), writing=record):
         ok, lines, checked = play(file, traj, record=record, robot=robot, library=library, gui=False if headless else None)
-    except InputError as e:
-        _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
-    except UsageError as e:
-        _err(f"modc play: {e}")
-        raise typer.Exit(EXIT_USAGE)
-    except OSError as e:
-        _err(f"modc play: cannot write {record}: {e.strerror or e}")
-        raise typer.Exit(EXIT_USAGE)
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not ok:
         from ..diagnostics import Span, codes
