@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 
@@ -199,3 +200,42 @@ def test_epsilon_and_torque_disagreement_is_told():
                    analyses=COMPILE_ANALYSES)
     over = [d for d in c.diagnostics if d.code == "torque-over-peak"]
     assert over and "obeys the paper's ε rule, but the physics says no" in over[0].hint
+
+
+# --- the dynamic check: torques along a trajectory ------------------------------------------------
+
+def test_a_trajectory_at_rest_needs_exactly_the_gravity_torques():
+    from modc.dynamics.along import torques
+
+    robot = checked_ok(ARMS[0]).design.robots[0]
+    dyn = Dynamics(robot)
+    q = np.array([0.3, -0.8, 1.1, 0.4])
+    tau = torques(dyn, [0.0, 0.5, 1.0], [q, q, q])
+    assert np.allclose(tau, [dyn.gravity(q)] * 3, atol=1e-12)
+
+
+def test_check_along_a_planned_motion(tmp_path):
+    """plan -> check --traj: the planned motion (rated speeds) is within the actuators' torques,
+    and the same path ten times faster is not; the failure names the joint and the time."""
+    farm = str(ROOT / "examples" / "farm.mod")
+    r = _modc("plan", farm, "--to", "plant", "--json")
+    assert r.returncode == 0, r.stderr
+    traj = tmp_path / "t.json"
+    traj.write_text(r.stdout)
+    r = _modc("check", farm, "--traj", str(traj), "--json")
+    assert r.returncode == 0, r.stderr
+    along = json.loads(r.stdout)["robots"][0]["trajectory"]["joints"]
+    assert [j["name"] for j in along] == ["joint_1", "joint_2", "joint_3"] and all(j["status"] == "ok" for j in along)
+    doc = json.loads(traj.read_text())
+    for p in doc["points"]:
+        p["t"] /= 25.0
+    fast = tmp_path / "fast.json"
+    fast.write_text(json.dumps(doc))
+    r = _modc("check", farm, "--traj", str(fast))
+    assert r.returncode == 1
+    assert "Traceback" not in r.stderr
+    assert re.search(r"^modc check: joint_\d \([HL]\d\) needs [\d.]+ N·m at t = [\d.]+ s of .*fast.json, above its peak", r.stderr, re.M), r.stderr
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"joint_names": ["joint_1"], "points": [{"t": 0, "q": [0]}]}))
+    r = _modc("check", farm, "--traj", str(bad))
+    assert r.returncode == 1 and f"{bad}:1:1: error[traj-invalid]" in r.stderr

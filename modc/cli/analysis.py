@@ -6,7 +6,16 @@ from typing import Annotated, Optional
 
 import typer
 
-from .app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, LibraryOpt, _print_diagnostics, app
+from .app import (
+    EXIT_ERRORS,
+    EXIT_OK,
+    EXIT_USAGE,
+    LibraryOpt,
+    _err,
+    _print_diagnostics,
+    app,
+    usage_errors,
+)
 
 
 def _mass(text: str) -> float | None:
@@ -25,10 +34,12 @@ def check_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
     payload: Annotated[Optional[str], typer.Option(help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")] = None,
     json_out: Annotated[bool, typer.Option("--json", help="print the torque table as JSON")] = False,
+    traj: Annotated[Optional[str], typer.Option("--traj", help="also the torques along this trajectory (inverse dynamics), e.g. from `modc plan --json`")] = None,
     library: LibraryOpt = None,
 ):
     """Torque feasibility: the worst static gravity torque of every joint over its range, against
-    the actuator's nominal and peak torque. Exit 1 if a joint can exceed its peak torque."""
+    the actuator's nominal and peak torque, and with --traj the peak torques along a motion.
+    Exit 1 if a joint can exceed its peak torque."""
     import json
     import math
 
@@ -47,9 +58,12 @@ def check_cmd(
         _print_diagnostics([e.diagnostic], {})
         raise typer.Exit(EXIT_USAGE)
     robots = [r for r in checked.design.robots if r.torque is not None]
+    along = _along(traj, robots, mass) if traj is not None and checked.ok else {}
     if json_out:
         doc = {"robots": [{"name": r.name, "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
-                           "joints": [j.to_json() for j in r.torque]} for r in robots]}
+                           "joints": [j.to_json() for j in r.torque],
+                           **({"trajectory": {"file": traj, "joints": [j.to_json() for j in along[r.name]]}} if r.name in along else {})}
+                          for r in robots]}
         print(json.dumps(doc, indent=2))
     else:
         for r in robots:
@@ -58,8 +72,44 @@ def check_cmd(
             for j in r.torque:
                 pose = ", ".join(f"{math.degrees(x):.0f}" for x in j.q)
                 print(f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}  ({pose})  {j.level}")
+            if r.name in along:
+                print(f"  along {traj} (inverse dynamics):")
+                print(f"  {'joint':<9}{'unit':<6}{'peak |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}  at t (s)")
+                for j in along[r.name]:
+                    print(f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}  {j.t:.3f}  {j.level}")
     _print_diagnostics(checked.diagnostics, checked.sources)
-    raise typer.Exit(EXIT_OK if checked.ok else EXIT_ERRORS)
+    over = [j for peaks in along.values() for j in peaks if j.level == "over-peak"]
+    for j in over:
+        _err(f"modc check: {j.name} ({j.variant}) needs {j.tau:.3g} N·m at t = {j.t:.3f} s of {traj}, above its peak {j.tau_max:g} N·m")
+    raise typer.Exit(EXIT_OK if checked.ok and not over else EXIT_ERRORS)
+
+
+def _along(traj_path: str, robots, mass) -> dict:
+    """Peak torques along the trajectory for the robot it belongs to (exit 1 on a bad file)."""
+    from ..diagnostics import Span, codes
+    from ..dynamics.along import peaks
+    from ..dynamics.worst import Dynamics
+    from ..sim.trajectory import load, validate_for
+
+    def invalid(lines):
+        _print_diagnostics([codes.TRAJ_INVALID.at(Span.point(traj_path), detail=line) for line in lines], {})
+        raise typer.Exit(EXIT_ERRORS)
+
+    with usage_errors("check"):
+        traj, errors = load(traj_path)
+    if traj is None:
+        invalid(errors)
+    named = [r for r in robots if traj.robot in (None, r.name)]
+    if len(named) != 1:
+        invalid([f"the trajectory names no single robot of the file ({', '.join(r.name for r in robots)}); add \"robot\""])
+    robot = named[0]
+    errors = validate_for(traj, robot)
+    if errors:
+        invalid(errors)
+    payload = None
+    if mass is not None:
+        payload = (mass, robot.payload.com if robot.payload is not None else (0.0, 0.0, 0.0))
+    return {robot.name: peaks(Dynamics(robot, payload), traj)}
 
 
 @app.command("dh2mod")
