@@ -43,6 +43,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _common import child_env  # benchmarks/_common.py
+
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
     sys.path.insert(0, str(ROOT))
@@ -75,24 +77,6 @@ def _stats(samples: list[float]) -> dict:
     }
 
 
-def _child_env(pycache: Path | None = None) -> dict[str, str]:
-    """The environment for subprocesses: make a fresh interpreter import this working tree.
-
-    With pycache, bytecode is cached there (PYTHONPYCACHEPREFIX) even if the calling
-    environment sets PYTHONDONTWRITEBYTECODE: an installed modc has its .pyc files, while
-    compiling modc from source on every start costs about 10 ms.
-    """
-    env = dict(os.environ)
-    if pycache is not None:
-        env.pop("PYTHONDONTWRITEBYTECODE", None)
-        env["PYTHONPYCACHEPREFIX"] = str(pycache)
-    probe = subprocess.run([sys.executable, "-c", "import modc, sys; sys.stdout.write(modc.__file__)"],
-                           capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
-    want = ROOT / "modc" / "__init__.py"
-    got = Path(probe.stdout.strip()) if probe.returncode == 0 else None
-    if got is None or got.resolve() != want.resolve():
-        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
-    return env
 
 
 def _console_script() -> Path | None:
@@ -551,9 +535,9 @@ def main(argv: list[str] | None = None) -> int:
     machine = _machine()
     with tempfile.TemporaryDirectory(prefix="modc-bench-") as tmp:
         tmpdir = Path(tmp)
-        env = _child_env(tmpdir / "pycache")
+        env = child_env(tmpdir / "pycache")
         no_pyc = bool(os.environ.get("PYTHONDONTWRITEBYTECODE"))
-        env_as_is = _child_env() if no_pyc else None
+        env_as_is = child_env() if no_pyc else None
         machine["PYTHONDONTWRITEBYTECODE"] = os.environ.get("PYTHONDONTWRITEBYTECODE")
         text, origin = six_dof_source()
         lint_file = tmpdir / "six.mod"

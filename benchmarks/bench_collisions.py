@@ -33,6 +33,8 @@ import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+from _common import pin_one_core  # benchmarks/_common.py
+
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
     sys.path.insert(0, str(ROOT))
@@ -41,13 +43,6 @@ TARGET_S = 0.5
 SIX_DOF_EXAMPLES = ("example_a", "example_b")
 
 
-def _pin_one_core() -> int | None:
-    try:
-        cpus = sorted(os.sched_getaffinity(0))
-        os.sched_setaffinity(0, {cpus[-1]})
-        return cpus[-1]
-    except (AttributeError, OSError):
-        return None
 
 
 def _time(fn, runs: int) -> tuple[dict, object]:
@@ -86,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", nargs="?", const="-", default=None, metavar="OUT")
     args = ap.parse_args(argv)
 
-    cpu = _pin_one_core()
+    cpu = pin_one_core()
     from modc.backends import srdf
     from modc.physical import collisions
 

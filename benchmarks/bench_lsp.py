@@ -21,11 +21,12 @@ import json
 import os
 import platform
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from _common import child_env  # benchmarks/_common.py
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -57,15 +58,6 @@ robot six {
 VALUES = ["30", "20", "45", "40", "60", "50", "75", "15"]
 
 
-def _child_env() -> dict[str, str]:
-    env = dict(os.environ)
-    probe = subprocess.run([sys.executable, "-c", "import modc, sys; sys.stdout.write(modc.__file__)"],
-                           capture_output=True, text=True, env=env, cwd=tempfile.gettempdir())
-    want = ROOT / "modc" / "__init__.py"
-    got = Path(probe.stdout.strip()) if probe.returncode == 0 else None
-    if got is None or got.resolve() != want.resolve():
-        env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
-    return env
 
 
 def _stats(samples: list[float]) -> dict:
@@ -85,7 +77,7 @@ def run(edits: int, warmup: int) -> dict:
     col = SIX_DOF.split("\n")[line].index("port=15deg") + len("port=")
 
     t_start = time.perf_counter()
-    client = Client([sys.executable, "-m", "modc.lsp"], cwd=str(ROOT), env=_child_env())
+    client = Client([sys.executable, "-m", "modc.lsp"], cwd=str(ROOT), env=child_env())
     try:
         client.initialize()
         t_ready = time.perf_counter() - t_start

@@ -34,6 +34,8 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+from _common import pin_one_core  # benchmarks/_common.py
+
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
     sys.path.insert(0, str(ROOT))
@@ -48,13 +50,6 @@ SIX_DOF = """robot a6 {
 """
 
 
-def _pin_one_core() -> int | None:
-    try:
-        cpus = sorted(os.sched_getaffinity(0))
-        os.sched_setaffinity(0, {cpus[-1]})
-        return cpus[-1]
-    except (AttributeError, OSError):
-        return None
 
 
 def _cases(tmp: Path) -> list[tuple[str, Path, str]]:
@@ -124,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", nargs="?", const="-", default=None, metavar="OUT")
     args = ap.parse_args(argv)
 
-    cpu = _pin_one_core()
+    cpu = pin_one_core()
     from modc.plan import plan  # noqa: F401  (imports outside the timings)
 
     seeds = list(range(3 if args.quick else 5))

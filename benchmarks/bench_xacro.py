@@ -32,6 +32,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _common import child_env  # benchmarks/_common.py
+
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
     sys.path.insert(0, str(ROOT))
@@ -58,10 +60,6 @@ def _backends() -> list[str]:
     return list(BACKENDS)
 
 
-def _child_env() -> dict[str, str]:
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
-    return env
 
 
 def prepare(src: Path, tmp: Path) -> tuple[Path, dict]:
@@ -140,7 +138,7 @@ def bench_breakdown(src: Path, runs: int) -> dict:
 
 
 def bench_subprocess(src: Path, xacro_file: Path, runs: int, tmp: Path) -> dict:
-    env = _child_env()
+    env = child_env()
     exe = Path(sys.executable).parent / "xacro"
     xacro_cmd = [str(exe)] if exe.is_file() else [sys.executable, "-m", "xacro"]
     cmds = {
