@@ -5,11 +5,11 @@ from ..model import Design
 from . import (
     check_assembly,
     check_environment,
+    check_modules,
     check_names,
     check_poses,
     check_torque,
     check_twists,
-    check_units,
     convert_dh,
     resolve_library,
 )
@@ -19,7 +19,7 @@ PASSES = (
     resolve_library,
     convert_dh,
     check_names,
-    check_units,
+    check_modules,
     check_assembly,
     check_twists,
     check_poses,

@@ -1,4 +1,7 @@
-"""Every unit exists in the library, its parameters apply to it, and the DoF is in bounds."""
+"""Every modular unit of the chain (H1…L4) exists in the library, its parameters apply to it, and
+the DoF is in bounds. (Modular units of the paper, not units of measure: those are checked while
+lowering the syntax.)
+"""
 from __future__ import annotations
 
 import difflib
