@@ -232,6 +232,14 @@ def joints(robot) -> list[JointData]:
     return out
 
 
+def _home_origin(robot) -> str:
+    """Where the initial positions come from (Robot.home), for the YAML's comment."""
+    if robot.pose("home") is not None or not any(robot.default_q()):
+        return "the file's `pose home` (zeros without one)"
+    return ("MoveIt's default values, as the file declares no `pose home`: 0, or the middle of a joint range "
+            "that excludes 0")
+
+
 def _joint_ctx(j: JointData, command: str) -> dict:
     lo, hi = (j.lower, j.upper) if command == "position" else (-j.effort, j.effort)
     return {
@@ -272,6 +280,7 @@ def robot_context(build: Build, robot, package: str) -> dict:
         "joint_state_broadcaster": JOINT_STATE_BROADCASTER,
         "joints": [_joint_ctx(j, iface) for j in js],
         "home_flow": "{" + ", ".join(f"{j.name}: {real(j.home)}" for j in js) + "}",
+        "home_origin": _home_origin(robot),
         "update_rate": str(UPDATE_RATE), "joint_state_rate": real(JOINT_STATE_RATE),
         "goal_time": real(GOAL_TIME), "goal_tolerance": real(GOAL_TOLERANCE),
         "path_tolerance": real(PATH_TOLERANCE), "stopped_velocity_tolerance": real(STOPPED_VELOCITY_TOLERANCE),

@@ -5,7 +5,8 @@ description of the URDF the urdf backend emits.
     group arm       chain base_link -> tool0
     group tool      links tool0 (and payload), plus an end_effector "tool" on the arm's last
                     link -- only when the file declares a tool (offset) or a payload
-    group_state     "home" (the pose named home, else all zeros), then every other named pose
+    group_state     "home" (Robot.home: the pose named home, else MoveIt's default values), then every
+                    other named pose
     disable_collisions   the self-collision matrix of modc.physical.collisions: seeded and
                     deterministic, computed on the emitted URDF and meshes with pinocchio + coal
 

@@ -214,7 +214,7 @@ def _complete_in_statement(an: Analysis, block: Block, stmt: Stmt, prev: Tok, ro
     if kw == "pose":
         if prev is stmt.keyword:
             have = {s.toks[0].text for s in block.find("pose") if s.toks and s is not stmt}
-            return [] if "home" in have else [Completion("home", types.CompletionItemKind.Constant, "the home pose", "the pose the robot starts in (all zeros when absent)")]
+            return [] if "home" in have else [Completion("home", types.CompletionItemKind.Constant, "the home pose", "the pose the robot starts in (when absent: 0 per joint, or mid-range where a limit excludes 0)")]
         if len(body) == 1 and prev is body[0]:
             n = len(_block_units(block))
             if n:

@@ -82,6 +82,12 @@ class Target(_M):
     span: SpanField
 
 
+def default_position(lower: float, upper: float) -> float:
+    """MoveIt's default value of a revolute joint with these bounds (moveit_core,
+    RevoluteJointModel::getVariableDefaultPositions): 0 inside the bounds, else their middle."""
+    return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
+
+
 class Robot(_M):
     name: str
     library_ref: str = "mark2"
@@ -127,8 +133,17 @@ class Robot(_M):
         return next((p for p in self.poses if p.name == name), None)
 
     def home(self) -> tuple[float, ...]:
+        """The one home pose (rad) of every backend and analysis: the pose declared `home`, else
+        MoveIt's default joint values (default_q). check_poses reports a declared home outside
+        the limits (pose-out-of-limits), so a checked robot's home is always inside them."""
         p = self.pose("home")
-        return p.q if p is not None else (0.0,) * self.dof
+        return tuple(p.q) if p is not None else self.default_q()
+
+    def default_q(self) -> tuple[float, ...]:
+        """MoveIt's default joint values (RobotState::setToDefaultValues, which the Setup
+        Assistant's collision matrix also starts from): per joint, 0 when its range (narrowed by
+        `limit`) contains 0, else the middle of the range."""
+        return tuple(default_position(*self.joint_range(i)) for i in range(1, self.dof + 1))
 
     def joint_range(self, i: int) -> tuple[float, float]:
         """Position limits of joint i (1-based), rad: the library's range, narrowed by `limit`."""

@@ -100,19 +100,13 @@ def _num(x: float) -> str:
 
 
 def start_pose(robot, name: str | None):
-    """(name, q) of the start pose: the pose named `name`, else home (the pose named home, or
-    zeros, with a joint whose range excludes 0 at the middle of its range)."""
+    """(name, q, span) of the start pose: the pose named `name`, else home (Robot.home); None
+    when the robot has no pose `name`."""
     if name is not None:
         p = robot.pose(name)
         return (p.name, tuple(p.q), p.span) if p is not None else None
     p = robot.pose("home")
-    if p is not None:
-        return ("home", tuple(p.q), p.span)
-    q = []
-    for i in range(1, robot.dof + 1):
-        lo, hi = robot.joint_range(i)
-        q.append(0.0 if lo <= 0.0 <= hi else (lo + hi) / 2.0)
-    return ("home", tuple(q), robot.name_span)
+    return ("home", robot.home(), p.span if p is not None else robot.name_span)
 
 
 def _known(kind: str, names) -> str:
@@ -206,7 +200,7 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
                 "(a floor may touch it)" if fixed else
                 "choose another start pose with --start, or move the obstacle")
         if robot.pose(start_name) is None:  # the implicit home pose
-            hint += "; the file declares no `pose home`, so the start is every joint at 0"
+            hint += "; the file declares no `pose home`, so the start is every joint at 0 (or mid-range where 0 is outside its limits)"
         raise PlanError.of("start-in-collision", start_span, sources, pose=start_name, contacts=_contacts_text(hit), hint=hint)
     if not checker.valid(q_start):
         clearance, pair = checker.clearance(q_start)

@@ -359,7 +359,7 @@ def save_png(img, out: str | Path, colors: int | None = None) -> None:
 
 def pose_of(robot, pose: str | None) -> tuple[float, ...]:
     if pose is None or pose == "home":
-        return scene.home_q(robot)
+        return robot.home()
     p = robot.pose(pose)
     if p is None:
         names = ", ".join(["home"] + [x.name for x in robot.poses if x.name != "home"])

@@ -86,18 +86,6 @@ def compiled(checked) -> Iterator[dict[str, Path]]:
         yield {r.name: root / "urdf" / f"{r.file_stem}.urdf" for r in checked.design.robots}
 
 
-def home_q(robot: Robot) -> tuple[float, ...]:
-    """The pose named home; else zeros, except that a joint whose range (narrowed by `limit`)
-    excludes 0 sits in the middle of its range (MoveIt's default joint values)."""
-    if robot.pose("home") is not None:
-        return tuple(robot.home())
-    q = []
-    for i in range(1, robot.dof + 1):
-        lo, hi = robot.joint_range(i)
-        q.append(0.0 if lo <= 0.0 <= hi else (lo + hi) / 2.0)
-    return tuple(q)
-
-
 # ------------------------------------------------------------------------------------------------
 # PyBullet's C-level output
 
@@ -254,7 +242,7 @@ def extent_points(robot: Robot, q=None, T_world_base=None):
 
     T = transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else T_world_base
     chain = Chain(robot)
-    q = home_q(robot) if q is None else q
+    q = robot.home() if q is None else q
     pts, radii = [np.zeros(3)], [MODULE_RADIUS]
     for f in chain.frames(q):
         for k in ("T_base_twist1", "T_base_joint", "T_base_end"):
@@ -495,7 +483,7 @@ def load_robot(client, robot: Robot, urdf: Path, T_world_base=None, *, environme
         for t in robot.targets:
             s.targets[t.name] = add_marker(client, (T_world_base @ np.array([*t.xyz, 1.0]))[:3])
     s.release_motors()
-    s.set_q(home_q(robot))
+    s.set_q(robot.home())
     return s
 
 

@@ -7,7 +7,7 @@ static bodies), then:
   load      PyBullet prints nothing while loading (any b3Warning / b3Error / "failed" line is a
             failure, quoted), every URDF link has an <inertial> with positive mass and principal
             moments, and PyBullet sees one revolute joint per module.
-  per pose  `home` (the pose named home, else zeros: scene.home_q), then every other named pose:
+  per pose  `home` (Robot.home: the pose named home, else MoveIt's default values), then every other named pose:
     FK          PyBullet's tool0 frame equals modc.kinematics (SPEC section 2) to FK_POS_TOL /
                 FK_ROT_TOL: the pip wheel of PyBullet computes in single precision, so 1e-6 m and
                 1e-5 (rotation-matrix entries), not the 1e-9 the double-precision consumers meet.
@@ -120,7 +120,7 @@ def check_urdf_inertials(urdf: Path) -> list[str]:
 
 
 def pose_list(robot) -> list[tuple[str, tuple[float, ...]]]:
-    return [("home", scene.home_q(robot))] + [(p.name, tuple(p.q)) for p in robot.poses if p.name != "home"]
+    return [("home", robot.home())] + [(p.name, tuple(p.q)) for p in robot.poses if p.name != "home"]
 
 
 def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOLD_TIME,
