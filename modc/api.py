@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .diagnostics.render import render_text
-from .model import Robot
+from .model import Design, Robot
 
 
 class ModcError(Exception):
@@ -22,7 +22,7 @@ class ModcError(Exception):
         self.diagnostics = diagnostics
 
 
-def load_all(path: str | Path, library: str | None = None) -> list[Robot]:
+def _design(path: str | Path, library: str | None) -> Design:
     from .compiler import InputError, check_file
 
     try:
@@ -31,19 +31,21 @@ def load_all(path: str | Path, library: str | None = None) -> list[Robot]:
         raise ModcError([e.diagnostic], {}) from None
     if not c.ok:
         raise ModcError(c.diagnostics, c.sources)
-    return list(c.design.robots)
+    return c.design
+
+
+def load_all(path: str | Path, library: str | None = None) -> list[Robot]:
+    return list(_design(path, library).robots)
 
 
 def load(path: str | Path, robot: str | None = None, library: str | None = None) -> Robot:
-    robots = load_all(path, library)
-    if robot is None:
-        if len(robots) != 1:
-            raise ValueError(f"{path} defines {len(robots)} robots; pass robot=NAME")
-        return robots[0]
-    for r in robots:
-        if r.name == robot:
-            return r
-    raise KeyError(f"{path} has no robot '{robot}'")
+    """The robot called `robot`, or the file's only one; ModcError (robot-unknown) otherwise."""
+    from .model.select import RobotChoiceError, choose_robot
+
+    try:
+        return choose_robot(_design(path, library), robot, say="robot=NAME")
+    except RobotChoiceError as e:
+        raise ModcError([e.diagnostic], {}) from None
 
 
 def chain(robot: Robot):

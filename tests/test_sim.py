@@ -19,6 +19,7 @@ import pytest
 from conftest import EXAMPLES, ROOT
 from modc.compiler import COMPILE_ANALYSES, build, check_file, check_text
 from modc.kinematics import Chain
+from modc.model.select import RobotChoiceError
 from modc.sim import scene, smoke, trajectory
 from modc.sim.play import play
 from modc.sim.render import render
@@ -221,7 +222,7 @@ def test_file_with_errors_is_not_simulated(tmp_path):
 
 
 def test_unknown_robot_is_a_usage_error():
-    with pytest.raises(scene.UsageError, match="no robot 'nope'"):
+    with pytest.raises(RobotChoiceError, match="no robot 'nope'"):
         smoke.run_sim(ROOT / "examples" / "farm.mod", robot="nope")
 
 
@@ -373,7 +374,7 @@ def test_play_usage_errors(tmp_path):
         play(ROOT / "examples" / "farm.mod", tmp_path / "missing.json")
     two = write(tmp_path, "robot a { chain H3 - L4 }\nrobot b { chain H3 - L4 }\n")
     doc = {"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]}
-    with pytest.raises(scene.UsageError, match="defines 2 robots"):
+    with pytest.raises(RobotChoiceError, match="defines 2 robots"):
         play(two, traj_file(tmp_path, doc))
     ok, _, _ = play(two, traj_file(tmp_path, {**doc, "robot": "b"}))
     assert ok

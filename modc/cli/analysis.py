@@ -58,7 +58,7 @@ def check_cmd(
         _print_diagnostics([e.diagnostic], {})
         raise typer.Exit(EXIT_USAGE)
     robots = [r for r in checked.design.robots if r.torque is not None]
-    along = _along(traj, robots, mass) if traj is not None and checked.ok else {}
+    along = _along(traj, checked.design, robots, mass) if traj is not None and checked.ok else {}
     if json_out:
         doc = {"robots": [{"name": r.name, "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
                            "joints": [j.to_json() for j in r.torque],
@@ -84,11 +84,12 @@ def check_cmd(
     raise typer.Exit(EXIT_OK if checked.ok and not over else EXIT_ERRORS)
 
 
-def _along(traj_path: str, robots, mass) -> dict:
+def _along(traj_path: str, design, robots, mass) -> dict:
     """Peak torques along the trajectory for the robot it belongs to (exit 1 on a bad file)."""
     from ..diagnostics import Span, codes
     from ..dynamics.along import peaks
     from ..dynamics.worst import Dynamics
+    from ..model.select import choose_robot
     from ..sim.trajectory import load, validate_for
 
     def invalid(lines):
@@ -99,10 +100,8 @@ def _along(traj_path: str, robots, mass) -> dict:
         traj, errors = load(traj_path)
     if traj is None:
         invalid(errors)
-    named = [r for r in robots if traj.robot in (None, r.name)]
-    if len(named) != 1:
-        invalid([f"the trajectory names no single robot of the file ({', '.join(r.name for r in robots)}); add \"robot\""])
-    robot = named[0]
+    with usage_errors("check"):
+        robot = choose_robot(design, traj.robot, robots, say='"robot" in the trajectory file', where=Span.point(traj_path))
     errors = validate_for(traj, robot)
     if errors:
         invalid(errors)

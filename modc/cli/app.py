@@ -60,13 +60,15 @@ def _expand(paths: list[str]) -> list[str]:
 
 @contextmanager
 def usage_errors(prog: str, usage: tuple[type[Exception], ...] = (), writing: str | None = None):
-    """Unreadable input, a bad name on the command line (`usage`) or a failed write (`writing`)
-    end the command with exit 2 and one plain line — never a traceback."""
+    """Unreadable input, an unknown robot, a bad name on the command line (`usage`) or a failed
+    write (`writing`) end the command with exit 2 and a diagnostic or one plain line — never a
+    traceback."""
     from ..compiler import InputError
+    from ..model.select import RobotChoiceError
 
     try:
         yield
-    except InputError as e:
+    except (InputError, RobotChoiceError) as e:
         _print_diagnostics([e.diagnostic], {})
         raise typer.Exit(EXIT_USAGE)
     except usage as e:

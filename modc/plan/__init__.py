@@ -13,7 +13,7 @@ Steps (modules of this package):
                   the collision-free solution closest to the start pose is the goal
     planner.py    OMPL RRT-Connect in joint space, then shortcutting
     timing.py     stop-at-every-vertex trapezoidal timing within the velocity limits
-    errors.py     PlanError and its diagnostic codes
+    errors.py     PlanError (diagnostics of the registry, exit code)
 
 Everything is deterministic for a given file, target, start pose and seed: numpy's
 default_rng(seed) for IK seeds and shortcuts, OMPL's RNG seeded from it, and a planner budget
@@ -27,6 +27,8 @@ import math
 import time
 from dataclasses import dataclass, field
 
+from ..diagnostics import codes
+from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
 
 IK_SEEDS_PER_JOINT = 16  # IK runs: 16 per joint (48 for a 3-joint arm), the start pose first
@@ -135,28 +137,18 @@ def plan(path, target: str, robot: str | None = None, seed: int = 0, start: str 
     if not checked.ok:
         raise PlanError([d for d in checked.diagnostics if d.is_error], checked.sources, EXIT_FAILED)
     robots = list(checked.design.robots)
-    from ..diagnostics import Span
-
-    here = Span.point("<command line>")
-    if robot is not None:
-        chosen = [r for r in robots if r.name == robot]
-        if not chosen:
-            raise PlanError.of("robot-unknown", here, detail=f"{checked.design.path} has no robot '{robot}'",
-                               known="robots: " + (", ".join(r.name for r in robots) or "none"))
-    else:
-        chosen = [r for r in robots if any(t.name == target for t in r.targets)] if len(robots) > 1 else robots
-        if len(chosen) > 1:
-            raise PlanError.of("robot-unknown", here,
-                               detail=f"robots {', '.join(r.name for r in chosen)} all have a target '{target}'",
-                               known="choose one with --robot NAME")
-        if not chosen:
-            if not robots:
-                raise PlanError.of("robot-unknown", here, detail=f"{checked.design.path} defines no robot",
-                                   known="add a block such as: robot arm { chain H1 - L1 }")
+    among = None
+    if robot is None and len(robots) > 1:
+        among = [r for r in robots if any(t.name == target for t in r.targets)]
+        if not among:
             known = "; ".join(f"{r.name}: {', '.join(t.name for t in r.targets) or 'none'}" for r in robots)
-            raise PlanError.of("target-unknown", here, robot=" or ".join(r.name for r in robots), target=target,
-                               known=f"targets per robot: {known}")
-    return plan_robot(chosen[0], target, seed=seed, start=start, sources=checked.sources,
+            raise PlanError.of(codes.TARGET_UNKNOWN, COMMAND_LINE, robot=" or ".join(r.name for r in robots),
+                               target=target, known=f"targets per robot: {known}")
+    try:
+        chosen = choose_robot(checked.design, robot, among, why=f"have a target '{target}'")
+    except RobotChoiceError as e:
+        raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
+    return plan_robot(chosen, target, seed=seed, start=start, sources=checked.sources,
                       with_robot_name=len(robots) > 1, **options)
 
 
@@ -167,22 +159,20 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     emits them ({relative path: content}); generated when omitted. Raises PlanError."""
     import numpy as np
 
-    from ..diagnostics import Span
     from . import ik, planner, timing
     from .collision import DEFAULT_MARGIN, CollisionChecker
 
     t_begin = time.perf_counter()
     sources = sources or {}
-    here = Span.point("<command line>")
     if seed < 0:
         raise ValueError("seed must be >= 0")
     tgt = next((t for t in robot.targets if t.name == target), None)
     if tgt is None:
-        raise PlanError.of("target-unknown", here, sources, robot=robot.name, target=target,
+        raise PlanError.of(codes.TARGET_UNKNOWN, COMMAND_LINE, sources, robot=robot.name, target=target,
                            known=_known("targets", (t.name for t in robot.targets)))
     sp = start_pose(robot, start)
     if sp is None:
-        raise PlanError.of("pose-unknown", here, sources, robot=robot.name, pose=start,
+        raise PlanError.of(codes.POSE_UNKNOWN, COMMAND_LINE, sources, robot=robot.name, pose=start,
                            known=_known("poses", (p.name for p in robot.poses)))
     start_name, q_start, start_span = sp
     margin = DEFAULT_MARGIN if margin is None else float(margin)
@@ -201,11 +191,11 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
                 "choose another start pose with --start, or move the obstacle")
         if robot.pose(start_name) is None:  # the implicit home pose
             hint += "; the file declares no `pose home`, so the start is every joint at 0 (or mid-range where 0 is outside its limits)"
-        raise PlanError.of("start-in-collision", start_span, sources, pose=start_name, contacts=_contacts_text(hit), hint=hint)
+        raise PlanError.of(codes.START_IN_COLLISION, start_span, sources, pose=start_name, contacts=_contacts_text(hit), hint=hint)
     if not checker.valid(q_start):
         clearance, pair = checker.clearance(q_start)
         if clearance / 2 < MIN_MARGIN:
-            raise PlanError.of("start-in-collision", start_span, sources, pose=start_name,
+            raise PlanError.of(codes.START_IN_COLLISION, start_span, sources, pose=start_name,
                                contacts=f"{pair.describe()} are {clearance * 1000:.2f} mm apart",
                                hint=f"the planner needs {2 * MIN_MARGIN * 1000:.1f} mm of clearance at the start")
         checker.set_margin(clearance / 2)
@@ -225,7 +215,7 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     if not solutions:
         tool = solver.position(best.q)
         raise PlanError.of(
-            "target-unreachable", tgt.span, sources, target=target, distance=f"{best.error:.3f}",
+            codes.TARGET_UNREACHABLE, tgt.span, sources, target=target, distance=f"{best.error:.3f}",
             hint=(f"the closest tool0 gets is ({', '.join(f'{v:.3f}' for v in tool)}) m, at joint angles "
                   f"({', '.join(f'{math.degrees(v):.1f}' for v in best.q)}) deg; move the target towards the arm, "
                   "or lengthen the arm (link=…, more units)"))
@@ -253,7 +243,7 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
                 if c.describe() not in names:
                     names.append(c.describe())
         what = "; ".join(names) if names else f"closer than {2 * MIN_MARGIN * 1000:.1f} mm to an obstacle"
-        raise PlanError.of("target-in-collision", tgt.span, sources, target=target, contacts=what,
+        raise PlanError.of(codes.TARGET_IN_COLLISION, tgt.span, sources, target=target, contacts=what,
                            hint=f"all {len(solutions)} arm pose(s) that put tool0 on the target collide; "
                                 "move the target or the obstacle")
 
@@ -272,21 +262,21 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
             path = planner.find_path(checker, q_start, q_goal, seed, cost, timeout=timeout, max_checks=max_checks,
                                      deadline=deadline)
         except planner.PlannerUnavailable as e:
-            raise PlanError.of("no-path", tgt.span, sources, pose=start_name, target=target,
+            raise PlanError.of(codes.NO_PATH, tgt.span, sources, pose=start_name, target=target,
                                detail=f"the straight motion collides and {e}",
                                hint="install OMPL 2: pip install 'ompl>=2.0'") from None
         if path is not None:
             break
     if path is None:
         raise PlanError.of(
-            "no-path", tgt.span, sources, pose=start_name, target=target,
+            codes.NO_PATH, tgt.span, sources, pose=start_name, target=target,
             detail=f"RRT-Connect towards {tried} of the {len(goals)} collision-free goal pose(s), "
                    f"{max_checks} collision checks each, {timeout:g} s in all",
             hint="try another --seed or --start pose; the target may be enclosed by obstacles")
     # an independent pass over the final polyline (every edge certified again)
     for a, b in zip(path[:-1], path[1:]):
         if not checker.motion_valid(a, b, check_ends=True):  # pragma: no cover - the planner certified it
-            raise PlanError.of("no-path", tgt.span, sources, pose=start_name, target=target,
+            raise PlanError.of(codes.NO_PATH, tgt.span, sources, pose=start_name, target=target,
                                detail="the simplified path failed its final collision check",
                                hint="try another --seed")
 

@@ -32,15 +32,10 @@ CAMERA_SAMPLES = 9  # configurations of the motion the camera is fitted to
 
 
 def pick_robot(checked, traj: trajectory.Trajectory, robot: str | None):
-    name = robot or traj.robot
-    if name is not None:
-        return scene.select_robots(checked, name)[0]
-    robots = list(checked.design.robots)
-    if len(robots) != 1:
-        names = ", ".join(r.name for r in robots)
-        raise scene.UsageError(f"{checked.design.path} defines {len(robots)} robots ({names}); say which one the trajectory is for "
-                               "(--robot NAME, or \"robot\" in the trajectory file)")
-    return robots[0]
+    """The robot named on the command line, else the trajectory's, else the file's only robot."""
+    from ..model.select import choose_robot
+
+    return choose_robot(checked.design, robot or traj.robot, say='--robot NAME, or "robot" in the trajectory file')
 
 
 def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
@@ -75,8 +70,8 @@ def play(path, traj_json, record=None, robot: str | None = None, library: str | 
     ok is False when the file has errors (see checked.diagnostics; lines empty) or the trajectory
     does not fit (lines: one error each, "TRAJ.json: points[3].t: …"); nothing is played then.
     gui: None = when a display exists, False = headless, True = ask for the GUI (falls back).
-    Raises modc.compiler.InputError (unreadable .mod), scene.UsageError (unreadable trajectory,
-    unknown or ambiguous robot) and OSError (cannot write the GIF).
+    Raises modc.compiler.InputError (unreadable .mod), scene.UsageError (unreadable trajectory),
+    modc.model.select.RobotChoiceError (unknown or ambiguous robot) and OSError (cannot write the GIF).
     """
     import numpy as np
 

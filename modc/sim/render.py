@@ -374,8 +374,8 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
 
     Every robot of the file (or the one named) at `pose` (default home), with its obstacles and
     targets. ok is False only when the file has errors (checked.diagnostics say which; nothing is
-    written). Raises modc.compiler.InputError (unreadable file), scene.UsageError (unknown robot
-    or pose) and OSError (cannot write OUT.png).
+    written). Raises modc.compiler.InputError (unreadable file), RobotChoiceError (unknown robot),
+    scene.UsageError (unknown pose) and OSError (cannot write OUT.png).
     """
     checked = scene.load_checked(path, library)
     if not checked.ok:

@@ -46,7 +46,8 @@ GRAVITY = 9.81  # m/s², the value modc.dynamics uses
 
 
 class UsageError(Exception):
-    """A request that cannot be served (unknown robot or pose, unreadable trajectory): exit 2."""
+    """A request that cannot be served (unknown pose, unreadable trajectory): exit 2. An unknown
+    robot is modc.model.select.RobotChoiceError."""
 
 
 # ------------------------------------------------------------------------------------------------
@@ -62,14 +63,10 @@ def load_checked(path, library: str | None = None):
 
 
 def select_robots(checked, robot: str | None = None) -> list[Robot]:
-    robots = list(checked.design.robots)
-    if robot is None:
-        return robots
-    chosen = [r for r in robots if r.name == robot]
-    if not chosen:
-        names = ", ".join(r.name for r in robots) or "none"
-        raise UsageError(f"{checked.design.path} has no robot '{robot}' (robots: {names})")
-    return chosen
+    """Every robot of the file, or the one named (RobotChoiceError when there is none)."""
+    from ..model.select import choose_robot
+
+    return list(checked.design.robots) if robot is None else [choose_robot(checked.design, robot)]
 
 
 @contextlib.contextmanager

@@ -280,7 +280,8 @@ def run_sim(path, library: str | None = None, robot: str | None = None, out_dir:
     checked: the modc.compiler.Checked of the file (its .diagnostics and .sources are for the
     caller to print). When it has errors nothing is simulated: (False, [], checked).
     out_dir: a compile output (OUT/) whose config/<stem>.srdf disabled pairs are honoured.
-    Raises modc.compiler.InputError (unreadable file) and scene.UsageError (unknown robot).
+    Raises modc.compiler.InputError (unreadable file) and modc.model.select.RobotChoiceError
+    (unknown robot).
     """
     checked = scene.load_checked(path, library)
     if not checked.ok:
