@@ -258,6 +258,7 @@ def test_json_plays(farm, plant_plan):
     parsed, errors = traj.parse(json.loads(plant_plan.dumps()))
     assert not errors, errors
     assert not traj.validate_for(parsed, robot)
+    assert parsed.dumps() == plant_plan.dumps()  # one writer: read back and written again, the same bytes
 
 
 def test_same_seed_same_json(plant_plan, tmp_path):

@@ -22,13 +22,13 @@ written in a fixed layout, so the JSON is byte-for-byte reproducible.
 """
 from __future__ import annotations
 
-import json
 import math
 import time
 from dataclasses import dataclass, field
 
 from ..diagnostics import codes
 from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
+from ..sim.trajectory import Trajectory
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
 
 IK_SEEDS_PER_JOINT = 16  # IK runs: 16 per joint (48 for a 3-joint arm), the start pose first
@@ -59,23 +59,17 @@ class Plan:
     def duration(self) -> float:
         return self.t[-1] - self.t[0]
 
+    @property
+    def trajectory(self) -> Trajectory:
+        """The motion as a trajectory file (SPEC section 6), naming the robot in several-robot files."""
+        return Trajectory(self.joint_names, self.t, self.q, self.robot if self.with_robot_name else None)
+
     def to_json(self) -> dict:
-        doc = {"joint_names": list(self.joint_names),
-               "points": [{"t": t, "q": list(q)} for t, q in zip(self.t, self.q)]}
-        if self.with_robot_name:
-            doc["robot"] = self.robot
-        return doc
+        return self.trajectory.to_json()
 
     def dumps(self) -> str:
         """SPEC section 6 JSON, one point per line, fixed number formatting."""
-        lines = ["{", f'  "joint_names": {json.dumps(list(self.joint_names))},']
-        if self.with_robot_name:
-            lines.append(f'  "robot": {json.dumps(self.robot)},')
-        lines.append('  "points": [')
-        pts = [f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}' for t, q in zip(self.t, self.q)]
-        lines.append(",\n".join(pts))
-        lines += ["  ]", "}"]
-        return "\n".join(lines) + "\n"
+        return self.trajectory.dumps()
 
     def summary(self) -> str:
         deg = lambda q: "(" + ", ".join(f"{math.degrees(x):.1f}" for x in q) + ") deg"  # noqa: E731
@@ -94,11 +88,6 @@ class Plan:
             out.append(f"  planning        {s.get('time', 0.0):.2f} s, {s.get('checks', 0)} collision checks, "
                        f"{s.get('ik_solutions', 0)} IK solution(s), seed {self.seed}")
         return "\n".join(out)
-
-
-def _num(x: float) -> str:
-    v = round(float(x), 12)
-    return "0.0" if v == 0 else repr(v)
 
 
 def start_pose(robot, name: str | None):

@@ -1,5 +1,5 @@
-"""The trajectory file (SPEC section 6): what `modc plan --json` prints and `modc play --traj`
-reads.
+"""The trajectory file (SPEC section 6): what `modc plan --json` prints (Trajectory.dumps, the one
+writer) and `modc play --traj` and `modc check --traj` read (load, the one reader).
 
     {"joint_names": ["joint_1", …, "joint_n"],
      "points": [{"t": 0.0, "q": [rad, …]}, {"t": 0.1, "q": [...]}, …],
@@ -51,13 +51,28 @@ class Trajectory:
         return tuple(x0 + a * (x1 - x0) for x0, x1 in zip(self.q[k - 1], self.q[k]))
 
     def to_json(self) -> dict:
-        doc = {"joint_names": list(self.joint_names), "points": [{"t": t, "q": list(q)} for t, q in zip(self.t, self.q)]}
+        doc: dict = {"joint_names": list(self.joint_names)}
         if self.robot is not None:
             doc["robot"] = self.robot
+        doc["points"] = [{"t": t, "q": list(q)} for t, q in zip(self.t, self.q, strict=True)]
         return doc
 
     def dumps(self) -> str:
-        return json.dumps(self.to_json(), indent=2) + "\n"
+        """The file's text: one point per line, numbers rounded to 1e-12 and written in a fixed
+        way, so the same trajectory always gives the same bytes."""
+        lines = ["{", f'  "joint_names": {json.dumps(list(self.joint_names))},']
+        if self.robot is not None:
+            lines.append(f'  "robot": {json.dumps(self.robot)},')
+        lines.append('  "points": [')
+        pts = [f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}' for t, q in zip(self.t, self.q, strict=True)]
+        lines.append(",\n".join(pts))
+        lines += ["  ]", "}"]
+        return "\n".join(lines) + "\n"
+
+
+def _num(x: float) -> str:
+    v = round(float(x), 12)
+    return "0.0" if v == 0 else repr(v)
 
 
 def _number(x) -> bool:
