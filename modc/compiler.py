@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .diagnostics import Diagnostic, Span, codes
-from .files import write_files
+from .files import REPORT, write_files
 from .model import Design
 from .model.lower import lower
 from .passes import Context, run_all
@@ -97,9 +97,6 @@ def build(checked: Checked, only: list[str] | None = None, **options) -> dict[st
     return dict(sorted(b.files.items()))
 
 
-MARKER = "report.json"
-
-
 def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False) -> None:
     """Write files into a fresh directory next to OUT, then swap it in: OUT is either the old
     tree or the complete new one, never half-written. Refuses to replace a directory modc did
@@ -107,7 +104,7 @@ def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: boo
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
-    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).is_file() and not force:
+    if out.is_dir() and any(out.iterdir()) and not (out / REPORT).is_file() and not force:
         raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
     parent = out.resolve().parent
     parent.mkdir(parents=True, exist_ok=True)

@@ -4,6 +4,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
+REPORT = "report.json"  # written by the report backend into every output tree; its presence marks a tree modc wrote
+
 
 def write_files(files: Mapping[str, str | bytes], root: Path) -> None:
     """Write a tree under root exactly as `modc FILE -o OUT` does (UTF-8, '\\n' line ends)."""

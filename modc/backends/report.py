@@ -5,12 +5,11 @@ import json
 
 from .. import __version__
 from ..dh.report import compare
+from ..files import REPORT
 from ..kinematics import Chain
 from ..physical.assembly import library_mass
 from . import Build, register
 from .format import num
-
-REPORT = "report.json"
 
 
 def _r(x: float) -> float:
