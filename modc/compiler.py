@@ -26,6 +26,7 @@ class Checked:
     design: Design
     diagnostics: list[Diagnostic]
     sources: dict[str, str] = field(default_factory=dict)
+    tree: ast.File | None = None  # the parse the design was lowered from (the LSP reuses it)
 
     @property
     def ok(self) -> bool:
@@ -71,7 +72,7 @@ def check_text(text: str, path: str = "<string>", library: str | None = None, **
     ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
     design = run_all(design, ctx)
-    return Checked(design, ctx.diagnostics, {path: text})
+    return Checked(design, ctx.diagnostics, {path: text}, tree)
 
 
 def check_file(path: str | os.PathLike, library: str | None = None, **options) -> Checked:

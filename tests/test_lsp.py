@@ -567,3 +567,27 @@ def test_lexer_and_outline_survive_anything():
             complete(an, off)
             hover(an, off)
             definition(an, off, "file:///x/a.mod")
+
+
+@pytest.mark.parametrize("path, text", [
+    ("/x/a.mod", "robot a {\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 10, 0) deg\n    target p at (0.2, 0, 0.3) m\n}\n"),
+    ("/x/a.yaml", "robots:\n  - name: a\n    chain: [H1, {unit: L4, port: 45deg}, L1]\n    poses: {home: \"(0, 10, 0) deg\"}\n"),
+])
+def test_each_version_is_parsed_once(monkeypatch, path, text):
+    """Diagnostics, symbols, hover, completion and definitions all use the check's own parse."""
+    import modc.syntax
+    import modc.syntax.yaml_form
+
+    calls = []
+    for module, name in ((modc.syntax, "parse"), (modc.syntax.yaml_form, "parse_yaml")):
+        real = getattr(module, name)
+        monkeypatch.setattr(module, name, lambda *a, real=real: calls.append(a) or real(*a))
+    an = Analysis(text, path)
+    an.diagnostics()
+    assert an.parsed
+    symbols(an)
+    for off in range(0, len(text), 7):
+        complete(an, off)
+        hover(an, off)
+        definition(an, off, "file://" + path)
+    assert len(calls) == 1

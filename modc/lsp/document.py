@@ -24,15 +24,13 @@ from typing import NamedTuple
 
 from lsprotocol import types
 
-from ..compiler import YAML_SUFFIXES, Checked, check_text, parse_text
+from ..compiler import YAML_SUFFIXES, Checked, check_text
 from ..model.library import Library
 from ..model.library import default as default_library
 from ..model.library import load as load_library
 from ..syntax import ast
 from . import convert
 from .language import DECLARING, NAME_TAKERS, STATEMENTS
-
-REPARSE_LIMIT = 100_000  # characters
 
 # --- tokens and outline ---------------------------------------------------------------------------
 
@@ -223,18 +221,8 @@ class Analysis:
 
     @cached_property
     def tree(self) -> ast.File:
-        """The AST: the check's own if it keeps one (Checked.tree), else parsed again (a
-        fraction of a millisecond for an ordinary file). A very large .mod text is served
-        from the token view instead of being parsed a second time."""
-        try:
-            tree = getattr(self.checked, "tree", None)
-        except Exception:
-            tree = None
-        if isinstance(tree, ast.File):
-            return tree
-        if len(self.text) > REPARSE_LIMIT and not self.is_yaml:
-            return ast.File(self.path, ())
-        return parse_text(self.text, self.path)[0]
+        """The AST the check parsed (Checked.tree): one parse per version of a document."""
+        return self.checked.tree or ast.File(self.path, ())
 
     @cached_property
     def tokens(self) -> list[Tok]:
