@@ -148,13 +148,46 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     emits them ({relative path: content}); generated when omitted. Raises PlanError."""
     import numpy as np
 
-    from . import ik, planner, timing
+    from . import planner
     from .collision import DEFAULT_MARGIN, CollisionChecker
 
     t_begin = time.perf_counter()
-    sources = sources or {}
     if seed < 0:
         raise ValueError("seed must be >= 0")
+    job = _job(robot, target, start, seed, sources or {})
+    margin = DEFAULT_MARGIN if margin is None else float(margin)
+    timeout = planner.DEFAULT_TIMEOUT if timeout is None else float(timeout)
+    max_checks = planner.DEFAULT_MAX_CHECKS if max_checks is None else int(max_checks)
+
+    checker = CollisionChecker(robot, files, margin)
+    q_start = np.clip(np.array(job.q_start, float), checker.lower, checker.upper)
+    _check_start(job, checker, q_start)
+    solver, solutions, goals = _goals(job, checker, q_start)
+    path, tried = _path(job, checker, q_start, goals, timeout, max_checks)
+    result = _timed(job, checker, solver, path, with_robot_name)
+    result.stats.update({"time": time.perf_counter() - t_begin, "checks": checker.checks,
+                         "ik_solutions": len(solutions), "goals_tried": tried})
+    return result
+
+
+@dataclass(frozen=True)
+class _Job:
+    """What one plan_robot call is asked: the robot, its target, where it starts, the seed."""
+
+    robot: object
+    target: object  # modc.model.Target
+    start: str  # name of the start pose
+    q_start: tuple[float, ...]
+    start_span: object
+    seed: int
+    sources: dict
+
+    def fail(self, code, span, **fields) -> PlanError:
+        return PlanError.of(code, span, self.sources, **fields)
+
+
+def _job(robot, target: str, start: str | None, seed: int, sources: dict) -> _Job:
+    """The target and start pose named on the command line (target-unknown, pose-unknown)."""
     tgt = next((t for t in robot.targets if t.name == target), None)
     if tgt is None:
         raise PlanError.of(codes.TARGET_UNKNOWN, COMMAND_LINE, sources, robot=robot.name, target=target,
@@ -163,33 +196,37 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     if sp is None:
         raise PlanError.of(codes.POSE_UNKNOWN, COMMAND_LINE, sources, robot=robot.name, pose=start,
                            known=_known("poses", (p.name for p in robot.poses)))
-    start_name, q_start, start_span = sp
-    margin = DEFAULT_MARGIN if margin is None else float(margin)
-    timeout = planner.DEFAULT_TIMEOUT if timeout is None else float(timeout)
-    max_checks = planner.DEFAULT_MAX_CHECKS if max_checks is None else int(max_checks)
+    return _Job(robot, tgt, sp[0], sp[1], sp[2], seed, sources)
 
-    checker = CollisionChecker(robot, files, margin)
-    q_start = np.clip(np.array(q_start, float), checker.lower, checker.upper)
 
-    # --- the start pose ------------------------------------------------------------------------
+def _check_start(job: _Job, checker, q_start) -> None:
+    """The start pose must be collision-free; closer than the margin, the margin shrinks to fit."""
     fixed = checker.static_contacts()
     hit = fixed + checker.contacts(q_start, 0.0)
     if hit:
         hint = ("base_link never moves: move or shrink the obstacle so that it does not reach into the arm's base "
                 "(a floor may touch it)" if fixed else
                 "choose another start pose with --start, or move the obstacle")
-        if robot.pose(start_name) is None:  # the implicit home pose
+        if job.robot.pose(job.start) is None:  # the implicit home pose
             hint += "; the file declares no `pose home`, so the start is every joint at 0 (or mid-range where 0 is outside its limits)"
-        raise PlanError.of(codes.START_IN_COLLISION, start_span, sources, pose=start_name, contacts=_contacts_text(hit), hint=hint)
+        raise job.fail(codes.START_IN_COLLISION, job.start_span, pose=job.start, contacts=_contacts_text(hit), hint=hint)
     if not checker.valid(q_start):
         clearance, pair = checker.clearance(q_start)
         if clearance / 2 < MIN_MARGIN:
-            raise PlanError.of(codes.START_IN_COLLISION, start_span, sources, pose=start_name,
-                               contacts=f"{pair.describe()} are {clearance * 1000:.2f} mm apart",
-                               hint=f"the planner needs {2 * MIN_MARGIN * 1000:.1f} mm of clearance at the start")
+            raise job.fail(codes.START_IN_COLLISION, job.start_span, pose=job.start,
+                           contacts=f"{pair.describe()} are {clearance * 1000:.2f} mm apart",
+                           hint=f"the planner needs {2 * MIN_MARGIN * 1000:.1f} mm of clearance at the start")
         checker.set_margin(clearance / 2)
 
-    # --- the goal: IK ----------------------------------------------------------------------------
+
+def _goals(job: _Job, checker, q_start):
+    """(IK solver, every IK solution, the collision-free goal poses closest first): IK of the
+    target, then the solutions that keep the margin (or, failing that, some clearance)."""
+    import numpy as np
+
+    from . import ik
+
+    tgt = job.target
     solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper)
     verdict: dict[bytes, bool] = {}
 
@@ -199,15 +236,21 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
             verdict[key] = checker.valid(q)
         return verdict[key]
 
-    solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * robot.dof, seed,
+    solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * job.robot.dof, job.seed,
                                batches=IK_BATCHES, enough=free)
     if not solutions:
         tool = solver.position(best.q)
-        raise PlanError.of(
-            codes.TARGET_UNREACHABLE, tgt.span, sources, target=target, distance=f"{best.error:.3f}",
+        raise job.fail(
+            codes.TARGET_UNREACHABLE, tgt.span, target=tgt.name, distance=f"{best.error:.3f}",
             hint=(f"the closest tool0 gets is ({', '.join(f'{v:.3f}' for v in tool)}) m, at joint angles "
                   f"({', '.join(f'{math.degrees(v):.1f}' for v in best.q)}) deg; move the target towards the arm, "
                   "or lengthen the arm (link=…, more units)"))
+    return solver, solutions, _free_goals(job, checker, solutions, free)
+
+
+def _free_goals(job: _Job, checker, solutions, free) -> list:
+    """The IK solutions that keep the margin (closest to the start first); else the first with
+    more than 2 MIN_MARGIN of clearance, the margin shrunk to it; else target-in-collision."""
     goals, near, colliding = [], [], []
     for s in solutions:
         if free(s.q):
@@ -232,14 +275,30 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
                 if c.describe() not in names:
                     names.append(c.describe())
         what = "; ".join(names) if names else f"closer than {2 * MIN_MARGIN * 1000:.1f} mm to an obstacle"
-        raise PlanError.of(codes.TARGET_IN_COLLISION, tgt.span, sources, target=target, contacts=what,
-                           hint=f"all {len(solutions)} arm pose(s) that put tool0 on the target collide; "
-                                "move the target or the obstacle")
+        raise job.fail(codes.TARGET_IN_COLLISION, job.target.span, target=job.target.name, contacts=what,
+                       hint=f"all {len(solutions)} arm pose(s) that put tool0 on the target collide; "
+                            "move the target or the obstacle")
+    return goals
 
-    # --- the path --------------------------------------------------------------------------------
+
+def _limits(robot):
+    """(velocity, acceleration) limits per joint, rad/s and rad/s² (timing.py)."""
+    import numpy as np
+
+    from . import timing
+
     vmax = np.array([_velocity(robot, i) for i in range(1, robot.dof + 1)])
-    amax = vmax / timing.ACCEL_RAMP_TIME
+    return vmax, vmax / timing.ACCEL_RAMP_TIME
+
+
+def _path(job: _Job, checker, q_start, goals, timeout: float, max_checks: int):
+    """(polyline of joint vectors, goals tried): RRT-Connect towards the goals in turn, every
+    edge of the result certified again."""
+    from . import planner, timing
+
+    vmax, amax = _limits(job.robot)
     cost = lambda p: timing.path_duration(p, vmax, amax)  # noqa: E731
+    tgt = job.target
     path = None
     tried = 0
     deadline = time.monotonic() + timeout
@@ -248,28 +307,37 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
             break
         tried += 1
         try:
-            path = planner.find_path(checker, q_start, q_goal, seed, cost, timeout=timeout, max_checks=max_checks,
+            path = planner.find_path(checker, q_start, q_goal, job.seed, cost, timeout=timeout, max_checks=max_checks,
                                      deadline=deadline)
         except planner.PlannerUnavailable as e:
-            raise PlanError.of(codes.NO_PATH, tgt.span, sources, pose=start_name, target=target,
-                               detail=f"the straight motion collides and {e}",
-                               hint="install OMPL 2: pip install 'ompl>=2.0'") from None
+            raise job.fail(codes.NO_PATH, tgt.span, pose=job.start, target=tgt.name,
+                           detail=f"the straight motion collides and {e}",
+                           hint="install OMPL 2: pip install 'ompl>=2.0'") from None
         if path is not None:
             break
     if path is None:
-        raise PlanError.of(
-            codes.NO_PATH, tgt.span, sources, pose=start_name, target=target,
+        raise job.fail(
+            codes.NO_PATH, tgt.span, pose=job.start, target=tgt.name,
             detail=f"RRT-Connect towards {tried} of the {len(goals)} collision-free goal pose(s), "
                    f"{max_checks} collision checks each, {timeout:g} s in all",
             hint="try another --seed or --start pose; the target may be enclosed by obstacles")
     # an independent pass over the final polyline (every edge certified again)
     for a, b in zip(path[:-1], path[1:]):
         if not checker.motion_valid(a, b, check_ends=True):  # pragma: no cover - the planner certified it
-            raise PlanError.of(codes.NO_PATH, tgt.span, sources, pose=start_name, target=target,
-                               detail="the simplified path failed its final collision check",
-                               hint="try another --seed")
+            raise job.fail(codes.NO_PATH, tgt.span, pose=job.start, target=tgt.name,
+                           detail="the simplified path failed its final collision check",
+                           hint="try another --seed")
+    return path, tried
 
-    # --- timing and output -------------------------------------------------------------------------
+
+def _timed(job: _Job, checker, solver, path, with_robot_name: bool) -> Plan:
+    """The polyline timed (timing.py) and rounded into the Plan."""
+    import numpy as np
+
+    from . import timing
+
+    robot, tgt = job.robot, job.target
+    vmax, amax = _limits(robot)
     ts, qs = timing.parameterise(path, vmax, amax)
     q_rows = tuple(tuple(round(float(v), 12) + 0.0 for v in q) for q in qs)
     t_rows = tuple(round(float(t), 9) for t in ts)
@@ -277,13 +345,11 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
     tool_error = float(np.linalg.norm(solver.position(final) - np.asarray(tgt.xyz)))
     clear = min(checker.clearance(np.array(q))[0] for q in q_rows)
     return Plan(
-        robot=robot.name, target=target, start=start_name, target_xyz=tuple(tgt.xyz),
+        robot=robot.name, target=tgt.name, start=job.start, target_xyz=tuple(tgt.xyz),
         joint_names=tuple(f"joint_{i}" for i in range(1, robot.dof + 1)), t=t_rows, q=q_rows,
         waypoints=tuple(tuple(float(v) for v in p) for p in path), tool_error=tool_error,
-        min_clearance=float(clear), margin=checker.margin, seed=seed, velocity_limits=tuple(float(v) for v in vmax),
-        with_robot_name=with_robot_name,
-        stats={"time": time.perf_counter() - t_begin, "checks": checker.checks, "ik_solutions": len(solutions),
-               "goals_tried": tried})
+        min_clearance=float(clear), margin=checker.margin, seed=job.seed, velocity_limits=tuple(float(v) for v in vmax),
+        with_robot_name=with_robot_name)
 
 
 def _velocity(robot, i: int) -> float:

@@ -3,6 +3,7 @@ trajectory playback (`modc play`).
 
     scene.py       build a PyBullet world from a checked robot: its compiled URDF and meshes (in a
                    temporary directory), its obstacles and its target markers (reused by `plan`)
+    contacts.py    the scene's collision queries (self, environment) and an SRDF's disabled pairs
     smoke.py       run_sim(path, ...) -> (ok, report lines, checked)
     render.py      render(path, out_png, pose=None, ...) -> (ok, report lines, checked)
     play.py        play(path, traj_json, record=None, ...) -> (ok, report lines, checked)

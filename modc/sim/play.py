@@ -16,6 +16,7 @@ input, same bytes.
 from __future__ import annotations
 
 import time as wallclock
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import scene, trajectory
@@ -73,92 +74,127 @@ def play(path, traj_json, record=None, robot: str | None = None, library: str | 
     Raises modc.compiler.InputError (unreadable .mod), scene.UsageError (unreadable trajectory),
     modc.model.select.RobotChoiceError (unknown or ambiguous robot) and OSError (cannot write the GIF).
     """
-    import numpy as np
-
     checked = scene.load_checked(path, library)
     if not checked.ok:
         return False, [], checked
+    r, traj, errors = _trajectory_for(checked, traj_json, robot)
+    if errors:
+        return False, [f"{traj_json}: {e}" for e in errors], checked
+    want_gui = scene.display_available() if gui is None else gui
+    with scene.compiled(checked) as urdfs, scene.connect(gui=want_gui) as client:
+        client.setTimeStep(TIME_STEP)
+        stage = Stage.build(client, [r], urdfs, {r.name: traj.q[0]})
+        if record is not None or client.gui:
+            _frame(client, stage, r, traj, size, azimuth)
+        stage.scenes[r.name].set_q(traj.q[0])
+        stage.place_axes()
+        run = _run(client, stage, r, traj, record is not None, fps, size)
+    lines = _report(r, traj, run)
+    if record is not None:
+        save_gif(run.frames, record, fps)
+        lines.append(f"  wrote {record}: {len(run.frames)} frames at {fps:g} fps, {size[0]}x{size[1]}")
+    return True, lines, checked
+
+
+def _trajectory_for(checked, traj_json, robot: str | None):
+    """(robot, trajectory in joint_1 … joint_n order, errors): the file read, its robot chosen,
+    the trajectory checked against that robot."""
     try:
         traj, errors = trajectory.load(traj_json)
     except OSError as e:
         raise scene.UsageError(f"cannot read {traj_json}: {e.strerror or e}") from None
     if traj is None:
-        return False, [f"{traj_json}: {e}" for e in errors], checked
+        return None, None, errors
     r = pick_robot(checked, traj, robot)
     errors = trajectory.validate_for(traj, r)
     if errors:
-        return False, [f"{traj_json}: {e}" for e in errors], checked
-    traj = traj.in_order([f"joint_{i}" for i in range(1, r.dof + 1)])
+        return r, traj, errors
+    return r, traj.in_order([f"joint_{i}" for i in range(1, r.dof + 1)]), []
 
-    want_gui = scene.display_available() if gui is None else gui
-    lines = []
-    with scene.compiled(checked) as urdfs, scene.connect(gui=want_gui) as client:
-        client.setTimeStep(TIME_STEP)
-        stage = Stage.build(client, [r], urdfs, {r.name: traj.q[0]})
-        s = stage.scenes[r.name]
-        width, height = size
-        if record is not None or client.gui:
-            stage.add_tool_axes()
-            samples = [traj.at(traj.t[0] + traj.duration * k / (CAMERA_SAMPLES - 1)) for k in range(CAMERA_SAMPLES)]
-            pts = []
-            for q in samples:
-                stage.set({r.name: q})
-                pts.append(stage.points())
-            pts = np.concatenate(pts)
-            stage.add_ground(pts)
-            cam = stage.choose_camera(pts, width, height, azimuth, poses=[{r.name: q} for q in samples])
-            if client.gui:
-                client.resetDebugVisualizerCamera(float(np.linalg.norm(np.subtract(cam.eye, cam.target))),
-                                                  cam.azimuth + 90.0, -cam.elevation, list(cam.target))
-        s.set_q(traj.q[0])
-        stage.place_axes()
 
-        t0, t_end = traj.t[0], traj.t[-1] + HOLD_AFTER
-        steps = int(round((t_end - t0) / TIME_STEP))
-        frame_every = 1.0 / fps
-        next_frame, next_check = 0.0, 0.0
-        frames, contacts = [], {}
-        worst = np.zeros(r.dof)
-        started = wallclock.monotonic()
-        for k in range(steps + 1):
-            t = k * TIME_STEP
-            if t + 1e-12 >= next_check:
-                for c in s.self_collisions() + s.environment_collisions():
-                    key = (c.a, c.b)
-                    if key not in contacts or c.depth > contacts[key][1]:
-                        contacts[key] = (contacts.get(key, (t0 + t,))[0], c.depth)
-                next_check += 1.0 / CHECK_HZ
-            if record is not None and t + 1e-12 >= next_frame:
-                stage.place_axes()
-                frames.append(stage.shoot(stage.camera, width, height, supersample=GIF_SUPERSAMPLE))
-                next_frame += frame_every
-            if k == steps:
-                break
-            q_cmd = traj.at(t0 + t)
-            q_next = traj.at(t0 + t + TIME_STEP)
-            s.hold(q_cmd, [(b - a) / TIME_STEP for a, b in zip(q_cmd, q_next)])
-            client.stepSimulation()
-            if k % 10 == 0:
-                worst = np.maximum(worst, np.abs(s.q() - np.array(traj.at(t0 + t + TIME_STEP))))
-            if client.gui:
-                ahead = (t + TIME_STEP) - (wallclock.monotonic() - started)
-                if ahead > 0:
-                    wallclock.sleep(ahead)
-        final = np.abs(s.q() - np.array(traj.q[-1]))
-        mode = "in the PyBullet GUI" if client.gui else "headless"
+def _frame(client, stage, r, traj, size: tuple[int, int], azimuth: float | None) -> None:
+    """Ground, tool0 axes and a camera fitted to CAMERA_SAMPLES configurations of the motion
+    (the GUI's camera too)."""
+    import numpy as np
 
-    j = int(np.argmax(worst))
-    lines.append(f"play: robot {r.name} ({r.sequence}), {len(traj.t)} points over {traj.duration:.2f} s, "
-                 f"simulated at {1 / TIME_STEP:.0f} Hz {mode}")
-    lines.append(f"  worst tracking error {worst[j]:.2g} rad (joint_{j + 1}) during the motion, "
-                 f"{final.max():.1g} rad after {HOLD_AFTER:g} s at the last point")
-    if contacts:
-        for (a, b), (t_first, depth) in sorted(contacts.items(), key=lambda kv: kv[1][0]):
-            what = f"obstacle {b}" if b in s.obstacles else b
+    stage.add_tool_axes()
+    samples = [traj.at(traj.t[0] + traj.duration * k / (CAMERA_SAMPLES - 1)) for k in range(CAMERA_SAMPLES)]
+    pts = []
+    for q in samples:
+        stage.set({r.name: q})
+        pts.append(stage.points())
+    pts = np.concatenate(pts)
+    stage.add_ground(pts)
+    cam = stage.choose_camera(pts, size[0], size[1], azimuth, poses=[{r.name: q} for q in samples])
+    if client.gui:
+        client.resetDebugVisualizerCamera(float(np.linalg.norm(np.subtract(cam.eye, cam.target))),
+                                          cam.azimuth + 90.0, -cam.elevation, list(cam.target))
+
+
+@dataclass
+class _Run:
+    """What playing the trajectory showed."""
+
+    frames: list = field(default_factory=list)
+    contacts: dict = field(default_factory=dict)  # (link, other) -> (first time, deepest)
+    worst: object = None  # worst tracking error per joint during the motion (rad)
+    final: object = None  # tracking error per joint after HOLD_AFTER at the last point (rad)
+    mode: str = "headless"
+    obstacles: tuple[str, ...] = ()
+
+
+def _run(client, stage, r, traj, recording: bool, fps: float, size: tuple[int, int]) -> _Run:
+    """The actuators follow the trajectory at 1 kHz (then hold its last point for HOLD_AFTER):
+    contacts CHECK_HZ times a second, a frame every 1 / fps s when recording, real time in the GUI."""
+    import numpy as np
+
+    s = stage.scenes[r.name]
+    run = _Run(worst=np.zeros(r.dof), obstacles=tuple(s.obstacles))
+    t0, t_end = traj.t[0], traj.t[-1] + HOLD_AFTER
+    steps = int(round((t_end - t0) / TIME_STEP))
+    next_frame, next_check = 0.0, 0.0
+    started = wallclock.monotonic()
+    for k in range(steps + 1):
+        t = k * TIME_STEP
+        if t + 1e-12 >= next_check:
+            for c in s.self_collisions() + s.environment_collisions():
+                key = (c.a, c.b)
+                if key not in run.contacts or c.depth > run.contacts[key][1]:
+                    run.contacts[key] = (run.contacts.get(key, (t0 + t,))[0], c.depth)
+            next_check += 1.0 / CHECK_HZ
+        if recording and t + 1e-12 >= next_frame:
+            stage.place_axes()
+            run.frames.append(stage.shoot(stage.camera, size[0], size[1], supersample=GIF_SUPERSAMPLE))
+            next_frame += 1.0 / fps
+        if k == steps:
+            break
+        q_cmd = traj.at(t0 + t)
+        q_next = traj.at(t0 + t + TIME_STEP)
+        s.hold(q_cmd, [(b - a) / TIME_STEP for a, b in zip(q_cmd, q_next)])
+        client.stepSimulation()
+        if k % 10 == 0:
+            run.worst = np.maximum(run.worst, np.abs(s.q() - np.array(traj.at(t0 + t + TIME_STEP))))
+        if client.gui:
+            ahead = (t + TIME_STEP) - (wallclock.monotonic() - started)
+            if ahead > 0:
+                wallclock.sleep(ahead)
+    run.final = np.abs(s.q() - np.array(traj.q[-1]))
+    run.mode = "in the PyBullet GUI" if client.gui else "headless"
+    return run
+
+
+def _report(r, traj, run: _Run) -> list[str]:
+    import numpy as np
+
+    j = int(np.argmax(run.worst))
+    lines = [f"play: robot {r.name} ({r.sequence}), {len(traj.t)} points over {traj.duration:.2f} s, "
+             f"simulated at {1 / TIME_STEP:.0f} Hz {run.mode}",
+             f"  worst tracking error {run.worst[j]:.2g} rad (joint_{j + 1}) during the motion, "
+             f"{run.final.max():.1g} rad after {HOLD_AFTER:g} s at the last point"]
+    if run.contacts:
+        for (a, b), (t_first, depth) in sorted(run.contacts.items(), key=lambda kv: kv[1][0]):
+            what = f"obstacle {b}" if b in run.obstacles else b
             lines.append(f"  warning: {a} collides with {what} from t = {t_first:.2f} s ({depth * 1000:.1f} mm deep at most)")
     else:
         lines.append("  no collisions (between links, or with the environment)")
-    if record is not None:
-        save_gif(frames, record, fps)
-        lines.append(f"  wrote {record}: {len(frames)} frames at {fps:g} fps, {width}x{height}")
-    return True, lines, checked
+    return lines

@@ -38,66 +38,35 @@ the first second. 1e-2 rad (0.57°, 2 mm at the end of a 0.22 m link) separates 
 than an order of magnitude on both sides. When a joint fails, the message gives the static
 gravity torque at the pose (modc.dynamics; PyBullet's own calculateInverseDynamics ignores a
 fixed base's orientation, so it is not used) next to the actuator's peak.
+
+Measuring and judging are apart: load_failures and measure_pose ask PyBullet, verdict.judge_pose
+turns a verdict.Measured into the checks above and their messages (tolerances in verdict.py), so
+another engine reuses the checks by filling a Measured.
 """
 from __future__ import annotations
 
-import math
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import scene
+from .contacts import srdf_disabled_pairs
+from .verdict import (  # noqa: F401  (the tolerances are part of this module's story)
+    FK_POS_TOL,
+    FK_ROT_TOL,
+    TRACK_TOL,
+    Failure,
+    Hold,
+    Measured,
+    RobotResult,
+    describe,
+    judge_pose,
+)
 
 TIME_STEP = 1e-3  # s
 HOLD_TIME = 2.0  # s of simulated time per pose
 SETTLE_WINDOW = 0.5  # s: tracking is judged over the end of the hold
-TRACK_TOL = 1e-2  # rad
 EXPLODE_VELOCITY = 50.0  # rad/s: no falling module comes near this; beyond it the simulation diverged
-FK_POS_TOL = 1e-6  # m
-FK_ROT_TOL = 1e-5
-TORQUE_TOL, TORQUE_REL = 1e-3, 1e-3  # N·m, and share of the gravity torque
-SATURATION = 0.999  # |applied torque| >= this share of the effort: the motor is at its limit
 WARNING_LINE = re.compile(r"warning|error|failed|cannot|unable", re.IGNORECASE)
-
-
-@dataclass(frozen=True)
-class Failure:
-    kind: str  # load | fk | self-collision | environment | sag | unstable
-    message: str  # complete sentence, names the robot and pose
-    joint: str | None = None
-    links: tuple[str, ...] = ()
-
-
-@dataclass
-class PoseResult:
-    name: str
-    q: tuple[float, ...]
-    track_error: list[float] = field(default_factory=list)  # rad per joint, worst over the window
-    fk_pos_error: float = 0.0
-    fk_rot_error: float = 0.0
-    max_velocity: float = 0.0
-    torque_error: float = 0.0  # N·m, PyBullet's holding torques against modc.dynamics' gravity torques
-    failures: list[Failure] = field(default_factory=list)
-
-
-@dataclass
-class RobotResult:
-    robot: str
-    sequence: str
-    poses: list[PoseResult] = field(default_factory=list)
-    failures: list[Failure] = field(default_factory=list)  # load failures
-
-    @property
-    def all_failures(self) -> list[Failure]:
-        return self.failures + [f for p in self.poses for f in p.failures]
-
-    @property
-    def ok(self) -> bool:
-        return not self.all_failures
-
-
-def _deg(x: float) -> str:
-    return f"{math.degrees(x):.1f}°"
 
 
 def check_urdf_inertials(urdf: Path) -> list[str]:
@@ -125,141 +94,101 @@ def pose_list(robot) -> list[tuple[str, tuple[float, ...]]]:
 
 def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOLD_TIME,
                    time_step: float = TIME_STEP) -> RobotResult:
-    """Load one robot into an empty client and run every check (see the module docstring)."""
-    import numpy as np
-
+    """Load one robot into an empty client and run every check (see the module docstring):
+    PyBullet measures each pose (measure_pose), verdict.judge_pose judges it."""
     from ..dynamics.model import Dynamics
     from ..kinematics import Chain
 
     res = RobotResult(robot.name, robot.sequence)
-    who = f"robot {robot.name}"
     client.resetSimulation()
     client.setGravity(0, 0, -scene.GRAVITY)
     client.setTimeStep(time_step)
     try:
         s = scene.load_robot(client, robot, urdf)
     except Exception as e:  # pybullet.error: a URDF or mesh PyBullet cannot read
-        res.failures.append(Failure("load", f"{who}: PyBullet cannot load {urdf.name}: {e}"))
+        res.failures.append(Failure("load", f"robot {robot.name}: PyBullet cannot load {urdf.name}: {e}"))
         return res
+    res.failures += load_failures(client, s, robot, urdf)
+    chain, dyn = Chain(robot), Dynamics(robot)
+    steps = max(1, round(hold_time / time_step))
+    window = max(1, round(SETTLE_WINDOW / time_step))
+    for pname, q in pose_list(robot):
+        measured = measure_pose(client, s, pname, q, allowed, steps, window, time_step)
+        res.poses.append(judge_pose(robot, measured, chain, dyn, engine="PyBullet"))
+    s.remove()
+    return res
+
+
+def load_failures(client, s, robot, urdf: Path) -> list[Failure]:
+    """What PyBullet printed while loading, links without a usable inertial (in the URDF and
+    as PyBullet sees them), and the number of revolute joints."""
+    who = f"robot {robot.name}"
+    out = []
     for line in s.load_log.splitlines():
         if WARNING_LINE.search(line):
-            res.failures.append(Failure("load", f"{who}: PyBullet, loading {urdf.name}: {line.strip()}"))
+            out.append(Failure("load", f"{who}: PyBullet, loading {urdf.name}: {line.strip()}"))
     for msg in check_urdf_inertials(urdf):
-        res.failures.append(Failure("load", f"{who}: {msg}"))
+        out.append(Failure("load", f"{who}: {msg}"))
     for name, i in s.links.items():
         if i == -1:
             continue  # the fixed base: PyBullet reports mass 0 for it by design
         mass, _, inertia = client.getDynamicsInfo(s.body, i)[:3]
         if not mass > 0 or not all(v > 0 for v in inertia):
-            res.failures.append(Failure("load", f"{who}: PyBullet gives link {name} mass {mass:g} kg, inertia {inertia}"))
+            out.append(Failure("load", f"{who}: PyBullet gives link {name} mass {mass:g} kg, inertia {inertia}"))
     if len(s.joints) != robot.dof:
-        res.failures.append(Failure("load", f"{who}: PyBullet finds {len(s.joints)} revolute joints, the chain has {robot.dof} modules"))
-
-    chain = Chain(robot)
-    dyn = Dynamics(robot)
-    steps = max(1, round(hold_time / time_step))
-    window = max(1, round(SETTLE_WINDOW / time_step))
-    for pname, q in pose_list(robot):
-        pr = PoseResult(pname, q)
-        res.poses.append(pr)
-        at = f"{who}, pose {pname}"
-        qv = np.array(q, dtype=float)
-
-        # kinematic checks at the pose itself
-        s.set_q(qv)
-        T_ref = chain.T_base_tool(qv)
-        T_pb = s.T_base_link("tool0")
-        pr.fk_pos_error = float(np.abs(T_pb[:3, 3] - T_ref[:3, 3]).max())
-        pr.fk_rot_error = float(np.abs(T_pb[:3, :3] - T_ref[:3, :3]).max())
-        if pr.fk_pos_error > FK_POS_TOL or pr.fk_rot_error > FK_ROT_TOL:
-            pr.failures.append(Failure("fk", f"{at}: PyBullet puts tool0 {pr.fk_pos_error:.3g} m / {pr.fk_rot_error:.3g} (rotation) "
-                                             f"away from modc's kinematics (tolerance {FK_POS_TOL:g} m, {FK_ROT_TOL:g})"))
-        for c in s.self_collisions(allowed):
-            pr.failures.append(Failure("self-collision", f"{at}: {c.a} and {c.b} collide ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
-        for c in s.environment_collisions():
-            pr.failures.append(Failure("environment", f"{at}: {c.a} is inside obstacle {c.b} ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
-
-        # dynamic hold
-        s.set_q(qv)
-        s.hold(qv)
-        worst = np.zeros(robot.dof)  # over the settle window
-        peak = np.zeros(robot.dof)  # over the whole hold
-        tau_sum, tau_n = np.zeros(robot.dof), 0  # applied torques, averaged over the settle window
-        vmax, diverged = 0.0, None
-        for k in range(steps):
-            client.stepSimulation()
-            late = k >= steps - window
-            if late or k % 10 == 0:
-                qk, qdk = s.q(), s.qd()
-                if not (np.all(np.isfinite(qk)) and np.all(np.isfinite(qdk))):
-                    diverged = f"joint states became NaN after {k * time_step:.3f} s"
-                    break
-                vmax = max(vmax, float(np.abs(qdk).max()))
-                peak = np.maximum(peak, np.abs(qk - qv))
-                if vmax > EXPLODE_VELOCITY:
-                    j = int(np.argmax(np.abs(qdk)))
-                    diverged = f"{s.joint_names[j]} reached {abs(qdk[j]):.0f} rad/s after {k * time_step:.3f} s"
-                    break
-                if late:
-                    worst = np.maximum(worst, np.abs(qk - qv))
-                    tau_sum += s.applied_torques()
-                    tau_n += 1
-        pr.max_velocity = vmax
-        pr.track_error = [float(e) for e in worst]
-        if diverged:
-            pr.failures.append(Failure("unstable", f"{at}: the simulation diverged: {diverged}"))
-            continue
-        tau_g = dyn.gravity(qv)
-        applied = tau_sum / max(tau_n, 1)
-        held = bool(np.all(worst <= TRACK_TOL))  # torques are comparable only when the whole arm is at rest
-        tau_here = dyn.gravity(s.q())  # where the arm actually rests (within TRACK_TOL of the pose)
-        pr.torque_error = float(np.abs(applied - tau_here).max()) if held else float("nan")
-        for j, name in enumerate(s.joint_names):
-            if held and abs(applied[j] - tau_here[j]) > TORQUE_TOL + TORQUE_REL * abs(tau_here[j]):
-                pr.failures.append(Failure(
-                    "torque", f"{at}: PyBullet holds {name} with {applied[j]:.4f} N·m, modc's dynamics (pinocchio) says "
-                              f"gravity takes {tau_here[j]:.4f} N·m: the two models of the arm disagree", joint=name))
-            if worst[j] <= TRACK_TOL:
-                continue
-            effort = s.limits[name][2]
-            variant = robot.units[j].variant
-            actuator = robot.library.variants[variant].actuator
-            if abs(tau_g[j]) > effort or abs(s.applied_torques()[j]) >= SATURATION * effort:
-                why = (f"holding the pose needs {abs(tau_g[j]):.2f} N·m, the {variant} actuator ({actuator.model}) peaks at "
-                       f"{effort:g} N·m: it cannot hold the arm")
-            else:
-                why = (f"the motor is below its {effort:g} N·m peak (needs {abs(tau_g[j]):.2f} N·m) yet the joint does not settle")
-            pr.failures.append(Failure(
-                "sag", f"{at}: {name} sags {peak[j]:.2f} rad ({_deg(peak[j])}) from its target {_deg(qv[j])}: {why}", joint=name))
-    s.remove()
-    return res
+        out.append(Failure("load", f"{who}: PyBullet finds {len(s.joints)} revolute joints, the chain has {robot.dof} modules"))
+    return out
 
 
-def describe(res: RobotResult) -> list[str]:
-    """Report lines: one for the robot, one per pose, then every failure."""
-    lines = []
-    state = "ok" if res.ok else f"{len(res.all_failures)} failure(s)"
-    lines.append(f"robot {res.robot} ({res.sequence}): {state}")
-    for f in res.failures:
-        lines.append(f"  FAIL {f.message}")
-    for p in res.poses:
-        if p.failures:
-            lines.append(f"  pose {p.name}: FAILED")
-        else:
-            j = max(range(len(p.track_error)), key=lambda i: p.track_error[i])
-            lines.append(f"  pose {p.name}: ok; held to {p.track_error[j]:.1e} rad (worst: joint_{j + 1}), "
-                         f"tool0 within {p.fk_pos_error:.1e} m of modc's kinematics, holding torques within "
-                         f"{p.torque_error:.1e} N·m of modc's dynamics, no collisions")
-        for f in p.failures:
-            lines.append(f"  FAIL {f.message}")
-    return lines
+def measure_pose(client, s, name: str, q, allowed, steps: int, window: int, time_step: float) -> Measured:
+    """The pose in PyBullet: tool0 and the contacts with the joints teleported to q, then the
+    actuators holding q for `steps` steps (tracking over the last `window` of them)."""
+    import numpy as np
+
+    qv = np.array(q, dtype=float)
+    s.set_q(qv)
+    T_tool = s.T_base_link("tool0")
+    self_contacts, env_contacts = s.self_collisions(allowed), s.environment_collisions()
+    s.set_q(qv)
+    s.hold(qv)
+    return Measured(name, tuple(q), T_tool, self_contacts, env_contacts, _hold(client, s, qv, steps, window, time_step))
+
+
+def _hold(client, s, qv, steps: int, window: int, time_step: float) -> Hold:
+    import numpy as np
+
+    n = len(qv)
+    worst = np.zeros(n)  # over the settle window
+    peak = np.zeros(n)  # over the whole hold
+    tau_sum, tau_n = np.zeros(n), 0  # applied torques, averaged over the settle window
+    vmax, diverged = 0.0, None
+    for k in range(steps):
+        client.stepSimulation()
+        late = k >= steps - window
+        if late or k % 10 == 0:
+            qk, qdk = s.q(), s.qd()
+            if not (np.all(np.isfinite(qk)) and np.all(np.isfinite(qdk))):
+                diverged = f"joint states became NaN after {k * time_step:.3f} s"
+                break
+            vmax = max(vmax, float(np.abs(qdk).max()))
+            peak = np.maximum(peak, np.abs(qk - qv))
+            if vmax > EXPLODE_VELOCITY:
+                j = int(np.argmax(np.abs(qdk)))
+                diverged = f"{s.joint_names[j]} reached {abs(qdk[j]):.0f} rad/s after {k * time_step:.3f} s"
+                break
+            if late:
+                worst = np.maximum(worst, np.abs(qk - qv))
+                tau_sum += s.applied_torques()
+                tau_n += 1
+    return Hold(worst=worst, peak=peak, max_velocity=vmax, diverged=diverged, applied=tau_sum / max(tau_n, 1),
+                q_end=s.q(), tau_end=s.applied_torques(), efforts=tuple(s.limits[j][2] for j in s.joint_names))
 
 
 def allowed_from_srdf(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
     if out_dir is None:
         return set()
     srdf = Path(out_dir) / "config" / f"{robot.file_stem}.srdf"
-    return scene.srdf_disabled_pairs(srdf) if srdf.is_file() else set()
+    return srdf_disabled_pairs(srdf) if srdf.is_file() else set()
 
 
 def simulate(checked, robot: str | None = None, out_dir: str | Path | None = None,

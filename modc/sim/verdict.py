@@ -1,0 +1,173 @@
+"""The smoke test's verdicts, apart from the engine that measured them (smoke.py measures in
+PyBullet; another engine fills the same Measured and gets the same checks and messages).
+
+    measured = Measured(name, q, T_base_tool, self_contacts, environment_contacts, hold)
+    result = judge_pose(robot, measured, Chain(robot), Dynamics(robot), engine="PyBullet")
+    lines = describe(RobotResult(robot.name, robot.sequence, poses=[result, ...]))
+
+The checks and their tolerances are explained in smoke.py's docstring.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+TRACK_TOL = 1e-2  # rad
+FK_POS_TOL = 1e-6  # m (PyBullet computes in single precision)
+FK_ROT_TOL = 1e-5
+TORQUE_TOL, TORQUE_REL = 1e-3, 1e-3  # N·m, and share of the gravity torque
+SATURATION = 0.999  # |applied torque| >= this share of the effort: the motor is at its limit
+
+
+@dataclass(frozen=True)
+class Failure:
+    kind: str  # load | fk | self-collision | environment | sag | unstable | torque
+    message: str  # complete sentence, names the robot and pose
+    joint: str | None = None
+    links: tuple[str, ...] = ()
+
+
+@dataclass
+class PoseResult:
+    name: str
+    q: tuple[float, ...]
+    track_error: list[float] = field(default_factory=list)  # rad per joint, worst over the window
+    fk_pos_error: float = 0.0
+    fk_rot_error: float = 0.0
+    max_velocity: float = 0.0
+    torque_error: float = 0.0  # N·m, the engine's holding torques against modc.dynamics' gravity torques
+    failures: list[Failure] = field(default_factory=list)
+
+
+@dataclass
+class RobotResult:
+    robot: str
+    sequence: str
+    poses: list[PoseResult] = field(default_factory=list)
+    failures: list[Failure] = field(default_factory=list)  # load failures
+
+    @property
+    def all_failures(self) -> list[Failure]:
+        return self.failures + [f for p in self.poses for f in p.failures]
+
+    @property
+    def ok(self) -> bool:
+        return not self.all_failures
+
+
+@dataclass(frozen=True)
+class Hold:
+    """What the engine saw while its actuators held a pose (position control limited to the
+    actuators' peak torque and rated speed). Arrays are per joint, joint_1 first."""
+
+    worst: object  # |q - target|, worst over the settle window (rad)
+    peak: object  # |q - target|, worst over the whole hold (rad)
+    max_velocity: float  # rad/s, over the hold
+    diverged: str | None  # what blew up ("joint_2 reached 80 rad/s after 0.120 s"), or None
+    applied: object  # joint torques, mean over the settle window (N·m)
+    q_end: object  # where the arm rests at the end (rad)
+    tau_end: object  # joint torques at the end (N·m)
+    efforts: tuple[float, ...]  # the engine's torque limits (the URDF effort: the actuator's peak)
+
+
+@dataclass(frozen=True)
+class Measured:
+    """One pose as an engine measured it. Contacts: objects with .a, .b and .depth (m)."""
+
+    name: str
+    q: tuple[float, ...]
+    T_base_tool: object  # 4x4, tool0 in base_link with the joints at q
+    self_contacts: list
+    environment_contacts: list
+    hold: Hold
+
+
+def _deg(x: float) -> str:
+    return f"{math.degrees(x):.1f}°"
+
+
+def judge_pose(robot, m: Measured, chain, dyn, engine: str = "PyBullet",
+               fk_tol: tuple[float, float] = (FK_POS_TOL, FK_ROT_TOL)) -> PoseResult:
+    """Every check of one pose: FK against modc.kinematics (chain), collisions, the hold, and
+    the holding torques against modc.dynamics (dyn)."""
+    import numpy as np
+
+    pr = PoseResult(m.name, m.q)
+    at = f"robot {robot.name}, pose {m.name}"
+    qv = np.array(m.q, dtype=float)
+    T_ref = chain.T_base_tool(qv)
+    pr.fk_pos_error = float(np.abs(m.T_base_tool[:3, 3] - T_ref[:3, 3]).max())
+    pr.fk_rot_error = float(np.abs(m.T_base_tool[:3, :3] - T_ref[:3, :3]).max())
+    pos_tol, rot_tol = fk_tol
+    if pr.fk_pos_error > pos_tol or pr.fk_rot_error > rot_tol:
+        pr.failures.append(Failure("fk", f"{at}: {engine} puts tool0 {pr.fk_pos_error:.3g} m / {pr.fk_rot_error:.3g} (rotation) "
+                                         f"away from modc's kinematics (tolerance {pos_tol:g} m, {rot_tol:g})"))
+    for c in m.self_contacts:
+        pr.failures.append(Failure("self-collision", f"{at}: {c.a} and {c.b} collide ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
+    for c in m.environment_contacts:
+        pr.failures.append(Failure("environment", f"{at}: {c.a} is inside obstacle {c.b} ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
+    h = m.hold
+    pr.max_velocity = h.max_velocity
+    pr.track_error = [float(e) for e in h.worst]
+    if h.diverged:
+        pr.failures.append(Failure("unstable", f"{at}: the simulation diverged: {h.diverged}"))
+        return pr
+    pr.failures += _hold_failures(robot, pr, h, qv, dyn, at, engine)
+    return pr
+
+
+def _hold_failures(robot, pr: PoseResult, h: Hold, qv, dyn, at: str, engine: str) -> list[Failure]:
+    """Joints that sag, and holding torques that disagree with modc's gravity torques (compared
+    only when the whole arm is at rest, where it actually rests)."""
+    import numpy as np
+
+    out = []
+    tau_g = dyn.gravity(qv)
+    applied = np.asarray(h.applied)
+    worst = np.asarray(h.worst)
+    held = bool(np.all(worst <= TRACK_TOL))
+    tau_here = dyn.gravity(h.q_end)
+    pr.torque_error = float(np.abs(applied - tau_here).max()) if held else float("nan")
+    for j in range(robot.dof):
+        name = f"joint_{j + 1}"
+        if held and abs(applied[j] - tau_here[j]) > TORQUE_TOL + TORQUE_REL * abs(tau_here[j]):
+            out.append(Failure(
+                "torque", f"{at}: {engine} holds {name} with {applied[j]:.4f} N·m, modc's dynamics (pinocchio) says "
+                          f"gravity takes {tau_here[j]:.4f} N·m: the two models of the arm disagree", joint=name))
+        if worst[j] <= TRACK_TOL:
+            continue
+        effort = h.efforts[j]
+        variant = robot.units[j].variant
+        actuator = robot.library.variants[variant].actuator
+        if abs(tau_g[j]) > effort or abs(h.tau_end[j]) >= SATURATION * effort:
+            why = (f"holding the pose needs {abs(tau_g[j]):.2f} N·m, the {variant} actuator ({actuator.model}) peaks at "
+                   f"{effort:g} N·m: it cannot hold the arm")
+        else:
+            why = (f"the motor is below its {effort:g} N·m peak (needs {abs(tau_g[j]):.2f} N·m) yet the joint does not settle")
+        out.append(Failure(
+            "sag", f"{at}: {name} sags {h.peak[j]:.2f} rad ({_deg(h.peak[j])}) from its target {_deg(qv[j])}: {why}", joint=name))
+    return out
+
+
+def describe(res: RobotResult) -> list[str]:
+    """Report lines: one for the robot, one per pose, then every failure."""
+    lines = []
+    state = "ok" if res.ok else f"{len(res.all_failures)} failure(s)"
+    lines.append(f"robot {res.robot} ({res.sequence}): {state}")
+    for f in res.failures:
+        lines.append(f"  FAIL {f.message}")
+    for p in res.poses:
+        if p.failures:
+            lines.append(f"  pose {p.name}: FAILED")
+        else:
+            j = max(range(len(p.track_error)), key=lambda i: p.track_error[i])
+            lines.append(f"  pose {p.name}: ok; held to {p.track_error[j]:.1e} rad (worst: joint_{j + 1}), "
+                         f"tool0 within {p.fk_pos_error:.1e} m of modc's kinematics, holding torques within "
+                         f"{p.torque_error:.1e} N·m of modc's dynamics, no collisions")
+        for f in p.failures:
+            lines.append(f"  FAIL {f.message}")
+    return lines
+
+
+__all__ = ["FK_POS_TOL", "FK_ROT_TOL", "SATURATION", "TORQUE_REL", "TORQUE_TOL", "TRACK_TOL", "Failure", "Hold",
+           "Measured", "PoseResult", "RobotResult", "describe", "judge_pose"]
