@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 from ..diagnostics import codes
 from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
@@ -174,11 +175,11 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
 class _Job:
     """What one plan_robot call is asked: the robot, its target, where it starts, the seed."""
 
-    robot: object
-    target: object  # modc.model.Target
+    robot: Any  # modc.model.Robot
+    target: Any  # modc.model.Target
     start: str  # name of the start pose
     q_start: tuple[float, ...]
-    start_span: object
+    start_span: Any
     seed: int
     sources: dict
 
@@ -251,7 +252,9 @@ def _goals(job: _Job, checker, q_start):
 def _free_goals(job: _Job, checker, solutions, free) -> list:
     """The IK solutions that keep the margin (closest to the start first); else the first with
     more than 2 MIN_MARGIN of clearance, the margin shrunk to it; else target-in-collision."""
-    goals, near, colliding = [], [], []
+    goals: list = []
+    near: list = []
+    colliding: list = []
     for s in solutions:
         if free(s.q):
             goals.append(s.q)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import time as wallclock
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from . import scene, trajectory
 from .render import Stage
@@ -137,8 +138,8 @@ class _Run:
 
     frames: list = field(default_factory=list)
     contacts: dict = field(default_factory=dict)  # (link, other) -> (first time, deepest)
-    worst: object = None  # worst tracking error per joint during the motion (rad)
-    final: object = None  # tracking error per joint after HOLD_AFTER at the last point (rad)
+    worst: Any = None  # worst tracking error per joint during the motion (rad)
+    final: Any = None  # tracking error per joint after HOLD_AFTER at the last point (rad)
     mode: str = "headless"
     obstacles: tuple[str, ...] = ()
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 TRACK_TOL = 1e-2  # rad
 FK_POS_TOL = 1e-6  # m (PyBullet computes in single precision)
@@ -60,13 +61,13 @@ class Hold:
     """What the engine saw while its actuators held a pose (position control limited to the
     actuators' peak torque and rated speed). Arrays are per joint, joint_1 first."""
 
-    worst: object  # |q - target|, worst over the settle window (rad)
-    peak: object  # |q - target|, worst over the whole hold (rad)
+    worst: Any  # |q - target|, worst over the settle window (rad)
+    peak: Any  # |q - target|, worst over the whole hold (rad)
     max_velocity: float  # rad/s, over the hold
     diverged: str | None  # what blew up ("joint_2 reached 80 rad/s after 0.120 s"), or None
-    applied: object  # joint torques, mean over the settle window (N·m)
-    q_end: object  # where the arm rests at the end (rad)
-    tau_end: object  # joint torques at the end (N·m)
+    applied: Any  # joint torques, mean over the settle window (N·m)
+    q_end: Any  # where the arm rests at the end (rad)
+    tau_end: Any  # joint torques at the end (N·m)
     efforts: tuple[float, ...]  # the engine's torque limits (the URDF effort: the actuator's peak)
 
 
@@ -76,7 +77,7 @@ class Measured:
 
     name: str
     q: tuple[float, ...]
-    T_base_tool: object  # 4x4, tool0 in base_link with the joints at q
+    T_base_tool: Any  # 4x4, tool0 in base_link with the joints at q
     self_contacts: list
     environment_contacts: list
     hold: Hold
