@@ -4,7 +4,8 @@ trajectory playback (`modc play`).
     scene.py       build a PyBullet world from a checked robot: its compiled URDF and meshes (in a
                    temporary directory), its obstacles and its target markers (reused by `plan`)
     contacts.py    the scene's collision queries (self, environment) and an SRDF's disabled pairs
-    smoke.py       run_sim(path, ...) -> (ok, report lines, checked)
+    smoke.py       run_sim(path, ...) -> (ok, report lines, checked): PyBullet measures each pose
+    verdict.py     the smoke test's checks and messages from what an engine measured (engine-neutral)
     render.py      render(path, out_png, pose=None, ...) -> (ok, report lines, checked)
     play.py        play(path, traj_json, record=None, ...) -> (ok, report lines, checked)
     trajectory.py  the trajectory file of `plan --json` / `play --traj` (SPEC section 6): load, validate
