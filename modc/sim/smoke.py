@@ -202,9 +202,15 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
     return results
 
 
+ENGINES = ("pybullet", "mujoco")  # the first is the default
+
+
 def run_sim(path, library: str | None = None, robot: str | None = None, out_dir: str | Path | None = None,
-            hold_time: float = HOLD_TIME):
-    """`modc sim FILE`. Returns (ok, report lines, checked).
+            hold_time: float = HOLD_TIME, engine: str = ENGINES[0]):
+    """`modc sim FILE [--engine E]`. Returns (ok, report lines, checked).
+
+    engine: "pybullet" (this module) or "mujoco" (mujoco_engine.py, on the compiled MJCF); the
+    checks and messages are verdict.py's either way. Raises scene.UsageError for another name.
 
     checked: the modc.compiler.Checked of the file (its .diagnostics and .sources are for the
     caller to print). When it has errors nothing is simulated: (False, [], checked).
@@ -212,10 +218,17 @@ def run_sim(path, library: str | None = None, robot: str | None = None, out_dir:
     Raises modc.compiler.InputError (unreadable file) and modc.model.select.RobotChoiceError
     (unknown robot).
     """
+    if engine not in ENGINES:
+        raise scene.UsageError(f"unknown engine '{engine}' (choose from {', '.join(ENGINES)})")
     checked = scene.load_checked(path, library)
     if not checked.ok:
         return False, [], checked
-    results = simulate(checked, robot, out_dir, hold_time)
+    if engine == "mujoco":
+        from . import mujoco_engine
+
+        results = mujoco_engine.simulate(checked, robot, out_dir, hold_time)
+    else:
+        results = simulate(checked, robot, out_dir, hold_time)
     lines = [line for r in results for line in describe(r)]
     failures = sum(len(r.all_failures) for r in results)
     poses = sum(len(r.poses) for r in results)
