@@ -71,14 +71,14 @@ def _placement(T) -> dict:
 def _inertial(link) -> dict | None:
     if link.inertial is None:
         return None
-    I = link.inertial.inertia
+    inertia = link.inertial.inertia  # MuJoCo's order: ixx iyy izz ixy ixz iyz
     return {"pos": vec(link.inertial.com), "mass": num(link.inertial.mass),
-            "fullinertia": vec((I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]))}
+            "fullinertia": vec(inertia[i, j] for i, j in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)))}
 
 
 def _bodies(desc: Description, robot: Robot) -> list[dict]:
     """The kinematic tree as nested bodies (children lists), base_link at the root."""
-    links = {l.name: l for l in desc.links}
+    links = {link.name: link for link in desc.links}
     by_parent: dict[str, list] = {}
     for j in desc.joints:
         by_parent.setdefault(j.parent, []).append(j)
@@ -107,7 +107,8 @@ def _assets(desc: Description) -> list[dict]:
     for link in desc.links:
         for v in link.visuals:
             name = mesh_name(v.part.mesh, v.part.scale_x)
-            seen.setdefault(name, {"name": name, "file": f"{v.part.mesh}.stl", "scale": vec((v.part.scale_x, 1.0, 1.0)) if v.part.scale_x != 1.0 else None})
+            scale = vec((v.part.scale_x, 1.0, 1.0)) if v.part.scale_x != 1.0 else None
+            seen.setdefault(name, {"name": name, "file": f"{v.part.mesh}.stl", "scale": scale})
     return [seen[k] for k in sorted(seen)]
 
 
