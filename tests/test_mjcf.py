@@ -269,3 +269,17 @@ def test_cli_engine_option(tmp_path):
     assert r.exit_code == 1 and "joint_2 sags" in r.output
     r = runner.invoke(app, ["sim", str(ROOT / "examples" / "table3_planar.mod"), "--engine", "ode"])
     assert r.exit_code == 2 and "unknown engine 'ode'" in r.output
+
+
+def test_home_keyframe_is_robot_home_within_narrowed_limits(tmp_path):
+    """No `pose home` and a `limit` that excludes 0: the keyframe is MoveIt's default (mid-range),
+    the one Robot.home, and the joint range is the narrowed one."""
+    from test_home import EXPECTED, LIMITED
+
+    checked = check_text(LIMITED, "limited.mod")
+    root = compiled(tmp_path, checked)
+    (robot,) = checked.design.robots
+    m = load(root, robot)
+    assert m.key(0).name == "home"
+    assert np.allclose(m.key_qpos[0], EXPECTED, atol=1e-11) and np.allclose(m.key_ctrl[0], EXPECTED, atol=1e-11)
+    assert np.allclose(m.jnt_range[1], np.radians([10.0, 90.0]), atol=1e-11)
