@@ -46,10 +46,11 @@ def write(tmp_path: Path, text: str, name: str = "t.mod") -> Path:
 
 
 def pin_model(root: Path, robot):
-    """pinocchio on the emitted URDF, gravity turned into base_link as the base placement says."""
+    """pinocchio on the emitted URDF, its gravity (-9.81 z of the world) turned into base_link as
+    the base placement says."""
     model = pin.buildModelFromUrdf(str(root / "urdf" / f"{robot.file_stem}.urdf"))
     R_world_base = transform(robot.base.xyz, robot.base.rpy)[:3, :3]
-    model.gravity.linear = R_world_base.T @ np.array([0.0, 0.0, -mjcf.GRAVITY])
+    model.gravity.linear = R_world_base.T @ model.gravity.linear
     return model
 
 

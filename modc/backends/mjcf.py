@@ -35,6 +35,8 @@ from .. import __version__
 from ..kinematics import matrix_rpy, transform
 from ..model import Robot
 from ..physical.assembly import Description
+from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
+from ..physical.statics import G
 from . import Build, register
 from .format import num, vec
 from .srdf import _comment, collision_matrix
@@ -42,14 +44,10 @@ from .templates import render
 from .urdf import MATERIALS
 
 TIME_STEP = 1e-3  # s, as `modc sim`
-GRAVITY = 9.81  # m/s², modc.dynamics' value
 ERROR_AT_PEAK = 0.005  # rad of position error at which a servo reaches the actuator's peak torque
 DERIVATIVE_TIME = 0.05 / 2.0  # s, the paper's d/p
 ARMATURE = 1e-3  # kg·m², reflected rotor inertia per joint (numerical regularisation, see above)
-TARGET_RADIUS = 0.012  # m, the visual-only sphere of a target site
 TOOL_SITE_RADIUS = 0.005  # m
-OBSTACLE_RGBA = (0.62, 0.70, 0.78, 1.0)
-TARGET_RGBA = (0.86, 0.12, 0.22, 1.0)
 TARGET_PREFIX = "target_"
 
 
@@ -141,7 +139,7 @@ def context(build: Build, robot: Robot) -> dict:
     return {
         "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": _comment(build.source_name),
         "library": robot.library.name if robot.library else "", "version": __version__,
-        "timestep": num(TIME_STEP), "gravity": vec((0.0, 0.0, -GRAVITY)),
+        "timestep": num(TIME_STEP), "gravity": vec(G),
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()]
         + [{"name": "obstacle", "rgba": vec(OBSTACLE_RGBA)}, {"name": "target", "rgba": vec(TARGET_RGBA)}],
         "meshes": _assets(desc), "bodies": _bodies(desc, robot), "obstacles": obstacles, "targets": targets,

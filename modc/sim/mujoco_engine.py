@@ -23,32 +23,16 @@ The checks and messages are verdict.py's, as for PyBullet; what differs is the m
 """
 from __future__ import annotations
 
-import contextlib
-import tempfile
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from .contacts import CONTACT_TOL, CollisionQueries, Contact
-from .smoke import EXPLODE_VELOCITY, HOLD_TIME, SETTLE_WINDOW, pose_list
-from .verdict import Failure, Hold, Measured, RobotResult, judge_pose
+from .smoke import HOLD_TIME, SETTLE_WINDOW, pose_list
+from .verdict import Failure, Hold, HoldRecorder, Measured, RobotResult, judge_pose
 
 FK_TOL = (1e-9, 1e-9)  # m, rotation-matrix entries
 ENGINE = "MuJoCo"
-
-
-@contextlib.contextmanager
-def compiled(checked) -> Iterator[dict[str, Path]]:
-    """The mjcf, urdf and meshes backends' output in a temporary directory: robot name -> MJCF path."""
-    from ..compiler import build
-    from ..files import write_files
-
-    files = build(checked, ["urdf", "meshes", "mjcf"])
-    with tempfile.TemporaryDirectory(prefix="modc-mujoco-") as tmp:
-        root = Path(tmp)
-        write_files(files, root)
-        yield {r.name: root / "mjcf" / f"{r.file_stem}.xml" for r in checked.design.robots}
 
 
 @dataclass
@@ -157,7 +141,6 @@ def measure_pose(s: MujocoScene, name: str, q, allowed, steps: int, window: int)
 def hold(s: MujocoScene, qv, steps: int, window: int) -> Hold:
     """The servos hold qv from rest at qv, contacts off (see the module docstring)."""
     import mujoco
-    import numpy as np
 
     m, d = s.model, s.data
     flags = m.opt.disableflags
@@ -167,32 +150,12 @@ def hold(s: MujocoScene, qv, steps: int, window: int) -> Hold:
         d.qpos[:] = qv
         d.ctrl[:] = qv
         mujoco.mj_forward(m, d)
-        n = len(qv)
-        worst, peak = np.zeros(n), np.zeros(n)
-        tau_sum, tau_n = np.zeros(n), 0
-        vmax, diverged = 0.0, None
+        rec = HoldRecorder(qv, s.joint_names, steps, window, float(m.opt.timestep))
         for k in range(steps):
             mujoco.mj_step(m, d)
-            late = k >= steps - window
-            if not (late or k % 10 == 0):
-                continue
-            qk, qdk = d.qpos.copy(), d.qvel.copy()
-            if not (np.all(np.isfinite(qk)) and np.all(np.isfinite(qdk))):
-                diverged = f"joint states became NaN after {k * m.opt.timestep:.3f} s"
+            if rec.wants(k) and not rec.sample(k, d.qpos.copy(), d.qvel.copy(), d.qfrc_actuator.copy()):
                 break
-            vmax = max(vmax, float(np.abs(qdk).max()))
-            peak = np.maximum(peak, np.abs(qk - qv))
-            if vmax > EXPLODE_VELOCITY:
-                j = int(np.argmax(np.abs(qdk)))
-                diverged = f"{s.joint_names[j]} reached {abs(qdk[j]):.0f} rad/s after {k * m.opt.timestep:.3f} s"
-                break
-            if late:
-                worst = np.maximum(worst, np.abs(qk - qv))
-                tau_sum += d.qfrc_actuator
-                tau_n += 1
-        return Hold(worst=worst, peak=peak, max_velocity=vmax, diverged=diverged, applied=tau_sum / max(tau_n, 1),
-                    q_end=d.qpos.copy(), tau_end=d.qfrc_actuator.copy(),
-                    efforts=tuple(float(v) for v in m.actuator_forcerange[:, 1]))
+        return rec.hold(d.qpos.copy(), d.qfrc_actuator.copy(), m.actuator_forcerange[:, 1])
     finally:
         m.opt.disableflags = flags
 
@@ -222,12 +185,12 @@ def simulate_robot(robot, xml: Path, allowed=(), hold_time: float = HOLD_TIME) -
 def simulate(checked, robot: str | None = None, out_dir: str | Path | None = None,
              hold_time: float = HOLD_TIME) -> list[RobotResult]:
     """Every (or the named) robot of a checked design without errors (as smoke.simulate)."""
-    from .scene import select_robots
+    from .scene import compiled, select_robots
     from .smoke import allowed_from_srdf
 
     robots = select_robots(checked, robot)
-    with compiled(checked) as xmls:
+    with compiled(checked, "mjcf") as xmls:
         return [simulate_robot(r, xmls[r.name], allowed_from_srdf(out_dir, r), hold_time) for r in robots]
 
 
-__all__ = ["ENGINE", "FK_TOL", "MujocoScene", "compiled", "load", "simulate", "simulate_robot"]
+__all__ = ["ENGINE", "FK_TOL", "MujocoScene", "load", "simulate", "simulate_robot"]
