@@ -19,10 +19,11 @@ its cell, made from the same description as the URDF (physical.assembly), never 
 
 Gains. The paper's decentralised PID [2, 0, 0.05] runs inside the Kinova actuator, in its own
 units: read as N·m/rad, p = 2 would let a 3 N·m gravity load sag 1.5 rad. What carries over
-unit-free is kept: no integral action (i = 0) and the derivative time d/p = 0.025 s. The
-stiffness is set so that the actuator reaches its peak torque at ERROR_AT_PEAK of position
-error: kp = τmax / ERROR_AT_PEAK, kv = kp · d/p. A load the actuator can carry then rests
-within ERROR_AT_PEAK of its target; one it cannot saturates the servo and falls.
+unit-free is kept: no integral action (i = 0) and the derivative time d/p = 0.025 s (both read
+from the library's `control`). The stiffness is set so that the actuator reaches its peak torque
+at ERROR_AT_PEAK of position error: kp = τmax / ERROR_AT_PEAK, kv = kp · d/p (H: 6100 N·m/rad
+and 152.5 N·m·s/rad; L: 1360 and 34). A load the actuator can carry then rests within
+ERROR_AT_PEAK of its target; one it cannot saturates the servo and falls.
 Joints have no damping of their own (kv is the only damper, so the servo's torque is all the
 actuator's) and ARMATURE of rotor inertia, which keeps the stiff servos of light distal links
 stable at the 1 ms step; neither changes a torque at rest.
@@ -45,16 +46,23 @@ from .urdf import MATERIALS
 
 TIME_STEP = 1e-3  # s, as `modc sim`
 ERROR_AT_PEAK = 0.005  # rad of position error at which a servo reaches the actuator's peak torque
-DERIVATIVE_TIME = 0.05 / 2.0  # s, the paper's d/p
 ARMATURE = 1e-3  # kg·m², reflected rotor inertia per joint (numerical regularisation, see above)
 TOOL_SITE_RADIUS = 0.005  # m
 TARGET_PREFIX = "target_"
 
 
-def gains(torque_peak: float) -> tuple[float, float]:
+def derivative_time(robot: Robot) -> float:
+    """s: the library's d/p (the paper's 0.05 / 2). Its i is not modelled: a position servo has
+    no integral term (the paper's is 0)."""
+    assert robot.library is not None
+    control = robot.library.control
+    return control.d / control.p
+
+
+def gains(robot: Robot, torque_peak: float) -> tuple[float, float]:
     """(kp N·m/rad, kv N·m·s/rad) of one joint's position servo."""
     kp = torque_peak / ERROR_AT_PEAK
-    return kp, kp * DERIVATIVE_TIME
+    return kp, kp * derivative_time(robot)
 
 
 def mesh_name(stem: str, scale_x: float) -> str:
@@ -130,7 +138,7 @@ def context(build: Build, robot: Robot) -> dict:
     actuators = []
     for j in joints:
         assert j.limits is not None
-        kp, kv = gains(j.limits.effort)
+        kp, kv = gains(robot, j.limits.effort)
         actuators.append({"name": j.name, "joint": j.name, "kp": num(kp), "kv": num(kv),
                           "forcerange": vec((-j.limits.effort, j.limits.effort)),
                           "ctrlrange": vec((j.limits.lower, j.limits.upper))})
@@ -146,7 +154,7 @@ def context(build: Build, robot: Robot) -> dict:
         "excludes": [{"body1": p.link1, "body2": p.link2} for p in collision_matrix(build, robot).disabled],
         "actuators": actuators,
         "keys": [{"name": n, "qpos": vec(q)} for n, q in poses],
-        "derivative_time": num(DERIVATIVE_TIME), "error_at_peak": num(ERROR_AT_PEAK),
+        "derivative_time": num(derivative_time(robot)), "error_at_peak": num(ERROR_AT_PEAK),
     }
 
 

@@ -140,9 +140,9 @@ class Rules(_Frozen):
 
 
 class Control(_Frozen):
-    p: float
-    i: float
-    d: float
+    p: float = Field(gt=0, description="proportional gain, actuator units (paper section 4.4)")
+    i: float = Field(ge=0)
+    d: float = Field(ge=0)
 
 
 class Library(_Frozen):
