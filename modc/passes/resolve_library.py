@@ -19,6 +19,9 @@ def run(design: Design, ctx: Context) -> Design:
         except lib.LibraryError as e:
             code = codes.LIBRARY_NOT_FOUND if "not found" in str(e) else codes.LIBRARY_INVALID
             span = r.library_span if r.library_ref == ref and r.library_span.file != "<unknown>" else r.name_span
+            if e.span is not None:  # a problem inside the library file: point at it there
+                span = e.span
+                ctx.sources[span.file] = e.text or ""
             ctx.report(code.at(span, name=ref, detail=str(e), builtins=", ".join(lib.BUILTIN)))
             robots.append(r)
             continue
