@@ -237,7 +237,7 @@ def _joint_ctx(j: JointData, command: str) -> dict:
     lo, hi = (j.lower, j.upper) if command == "position" else (-j.effort, j.effort)
     return {
         "command_min": real(lo), "command_max": real(hi),
-        "name": j.name, "variant": j.variant, "actuator": j.actuator,
+        "name": j.name, "variant": j.variant, "actuator": comment(j.actuator),
         "lower": real(j.lower), "upper": real(j.upper), "velocity": real(j.velocity),
         "acceleration": real(j.acceleration), "effort": real(j.effort), "home": real(j.home),
         "p": real(j.p), "i": real(j.i), "d": real(j.d),
