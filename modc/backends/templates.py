@@ -3,8 +3,8 @@
 Escaping is done here, by construction, not by each backend:
 - XML templates (names ending in XML_TEMPLATES) autoescape every value: a value that is already
   XML or a trusted xacro expression must be passed as markupsafe.Markup, built from checked parts;
-- every comment of every output (XML, xacro, YAML, launch, CMake) and any free text in XML takes
-  text from outside through comment();
+- every comment of every output (XML, xacro, YAML, launch, CMake) takes text from outside through
+  comment(), and XML text content through text_line();
 - names are identifiers (modc.names), so nothing else reaches a name position; scene_token() keeps
   MoveIt's line-based .scene format one token per line anyway.
 """
@@ -44,13 +44,20 @@ def render(name: str, context: dict) -> str:
 _EXPANDS = re.compile(r"\$(?=[{(])")  # ${...} (xacro, roslaunch) and $(...) (xacro, roslaunch substitution args)
 
 
+def text_line(text: str) -> str:
+    """Text from outside as XML text content (package.xml's description): one line, control and
+    line-breaking characters escaped (\\n, \\x01), which XML cannot hold, and no "${" or "$("
+    (no output carries an expression from user text); autoescape does <, &."""
+    return _EXPANDS.sub("$ ", "".join(c if c.isprintable() or c == " " else ascii(c)[1:-1] for c in text))
+
+
 def comment(text: str) -> str:
     """Any text from outside (a file name, a library description, a warning) as it may stand in a
-    comment of any output, or in XML text: one line of printable ASCII (xacro reads files in the
-    locale's encoding; control characters are not XML), no "--" and no final "-" (XML comments), and
-    no "${" or "$(" (expressions xacro and roslaunch would expand). Characters are escaped (\\n,
-    \\xe9), never dropped, so the comment still says what the text was. XML metacharacters are
-    left to autoescape (a comment shows &amp; for &; it stays well-formed)."""
+    comment of any output: one line of printable ASCII (xacro reads files in the locale's encoding;
+    control characters are not XML), no "--" and no final "-" (XML comments), and no "${" or "$("
+    (expressions xacro and roslaunch would expand). Characters are escaped (\\n, \\xe9), never
+    dropped, so the comment still says what the text was. XML metacharacters are left to
+    autoescape (a comment shows &amp; for &; it stays well-formed)."""
     s = "".join(c if c.isascii() and c.isprintable() else ascii(c)[1:-1] for c in text)
     s = _EXPANDS.sub("$ ", s)
     while "--" in s:
