@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 from typing import Annotated, Literal
@@ -18,7 +19,7 @@ from ..diagnostics import Span
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
 
-def _rule(problem):
+def _rule(problem: Callable[[str], str | None]) -> AfterValidator:
     def check(text: str) -> str:
         why = problem(text)
         if why:
