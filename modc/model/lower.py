@@ -180,8 +180,8 @@ class _Lowerer:
                         if c.text in REGISTRY and REGISTRY[c.text].allowable:
                             allow.add(c.text)
                         else:
-                            names = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
-                            self.error(codes.UNKNOWN_ALLOW.at(c.span, name=c.text, allowable=names))
+                            allowable = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
+                            self.error(codes.UNKNOWN_ALLOW.at(c.span, name=_say(c), allowable=allowable))
         if "chain" in seen and "dh" in seen:
             self.error(codes.CHAIN_AND_DH.at(seen["dh"].span, robot=rname))
             fields.pop("dh")
