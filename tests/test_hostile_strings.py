@@ -58,6 +58,15 @@ def test_the_model_refuses_any_other_name(bad):
             make()
 
 
+def test_the_rule_is_the_grammars():
+    """modc.names states the .mod grammar's own NAME and LIBRARY_REF terminals (one rule, two forms)."""
+    from modc.syntax.parser import _lark
+
+    assert _lark().get_terminal("NAME").pattern.value == names.IDENTIFIER
+    assert _lark().get_terminal("LIBRARY_REF").pattern.value == names.LABEL
+    assert re.fullmatch(_lark().get_terminal("UNIT_NAME").pattern.value, "H" * names.MAX_VARIANT + "4")
+
+
 def test_the_rule_accepts_identifiers_up_to_the_limit():
     for good in ("a", "_", "A_9", "joint_1", "a" * names.MAX_NAME):
         assert names.identifier_problem(good) is None
