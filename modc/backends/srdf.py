@@ -24,7 +24,7 @@ from ..model import Robot, Transform
 from ..physical import collisions
 from . import Build, register
 from .format import num
-from .templates import render
+from .templates import comment, render
 
 GROUP = "arm"
 TOOL_GROUP = "tool"
@@ -87,13 +87,6 @@ def warnings(build: Build) -> list[str]:
     return [w for r in build.design.robots for w in robot_warnings(r, collision_matrix(build, r))]
 
 
-def _comment(text: str) -> str:
-    """XML comments may not contain '--' or end with '-'."""
-    while "--" in text:
-        text = text.replace("--", "- -")
-    return text.rstrip("-")
-
-
 def has_tool(robot: Robot) -> bool:
     return robot.tool != Transform() or robot.payload is not None
 
@@ -109,10 +102,10 @@ def context(build: Build, robot: Robot) -> dict:
         links = [TIP_LINK] + [j.child for j in desc.joints if j.parent == TIP_LINK]
         tool = {"group": TOOL_GROUP, "links": links, "parent_link": parent}
     return {
-        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": _comment(build.source_name),
-        "library": robot.library.name, "version": __version__,
+        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
+        "library": comment(robot.library.name), "version": __version__,
         "samples": matrix.samples, "seed": matrix.seed, "always_percent": collisions.ALWAYS_PERCENT,
-        "warnings": [_comment(w) for w in robot_warnings(robot, matrix)],
+        "warnings": [comment(w) for w in robot_warnings(robot, matrix)],
         "group": GROUP, "base_link": BASE_LINK, "tip_link": TIP_LINK, "tool": tool,
         "states": [{"name": name, "joints": [{"name": j, "value": num(v)} for j, v in zip(joints, q, strict=True)]}
                    for name, q in states],

@@ -6,7 +6,7 @@ from ..kinematics import matrix_rpy
 from ..physical.assembly import Description
 from . import Build, register
 from .format import num, vec
-from .templates import render
+from .templates import comment, render
 
 # name -> RGBA; parts pick a material by role
 MATERIALS = {
@@ -48,8 +48,8 @@ def context(desc: Description, robot, source: str, mesh_prefix: str) -> dict:
                 "lower": num(lim.lower), "upper": num(lim.upper), "effort": num(lim.effort), "velocity": num(lim.velocity)},
         })
     return {
-        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": source,
-        "library": robot.library.name, "version": __version__,
+        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(source),
+        "library": comment(robot.library.name), "version": __version__,
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()],
         "links": links, "joints": joints,
     }
