@@ -40,7 +40,8 @@ from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
 from ..physical.statics import G
 from . import Build, register
 from .format import num, vec
-from .srdf import _comment, collision_matrix
+from .srdf import collision_matrix
+from .templates import comment
 from .templates import render
 from .urdf import MATERIALS
 
@@ -145,7 +146,7 @@ def context(build: Build, robot: Robot) -> dict:
     poses = [("home", robot.home())] + [(p.name, p.q) for p in robot.poses if p.name != "home"]
     obstacles, targets = _cell(robot)
     return {
-        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": _comment(build.source_name),
+        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
         "library": robot.library.name if robot.library else "", "version": __version__,
         "timestep": num(TIME_STEP), "gravity": vec(G),
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()]
