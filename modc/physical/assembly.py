@@ -59,6 +59,7 @@ class Description:
     name: str
     links: list[Link]
     joints: list[Joint]
+    file_stem: str = ""  # the robot's output name (URDF <robot name>): mod<n>_<name>
 
     @property
     def parts(self) -> dict[str, Part]:
@@ -68,6 +69,24 @@ class Description:
             for v in link.visuals:
                 out.setdefault(v.part.mesh, v.part)
         return dict(sorted(out.items()))
+
+    def fingerprint(self) -> str:
+        """A digest of everything the description holds: results computed from it (collision
+        matrix, worst-case torques) are cached under it."""
+        from .. import cache
+
+        parts: list[str | bytes] = [self.name, self.file_stem]
+        for link in self.links:
+            parts += [link.name, str(len(link.visuals))]
+            for v in link.visuals:
+                parts += [repr(v.part), np.asarray(v.T_link_part, float).tobytes()]
+            i = link.inertial
+            parts += ["-"] if i is None else [repr(float(i.mass)), np.asarray(i.com, float).tobytes(),
+                                              np.asarray(i.inertia, float).tobytes()]
+        for j in self.joints:
+            parts += [j.name, j.kind, j.parent, j.child, j.variant, repr(j.limits),
+                      np.asarray(j.T_parent_child, float).tobytes()]
+        return cache.key(*parts)
 
     @property
     def total_mass(self) -> float:
@@ -109,7 +128,7 @@ def describe(robot: Robot) -> Description:
         T[:3, 3] = robot.payload.com
         links.append(Link("payload", inertial=sphere(robot.payload.mass, PAYLOAD_RADIUS, (0.0, 0.0, 0.0))))
         joints.append(Joint("payload_joint", "fixed", "tool0", "payload", T))
-    return Description(robot.name, links, joints)
+    return Description(robot.name, links, joints, robot.file_stem)
 
 
 def library_mass(robot: Robot) -> float:

@@ -13,10 +13,12 @@ Every pair of links that carry collision geometry gets at most one reason to be 
               Assistant), drawn uniformly within the joint limits from a seeded PCG64 stream.
 Other pairs stay enabled: MoveIt checks them while planning.
 
-What is tested is exactly what MoveIt loads: pinocchio's GeometryModel built from the emitted
-URDF's <collision> meshes, tested by coal (BVH meshes, so coal's mesh-mesh semantics, which are
-FCL's and MoveIt's: surfaces that cross or touch collide; a mesh wholly inside another one does
-not). No geometry test is hand-written here.
+What is tested is what MoveIt loads: the <collision> meshes of the emitted URDF, here built in
+memory from the arm's Description (modc.physical.multibody: the STL files' triangles as coal BVH
+models, placed as pinocchio's URDF parser places them; tests/test_multibody.py checks both give
+the same matrix), tested by coal (BVH meshes, so coal's mesh-mesh semantics, which are FCL's and
+MoveIt's: surfaces that cross or touch collide; a mesh wholly inside another one does not). No
+geometry test is hand-written here. load() reads an emitted URDF instead (the consumer check).
 
 Speed (10,000 samples of a 6-DoF arm well under 0.5 s on one core; see
 benchmarks/bench_collisions.py for the figure next to a naive all-mesh-pairs anchor) comes from
@@ -31,8 +33,8 @@ three things, none of which can change a result:
      would be conservative for Never but would wrongly disable pairs as Default or Always.)
   3. the exact test of a link pair is one pinocchio call over all its mesh pairs, stopping at
      the first collision (coal's BVH rejects far meshes at the root).
-Samples are drawn and visited in order on one thread, so the result depends only on the URDF,
-the meshes, the sample count and the seed: same input -> same matrix on any machine and thread
+Samples are drawn and visited in order on one thread, so the result depends only on the arm's
+geometry and joints, the sample count and the seed: same input -> same matrix on any machine and thread
 count (barring floating-point differences in coal for meshes that touch to within rounding;
 the filter's margin keeps near-contacts out of the broad phase's hands).
 """
@@ -45,6 +47,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .assembly import Description
 
 DEFAULT_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling density"
 DEFAULT_SEED = 0
@@ -88,7 +92,7 @@ class CollisionMatrix:
 
 @dataclass
 class Geometry:
-    """A pinocchio model and collision GeometryModel of one URDF, plus its link graph."""
+    """A pinocchio model and collision GeometryModel of one arm, plus its link graph."""
 
     model: object  # pin.Model
     geom_model: object  # pin.GeometryModel (collision meshes)
@@ -99,6 +103,19 @@ class Geometry:
     @property
     def geometry_links(self) -> tuple[str, ...]:
         return tuple(l for l in self.links if self.objects.get(l))
+
+
+def geometry(desc: Description) -> Geometry:
+    """The arm's collision model, built in memory from its Description (no files)."""
+    from . import multibody
+
+    model = multibody.model(desc)
+    geom_model = multibody.geometry(desc, model)
+    links = tuple(l.name for l in desc.links)
+    objects: dict[str, list[int]] = {l: [] for l in links}
+    for i, go in enumerate(geom_model.geometryObjects):
+        objects[model.frames[go.parentFrame].name].append(i)
+    return Geometry(model, geom_model, links, tuple((j.parent, j.child) for j in desc.joints), objects)
 
 
 def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
@@ -389,19 +406,15 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
 ALGORITHM = "1"  # bump when compute() could classify any pair differently
 
 
-def cached_compute(files: Mapping[str, str | bytes], urdf_path: str, samples: int = DEFAULT_SAMPLES,
-                   seed: int = DEFAULT_SEED) -> CollisionMatrix:
-    """compute() on the emitted files, through the disk cache: the matrix is a pure function of
-    the URDF, its meshes, the sample count and the seed, so a hit equals a fresh computation
-    (per-pair counts and stats are not kept)."""
+def cached_matrix(desc: Description, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_SEED) -> CollisionMatrix:
+    """compute() on the arm's geometry, through the disk cache: the matrix is a pure function of
+    the Description (links, joints, limits, parts), the sample count and the seed, so a hit
+    equals a fresh computation (per-pair counts and stats are not kept)."""
     import json
 
     from .. import cache
 
-    parts = [ALGORITHM, str(samples), str(seed), urdf_path]
-    for rel in sorted(files):
-        parts += [rel, files[rel]]
-    name = cache.key(*parts) + ".json"
+    name = cache.key(ALGORITHM, str(samples), str(seed), desc.fingerprint()) + ".json"
     hit = cache.get("collisions", name)
     if hit is not None:
         d = json.loads(hit)
@@ -409,7 +422,7 @@ def cached_compute(files: Mapping[str, str | bytes], urdf_path: str, samples: in
             links=tuple(d["links"]), geometry_links=tuple(d["geometry_links"]),
             disabled=tuple(Pair(*p) for p in d["disabled"]), enabled=tuple(tuple(p) for p in d["enabled"]),
             samples=d["samples"], seed=d["seed"], default_q=tuple(d["default_q"]))
-    matrix = compute(load(files, urdf_path), samples=samples, seed=seed)
+    matrix = compute(geometry(desc), samples=samples, seed=seed)
     doc = {"links": matrix.links, "geometry_links": matrix.geometry_links,
            "disabled": [[p.link1, p.link2, p.reason] for p in matrix.disabled], "enabled": matrix.enabled,
            "samples": matrix.samples, "seed": matrix.seed, "default_q": matrix.default_q}
@@ -467,5 +480,5 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
 
 
 __all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "CollisionMatrix", "Geometry", "Pair",
-           "adjacent_pairs", "batch_placements", "compute", "compute_naive", "default_configuration", "joint_limits",
-           "load", "sample_configurations"]
+           "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive", "default_configuration",
+           "geometry", "joint_limits", "load", "sample_configurations"]

@@ -1,12 +1,12 @@
 """Collision checking for planning: pinocchio + coal, double precision, on the geometry the
 compiler emits.
 
-The robot is exactly what `modc FILE -o OUT` writes: the URDF's <collision> meshes (loaded by
-pinocchio from the urdf and meshes backends' output, through modc.physical.collisions.load, as
-the SRDF backend does), tested by coal as BVH meshes. The environment is the file's obstacles,
-in base_link, as coal primitives attached to the universe (base_link is the root and never
-moves): box (size = full extents), sphere (radius), cylinder (radius, length along its z), each
-placed by its origin (xyz, then URDF roll-pitch-yaw).
+The robot is what `modc FILE -o OUT` writes: the URDF's <collision> meshes, built in memory
+from the robot's Description (modc.physical.collisions.geometry, as the SRDF backend does; or
+read from emitted files when given), tested by coal as BVH meshes. The environment is the file's
+obstacles, in base_link, as coal primitives attached to the universe (base_link is the root and
+never moves): box (size = full extents), sphere (radius), cylinder (radius, length along its
+z), each placed by its origin (xyz, then URDF roll-pitch-yaw).
 
 Pairs that are checked:
     robot vs environment   every moving link with geometry vs every obstacle. base_link never
@@ -17,7 +17,7 @@ Pairs that are checked:
                            Default (touching in the default pose by construction) or Always.
                            The SRDF's Never pairs stay checked: never colliding in 10,000 random
                            poses is a sampling result, not a guarantee, and checking them is cheap.
-The matrix is modc.physical.collisions.compute with the SRDF's defaults (same samples, same
+The matrix is modc.physical.collisions.cached_matrix with the SRDF's defaults (same samples, same
 seed), so "disabled" means what the emitted SRDF says.
 
 Clearance and certified motions. A configuration is valid when every checked pair is more than
@@ -52,15 +52,6 @@ class Contact:
     def describe(self) -> str:
         other = f"{self.b_shape} '{self.b}'" if self.b_is_obstacle else self.b
         return f"{self.a} with {other}"
-
-
-def robot_files(robot: Robot) -> dict[str, str | bytes]:
-    """The URDF and meshes of one robot, as `modc FILE -o OUT` writes them (urdf/…, meshes/…)."""
-    from ..backends.build import Build
-    from ..backends.srdf import robot_files as srdf_robot_files
-    from ..model import Design
-
-    return srdf_robot_files(Build(Design(path=f"{robot.name}.mod", robots=(robot,))), robot)
 
 
 def obstacle_geometry(obstacle):
@@ -106,15 +97,18 @@ class CollisionChecker:
         import pinocchio as pin
 
         from ..physical import collisions
+        from ..physical.assembly import describe
 
         self.pin = pin
         self.robot = robot
-        files = robot_files(robot) if files is None else files
-        geo = collisions.load(files, f"urdf/{robot.file_stem}.urdf")
+        desc = describe(robot)
+        # files: the emitted URDF and meshes ({relative path: content}) to check instead of the
+        # in-memory geometry (they describe the same arm; the tests compare the two)
+        geo = collisions.geometry(desc) if files is None else collisions.load(files, f"urdf/{robot.file_stem}.urdf")
         self.geo = geo
         self.model = geo.model
         self.data = self.model.createData()
-        self.matrix = collisions.compute(geo) if matrix is None else matrix
+        self.matrix = collisions.cached_matrix(desc) if matrix is None else matrix
         self.tool_frame = self.model.getFrameId("tool0")
         names = [self.model.names[j] for j in range(1, self.model.njoints)]
         want = [f"joint_{i}" for i in range(1, robot.dof + 1)]
@@ -314,5 +308,4 @@ def bisection_order(n: int) -> list[int]:
     return out
 
 
-__all__ = ["DEFAULT_MARGIN", "STATIC_TOLERANCE", "CollisionChecker", "Contact", "bisection_order", "obstacle_geometry",
-           "robot_files"]
+__all__ = ["DEFAULT_MARGIN", "STATIC_TOLERANCE", "CollisionChecker", "Contact", "bisection_order", "obstacle_geometry"]
