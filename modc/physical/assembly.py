@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..kinematics import Chain, A_J
+from ..kinematics import A_J, A_t1, A_t2, transform
 from ..model import Robot
-from .inertia import Inertial, combine, part_inertial, sphere
+from .inertia import Inertial, combine_groups, local_inertial, sphere
 from .parts import Part, unit_parts
 
 PAYLOAD_RADIUS = 0.02  # m: a payload is modelled as a solid sphere this size around its centre of mass
@@ -94,35 +94,94 @@ class Description:
         return sum(l.inertial.mass for l in self.links if l.inertial is not None and l.name != "tool0")
 
 
+@dataclass(frozen=True)
+class _Unit:
+    """What one modular unit contributes, independent of where it sits in the arm."""
+
+    output: tuple[tuple[Part, Inertial], ...]  # carried by the unit's own link, in its joint frame
+    input: tuple[tuple[Part, str, Inertial], ...]  # carried by the link before; part frame name
+    A_t1: np.ndarray  # unit base -> twist1
+    A_J0: np.ndarray  # twist1 -> joint at q = 0
+    A_t2: np.ndarray | None  # joint -> twist2 (units with a link module)
+
+
+_UNITS: dict[tuple, tuple[object, _Unit]] = {}  # per library (by identity) and unit settings
+
+
+def _unit(lib, variant: str, kind: int, link_length: float, pivot: float, port: float) -> _Unit:
+    """Cached: design search describes thousands of arms built from the same few units."""
+    key = (id(lib), variant, kind, link_length, pivot, port)
+    hit = _UNITS.get(key)
+    if hit is not None and hit[0] is lib:  # the library object is kept alive, so its id is not reused
+        return hit[1]
+    t = lib.units[kind]
+    out, inp = [], []
+    for p in unit_parts(lib, variant, kind, link_length):
+        if p.mesh.startswith(("output_casing", "link_")):
+            out.append((p, local_inertial(p)))
+        else:
+            inp.append((p, p.frame, local_inertial(p)))
+    unit = _Unit(tuple(out), tuple(inp), A_t1(pivot, t.x01, t.z01), A_J(0.0, t.z12),
+                 A_t2(port, link_length) if t.link else None)
+    if len(_UNITS) >= 4096:
+        _UNITS.clear()
+    _UNITS[key] = (lib, unit)
+    return unit
+
+
+_EYE4 = np.eye(4)
+
+
+def _link_inertials(inertials: list[list[tuple[Inertial, np.ndarray | None]]]) -> list[Inertial]:
+    """Each link's parts combined (links without parts skipped): every part moved into its link
+    frame and every link combined in a few array operations for the whole arm."""
+    items = [it for group in inertials for it in group]
+    m = np.array([local.mass for local, _ in items])
+    C = np.array([local.com for local, _ in items])
+    I = np.array([local.inertia for local, _ in items])
+    moving = [k for k, (_, T) in enumerate(items) if T is not None]
+    if moving:
+        T = np.array([items[k][1] for k in moving])
+        R = T[:, :3, :3]
+        C[moving] = (R @ C[moving][:, :, None])[:, :, 0] + T[:, :3, 3]
+        I[moving] = R @ I[moving] @ R.transpose(0, 2, 1)
+    starts = np.cumsum([0] + [len(g) for g in inertials if g])[:-1].tolist()
+    return combine_groups(m, C, I, starts)
+
+
 def describe(robot: Robot) -> Description:
+    """The assembled arm as links and joints (kinematics: modc.kinematics, SPEC section 2)."""
     lib = robot.library
     assert lib is not None
-    chain = Chain(robot)
     n = robot.dof
     links = [Link("base_link")] + [Link(f"link_{i}") for i in range(1, n + 1)]
     joints: list[Joint] = []
+    inertials: list[list[tuple[Inertial, np.ndarray | None]]] = [[] for _ in range(n + 1)]  # (local, T or None)
+    T_prev_unit = _EYE4  # unit i's base frame in the link before it
     for i, u in enumerate(robot.units):
-        parts = unit_parts(lib, u.variant, u.kind, robot.link_length(u))
+        unit = _unit(lib, u.variant, u.kind, robot.link_length(u), u.pivot, u.port if lib.units[u.kind].link else 0.0)
         # Frames of this unit's parts, in the link that carries them.
-        T_prev_unit = np.eye(4) if i == 0 else chain.T_joint_end(i - 1)
-        T_prev_twist1 = T_prev_unit @ chain.T_unit_twist1(i)
-        T_prev_joint0 = T_prev_twist1 @ A_J(0.0, chain.units[i].z12)
+        T_prev_twist1 = T_prev_unit @ unit.A_t1
+        T_prev_joint0 = T_prev_twist1 @ unit.A_J0
         input_side = {"unit": T_prev_unit, "twist1": T_prev_twist1, "joint": T_prev_joint0}
-        for p in parts:
-            if p.mesh.startswith(("output_casing", "link_")):
-                links[i + 1].visuals.append(Visual(p, np.eye(4)))
-            else:
-                links[i].visuals.append(Visual(p, input_side[p.frame]))
+        for p, frame, local in unit.input:
+            T = input_side[frame]
+            links[i].visuals.append(Visual(p, T))
+            inertials[i].append((local, None if T is _EYE4 else T))
+        for p, local in unit.output:
+            links[i + 1].visuals.append(Visual(p, _EYE4))
+            inertials[i + 1].append((local, None))
         v = lib.variants[u.variant]
         lo, hi = robot.joint_range(i + 1)
         joints.append(Joint(
-            f"joint_{i + 1}", "revolute", links[i].name, links[i + 1].name, chain.T_parent_joint(i),
+            f"joint_{i + 1}", "revolute", links[i].name, links[i + 1].name, T_prev_joint0,
             Limits(lo, hi, v.actuator.torque_peak, v.actuator.velocity), u.variant))
-    for link in links:
-        if link.visuals:
-            link.inertial = combine([part_inertial(v.part, v.T_link_part) for v in link.visuals])
+        T_prev_unit = _EYE4 if unit.A_t2 is None else unit.A_t2
+    for link, inertial in zip((l for l, items in zip(links, inertials) if items), _link_inertials(inertials)):
+        link.inertial = inertial
     links.append(Link("tool0", inertial=sphere(FRAME_MASS, FRAME_RADIUS, (0.0, 0.0, 0.0))))
-    joints.append(Joint("tool0_joint", "fixed", links[n].name, "tool0", chain.T_last_tool()))
+    T_flange_tool = transform(robot.tool.xyz, robot.tool.rpy)
+    joints.append(Joint("tool0_joint", "fixed", links[n].name, "tool0", T_prev_unit @ T_flange_tool))
     if robot.payload is not None:
         T = np.eye(4)
         T[:3, 3] = robot.payload.com
