@@ -11,10 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import rpy_matrix
 from ..model import Payload, Robot
-
-G_WORLD = np.array([0.0, 0.0, -9.81])
+from ..physical.multibody import gravity
 
 
 PayloadOverride = tuple[float, tuple[float, float, float]]  # (kg, centre of mass in tool0, m)
@@ -25,11 +23,6 @@ def with_payload(robot: Robot, payload: PayloadOverride | None) -> Robot:
     if payload is None:
         return robot
     return robot.model_copy(update={"payload": Payload(mass=payload[0], com=payload[1])})
-
-
-def gravity(robot: Robot) -> np.ndarray:
-    """Gravity as seen in base_link: base_link may be mounted tilted (`base … rpy`)."""
-    return rpy_matrix(robot.base.rpy).T @ G_WORLD
 
 
 class Dynamics:

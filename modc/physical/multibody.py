@@ -19,15 +19,41 @@ from typing import Any
 
 import numpy as np
 
+from ..kinematics import rpy_matrix
+from ..model import Robot
 from .assembly import Description
 from .meshes import tessellate
 from .parts import Part
 
 ROOT = "base_link"
+G_WORLD = np.array([0.0, 0.0, -9.81])  # m/s², world z up
+
+
+def gravity(robot: Robot) -> np.ndarray:
+    """Gravity as seen in base_link: base_link may be mounted tilted (`base … rpy`)."""
+    return rpy_matrix(robot.base.rpy).T @ G_WORLD
 
 
 def _se3(pin, T: np.ndarray):
     return pin.SE3(np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3]))
+
+
+EYE4 = np.eye(4)
+
+
+def link_frames(desc: Description) -> dict[str, tuple[int, np.ndarray]]:
+    """Per link: the index of the joint that carries it (0: the universe, as pinocchio numbers
+    joints) and the link frame's placement in that joint's frame (4x4)."""
+    out = {ROOT: (0, EYE4)}
+    n = 0
+    for j in desc.joints:
+        parent_joint, T = out[j.parent]
+        if j.kind == "revolute":
+            n += 1
+            out[j.child] = (n, EYE4)
+        else:
+            out[j.child] = (parent_joint, T @ j.T_parent_child)
+    return out
 
 
 def model(desc: Description, gravity: np.ndarray | None = None) -> Any:
@@ -39,30 +65,29 @@ def model(desc: Description, gravity: np.ndarray | None = None) -> Any:
     if gravity is not None:
         m.gravity.linear = np.asarray(gravity, float)
     links = {link.name: link for link in desc.links}
-    # where each link sits: (joint index, placement in the joint frame, index of its BODY frame)
-    where: dict[str, tuple[int, Any, int]] = {}
+    placed = link_frames(desc)
+    body_frame = {}  # link -> index of its BODY frame
     identity = pin.SE3.Identity()
-    root = links[ROOT]
-    Y = _inertia(pin, root.inertial)
     # a frame's inertia is added to its joint's by addFrame, as the URDF parser has it
-    where[ROOT] = (0, identity, m.addFrame(pin.Frame(ROOT, 0, 0, identity, pin.FrameType.BODY, Y or pin.Inertia.Zero())))
+    Y = _inertia(pin, links[ROOT].inertial)
+    body_frame[ROOT] = m.addFrame(pin.Frame(ROOT, 0, 0, identity, pin.FrameType.BODY, Y or pin.Inertia.Zero()))
     for j in desc.joints:
-        parent_joint, M_joint_parent, parent_frame = where[j.parent]
-        M = M_joint_parent * _se3(pin, j.T_parent_child)
+        parent_joint, T_joint_parent = placed[j.parent]
+        M = _se3(pin, T_joint_parent @ j.T_parent_child)
         Y = _inertia(pin, links[j.child].inertial)
         if j.kind == "revolute":
             lim = j.limits
             assert lim is not None
             jid = m.addJoint(parent_joint, pin.JointModelRZ(), M, j.name, np.array([lim.effort]),
                              np.array([lim.velocity]), np.array([lim.lower]), np.array([lim.upper]))
-            fid = m.addJointFrame(jid, parent_frame)
+            fid = m.addJointFrame(jid, body_frame[j.parent])
             if Y is not None:
                 m.appendBodyToJoint(jid, Y, identity)
-            where[j.child] = (jid, identity, m.addBodyFrame(j.child, jid, identity, fid))
+            body_frame[j.child] = m.addBodyFrame(j.child, jid, identity, fid)
         else:
-            fid = m.addFrame(pin.Frame(j.name, parent_joint, parent_frame, M, pin.FrameType.FIXED_JOINT,
+            fid = m.addFrame(pin.Frame(j.name, parent_joint, body_frame[j.parent], M, pin.FrameType.FIXED_JOINT,
                                        Y or pin.Inertia.Zero()))
-            where[j.child] = (parent_joint, M, m.addBodyFrame(j.child, parent_joint, M, fid))
+            body_frame[j.child] = m.addBodyFrame(j.child, parent_joint, M, fid)
     return m
 
 
@@ -101,6 +126,32 @@ def bvh(part: Part) -> Any:
     return mesh
 
 
+@lru_cache(maxsize=512)
+def bounding_sphere(part: Part) -> tuple[np.ndarray, float]:
+    """A sphere containing the part's collision mesh (as scaled), in the part's frame: the
+    centre of its bounding box and the distance to the farthest vertex."""
+    vertices = _mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0])
+    c = (vertices.min(axis=0) + vertices.max(axis=0)) / 2
+    return c, float(np.sqrt(((vertices - c) ** 2).sum(axis=1)).max())
+
+
+_MESHES: dict[int, tuple[Part, tuple[Any, np.ndarray, float]]] = {}
+
+
+def collision_mesh(part: Part) -> tuple[Any, np.ndarray, float]:
+    """(bvh(part), *bounding_sphere(part)), found by the part's identity first: the design
+    search meets the same Part objects (cached per unit by describe()) thousands of times, and
+    hashing a Part costs more than the lookup it keys."""
+    hit = _MESHES.get(id(part))
+    if hit is not None and hit[0] is part:
+        return hit[1]
+    value = (bvh(part), *bounding_sphere(part))
+    if len(_MESHES) >= 4096:
+        _MESHES.clear()
+    _MESHES[id(part)] = (part, value)
+    return value
+
+
 def geometry(desc: Description, m: Any) -> Any:
     """pin.GeometryModel of the parts' collision meshes, named <link>_<k> as the URDF parser names them."""
     import pinocchio as pin
@@ -119,4 +170,22 @@ def geometry(desc: Description, m: Any) -> Any:
     return gm
 
 
-__all__ = ["bvh", "geometry", "model"]
+def obstacle_geometry(obstacle) -> tuple[Any, Any]:
+    """coal geometry and pinocchio placement (in base_link) of one obstacle of the file: box
+    (size = full extents), sphere (radius), cylinder (radius, full length along its z)."""
+    import coal
+    import pinocchio as pin
+
+    s = obstacle.size
+    if obstacle.shape == "box":
+        g = coal.Box(float(s[0]), float(s[1]), float(s[2]))
+    elif obstacle.shape == "sphere":
+        g = coal.Sphere(float(s[0]))
+    elif obstacle.shape == "cylinder":
+        g = coal.Cylinder(float(s[0]), float(s[1]))
+    else:  # pragma: no cover - the model admits only the three shapes
+        raise ValueError(f"unknown obstacle shape {obstacle.shape!r}")
+    return g, pin.SE3(rpy_matrix(obstacle.origin.rpy), np.array(obstacle.origin.xyz, dtype=float))
+
+
+__all__ = ["G_WORLD", "bounding_sphere", "bvh", "collision_mesh", "geometry", "gravity", "model", "obstacle_geometry"]

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import Robot
+from ..physical.multibody import obstacle_geometry
 
 DEFAULT_MARGIN = 0.005  # m kept between the arm and obstacles, and between links, while planning
 STATIC_TOLERANCE = 1e-3  # m: base_link may touch (penetrate by less than this) a fixed obstacle
@@ -52,26 +53,6 @@ class Contact:
     def describe(self) -> str:
         other = f"{self.b_shape} '{self.b}'" if self.b_is_obstacle else self.b
         return f"{self.a} with {other}"
-
-
-def obstacle_geometry(obstacle):
-    """coal geometry and pinocchio placement (in base_link) of one obstacle."""
-    import coal
-    import pinocchio as pin
-
-    from ..kinematics import rpy_matrix
-
-    s = obstacle.size
-    if obstacle.shape == "box":
-        g = coal.Box(float(s[0]), float(s[1]), float(s[2]))  # full side lengths
-    elif obstacle.shape == "sphere":
-        g = coal.Sphere(float(s[0]))
-    elif obstacle.shape == "cylinder":
-        g = coal.Cylinder(float(s[0]), float(s[1]))  # radius, full length along z
-    else:  # pragma: no cover - the model admits only the three shapes
-        raise ValueError(f"unknown obstacle shape {obstacle.shape!r}")
-    M = pin.SE3(rpy_matrix(obstacle.origin.rpy), np.array(obstacle.origin.xyz, dtype=float))
-    return g, M
 
 
 def _box_corners(geometry) -> np.ndarray:
