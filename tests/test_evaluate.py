@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import ROOT
+
 from modc.compiler import build, check_file, check_text
 from modc.kinematics import Chain
 from modc.physical.evaluate import Candidate, evaluate

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from conftest import EXAMPLES, compile_file
+
 from modc.compiler import check_file
 from modc.physical import collisions, multibody
 from modc.physical.assembly import describe

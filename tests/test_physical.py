@@ -6,13 +6,13 @@ import io
 import numpy as np
 import pytest
 import trimesh
-
 from conftest import checked_ok
+
+from modc.model import library
 from modc.physical.assembly import describe, library_mass
 from modc.physical.inertia import part_inertial
 from modc.physical.meshes import SECTIONS, build
 from modc.physical.parts import mesh_primitives, unit_parts
-from modc.model import library
 
 
 @pytest.mark.parametrize("variant", ["H", "L"])
@@ -81,7 +81,7 @@ def test_described_mass_is_the_library_mass():
 def test_inertias_are_physical():
     r = checked_ok("robot r { chain H1 - H4(pivot=-90deg, port=45deg) - H3(pivot=30deg) - L4 - L2 }").design.robots[0]
     for link in describe(r).links:
-        I = link.inertial.inertia
-        ev = np.linalg.eigvalsh(I)
+        inertia = link.inertial.inertia
+        ev = np.linalg.eigvalsh(inertia)
         assert ev.min() > 0, link.name
         assert ev[0] + ev[1] >= ev[2] - 1e-15, link.name  # triangle inequality

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..diagnostics.span import NOWHERE
 from ..model import Payload, Robot
 from ..physical.multibody import gravity
-
 
 PayloadOverride = tuple[float, tuple[float, float, float]]  # (kg, centre of mass in tool0, m)
 
@@ -22,7 +22,8 @@ def with_payload(robot: Robot, payload: PayloadOverride | None) -> Robot:
     """The robot carrying another payload (None: the file's own)."""
     if payload is None:
         return robot
-    return robot.model_copy(update={"payload": Payload(mass=payload[0], com=payload[1])})
+    span = robot.payload.span if robot.payload is not None else NOWHERE
+    return robot.model_copy(update={"payload": Payload(mass=payload[0], com=payload[1], span=span)})
 
 
 class Dynamics:
@@ -41,7 +42,8 @@ class Dynamics:
         self.upper = np.array(self.model.upperPositionLimit)
 
     def rnea(self, q, v, a) -> np.ndarray:
-        return np.array(self.pin.rnea(self.model, self.data, np.asarray(q, float), np.asarray(v, float), np.asarray(a, float)))
+        q, v, a = (np.asarray(x, float) for x in (q, v, a))
+        return np.array(self.pin.rnea(self.model, self.data, q, v, a))
 
     def gravity(self, q) -> np.ndarray:
         return np.array(self.pin.computeGeneralizedGravity(self.model, self.data, np.asarray(q, float)))

@@ -91,7 +91,7 @@ class Description:
     @property
     def total_mass(self) -> float:
         """Mass of the arm and payload (the tool0 frame's placeholder inertial excluded)."""
-        return sum(l.inertial.mass for l in self.links if l.inertial is not None and l.name != "tool0")
+        return sum(link.inertial.mass for link in self.links if link.inertial is not None and link.name != "tool0")
 
 
 @dataclass(frozen=True)
@@ -138,15 +138,15 @@ def _link_inertials(inertials: list[list[tuple[Inertial, np.ndarray | None]]]) -
     items = [it for group in inertials for it in group]
     m = np.array([local.mass for local, _ in items])
     C = np.array([local.com for local, _ in items])
-    I = np.array([local.inertia for local, _ in items])
+    inertia = np.array([local.inertia for local, _ in items])
     moving = [k for k, (_, T) in enumerate(items) if T is not None]
     if moving:
         T = np.array([items[k][1] for k in moving])
         R = T[:, :3, :3]
         C[moving] = (R @ C[moving][:, :, None])[:, :, 0] + T[:, :3, 3]
-        I[moving] = R @ I[moving] @ R.transpose(0, 2, 1)
+        inertia[moving] = R @ inertia[moving] @ R.transpose(0, 2, 1)
     starts = np.cumsum([0] + [len(g) for g in inertials if g])[:-1].tolist()
-    return combine_groups(m, C, I, starts)
+    return combine_groups(m, C, inertia, starts)
 
 
 def describe(robot: Robot) -> Description:
@@ -177,7 +177,8 @@ def describe(robot: Robot) -> Description:
             f"joint_{i + 1}", "revolute", links[i].name, links[i + 1].name, T_prev_joint0,
             Limits(lo, hi, v.actuator.torque_peak, v.actuator.velocity), u.variant))
         T_prev_unit = _EYE4 if unit.A_t2 is None else unit.A_t2
-    for link, inertial in zip((l for l, items in zip(links, inertials) if items), _link_inertials(inertials)):
+    carrying = [link for link, items in zip(links, inertials, strict=True) if items]
+    for link, inertial in zip(carrying, _link_inertials(inertials), strict=True):
         link.inertial = inertial
     links.append(Link("tool0", inertial=sphere(FRAME_MASS, FRAME_RADIUS, (0.0, 0.0, 0.0))))
     T_flange_tool = transform(robot.tool.xyz, robot.tool.rpy)

@@ -125,9 +125,9 @@ class _Collisions:
         self.R, self.p = T[:, :3, :3], T[:, :3, 3]
         self.centers = np.einsum("kij,kj->ki", self.R, np.array(centers)) + self.p  # in the joint frames
         self.radii = np.array(radii)
-        links = tuple(l.name for l in arm.desc.links)
+        links = tuple(link.name for link in arm.desc.links)
         has = set(names[:n_links])
-        adjacent = adjacent_pairs(links, [(j.parent, j.child) for j in arm.desc.joints], lambda l: l in has)
+        adjacent = adjacent_pairs(links, [(j.parent, j.child) for j in arm.desc.joints], lambda name: name in has)
         counted = np.zeros((len(names), len(names)), bool)  # counted[a, b], a < b
         for a in range(n_links):
             for b in range(a + 1, n_links):
@@ -140,12 +140,12 @@ class _Collisions:
         for a, b in self._hits(*arm.placements(q0), first=False):
             if b < n_links:
                 counted[a, b] = False
-        self.I, self.J = self._body_pairs()
+        self.first_body, self.second_body = self._body_pairs()
 
     def _body_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         o = self.owner
-        I, J = np.nonzero(self.counted[o[:, None], o[None, :]])
-        return I, J
+        first, second = np.nonzero(self.counted[o[:, None], o[None, :]])
+        return first, second
 
     def first(self, arm: Candidate, q: np.ndarray) -> tuple[str, str] | None:
         hits = self._hits(*arm.placements(q), first=True)
@@ -153,17 +153,18 @@ class _Collisions:
 
     def _hits(self, R: np.ndarray, p: np.ndarray, first: bool) -> list[tuple[int, int]]:
         """Owner pairs in collision with the joints placed at (R, p): all of them, or the first."""
-        I, J = self._body_pairs() if not first else (self.I, self.J)
-        if not len(I):
+        first_body, second_body = self._body_pairs() if not first else (self.first_body, self.second_body)
+        if not len(first_body):
             return []
         j = self.joints
         centers = np.einsum("kij,kj->ki", R[j], self.centers) + p[j]
-        d2 = ((centers[I] - centers[J]) ** 2).sum(axis=1)
-        near = np.flatnonzero(d2 <= (self.radii[I] + self.radii[J] + SPHERE_MARGIN) ** 2)
+        d2 = ((centers[first_body] - centers[second_body]) ** 2).sum(axis=1)
+        reach = self.radii[first_body] + self.radii[second_body] + SPHERE_MARGIN
+        near = np.flatnonzero(d2 <= reach ** 2)
         placed: dict[int, Any] = {}
         hits: list[tuple[int, int]] = []
         for k in near.tolist():
-            a, b = int(I[k]), int(J[k])
+            a, b = int(first_body[k]), int(second_body[k])
             pair = (int(self.owner[a]), int(self.owner[b]))
             if pair in hits:
                 continue

@@ -22,7 +22,8 @@ def local_inertial(part: Part) -> Inertial:
     constant, so computed once per part."""
     vols = np.array([p.volume for p in part.primitives])
     masses = part.mass * vols / vols.sum()
-    return combine([Inertial(m, np.array(prim.center), prim.inertia(m)) for prim, m in zip(part.primitives, masses)])
+    return combine([Inertial(m, np.array(prim.center), prim.inertia(m))
+                    for prim, m in zip(part.primitives, masses, strict=True)])
 
 
 def moved(local: Inertial, T_link_part: np.ndarray) -> Inertial:
@@ -45,7 +46,7 @@ def combine(items: list[Inertial]) -> Inertial:
                           np.array([i.inertia for i in items]), [0])[0]
 
 
-def combine_groups(m: np.ndarray, C: np.ndarray, I: np.ndarray, starts: list[int]) -> list[Inertial]:
+def combine_groups(m: np.ndarray, C: np.ndarray, inertia: np.ndarray, starts: list[int]) -> list[Inertial]:
     """combine() of consecutive groups of items at once (group g: items starts[g] to the next
     start): masses (k,), mass centres (k, 3), inertias about them (k, 3, 3). Vectorised over the
     groups; the sums run over the items in order, from 0, as a loop over one group's items would
@@ -68,7 +69,7 @@ def combine_groups(m: np.ndarray, C: np.ndarray, I: np.ndarray, starts: list[int
     d = C - com[group]
     dd = (d[:, None, :] @ d[:, :, None])[:, 0, 0]  # row by row d @ d, rounded as a loop of d @ d is
     pad_I = np.zeros((*pad_m.shape, 3, 3))
-    pad_I[group, pos] = I + m[:, None, None] * (dd[:, None, None] * _EYE3 - d[:, :, None] * d[:, None, :])
+    pad_I[group, pos] = inertia + m[:, None, None] * (dd[:, None, None] * _EYE3 - d[:, :, None] * d[:, None, :])
     S = np.zeros((G, 3, 3))
     for j in range(pad_m.shape[1]):
         S += pad_I[:, j]

@@ -73,8 +73,8 @@ def _revolve(profile: list[list[float]], T: np.ndarray) -> tuple[np.ndarray, np.
     points = np.column_stack((np.cos(theta), np.sin(theta)))
     per = len(line)
     radius, height = line[:, 0], line[:, 1]
-    vertices = np.column_stack((np.tile(points, (1, per)).reshape((-1, 2)) * np.tile(radius, len(points)).reshape((-1, 1)),
-                                np.tile(height, len(points))))
+    ring = np.tile(points, (1, per)).reshape((-1, 2)) * np.tile(radius, len(points)).reshape((-1, 1))
+    vertices = np.column_stack((ring, np.tile(height, len(points))))
     vertices = vertices[:-per]  # the last ring is the first one again
     quad = np.array([0, per, 1, 1, per, per + 1])
     single = np.tile(quad, per - 1).reshape((-1, 3))

@@ -126,13 +126,26 @@ def bvh(part: Part) -> Any:
     return mesh
 
 
+def hull_points(geometry) -> np.ndarray:
+    """Points whose convex hull contains a coal geometry, in its own frame: a mesh's vertices,
+    else the corners of its local bounding box (boxes, cylinders, spheres)."""
+    if hasattr(geometry, "vertices"):
+        return np.asarray(geometry.vertices(), float)
+    geometry.computeLocalAABB()
+    lo, hi = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
+    return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+
+
+def enclosing_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """A sphere containing the points: the centre of their bounding box, the radius to the farthest."""
+    c = (points.min(axis=0) + points.max(axis=0)) / 2
+    return c, float(np.sqrt(((points - c) ** 2).sum(axis=1)).max())
+
+
 @lru_cache(maxsize=512)
 def bounding_sphere(part: Part) -> tuple[np.ndarray, float]:
-    """A sphere containing the part's collision mesh (as scaled), in the part's frame: the
-    centre of its bounding box and the distance to the farthest vertex."""
-    vertices = _mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0])
-    c = (vertices.min(axis=0) + vertices.max(axis=0)) / 2
-    return c, float(np.sqrt(((vertices - c) ** 2).sum(axis=1)).max())
+    """A sphere containing the part's collision mesh (as scaled), in the part's frame."""
+    return enclosing_sphere(_mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0]))
 
 
 _MESHES: dict[int, tuple[Part, tuple[Any, np.ndarray, float]]] = {}
@@ -188,4 +201,5 @@ def obstacle_geometry(obstacle) -> tuple[Any, Any]:
     return g, pin.SE3(rpy_matrix(obstacle.origin.rpy), np.array(obstacle.origin.xyz, dtype=float))
 
 
-__all__ = ["G_WORLD", "bounding_sphere", "bvh", "collision_mesh", "geometry", "gravity", "model", "obstacle_geometry"]
+__all__ = ["EYE4", "G_WORLD", "ROOT", "bounding_sphere", "bvh", "collision_mesh", "enclosing_sphere", "hull_points",
+           "link_frames", "geometry", "gravity", "model", "obstacle_geometry"]

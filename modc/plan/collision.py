@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import Robot
-from ..physical.multibody import obstacle_geometry
+from ..physical.multibody import hull_points, obstacle_geometry
 
 DEFAULT_MARGIN = 0.005  # m kept between the arm and obstacles, and between links, while planning
 STATIC_TOLERANCE = 1e-3  # m: base_link may touch (penetrate by less than this) a fixed obstacle
@@ -57,16 +57,8 @@ class Contact:
 
 def _box_corners(geometry) -> np.ndarray:
     """The 8 corners of a geometry's bounding box in its own frame."""
-    v = _vertices(geometry)
+    v = hull_points(geometry)
     lo, hi = v.min(axis=0), v.max(axis=0)
-    return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-
-
-def _vertices(geometry) -> np.ndarray:
-    if hasattr(geometry, "vertices"):
-        return np.asarray(geometry.vertices(), float)
-    geometry.computeLocalAABB()
-    lo, hi = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
     return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
 
 
@@ -116,8 +108,9 @@ class CollisionChecker:
         disabled = {frozenset((p.link1, p.link2)) for p in self.matrix.disabled
                     if p.reason in ("Adjacent", "Default", "Always")}
         glinks = geo.geometry_links
-        self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:] if frozenset((a, b)) not in disabled]
-        moving = [l for l in glinks if l != "base_link"]
+        self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]
+                           if frozenset((a, b)) not in disabled]
+        moving = [name for name in glinks if name != "base_link"]
         pairs: list[tuple[int, int]] = []
         for a, b in self.self_pairs:
             pairs += [(i, j) for i in objects[a] for j in objects[b]]
@@ -173,7 +166,8 @@ class CollisionChecker:
         self.set_margin(margin)
         try:
             pin.computeCollisions(self.model, self.data, self.gm, self.gd, np.asarray(q, float), False)
-            return self._named(p for p, r in zip(self.gm.collisionPairs, self.gd.collisionResults) if r.isCollision())
+            return self._named(p for p, r in zip(self.gm.collisionPairs, self.gd.collisionResults, strict=True)
+                               if r.isCollision())
         finally:
             self.set_margin(saved)
 
@@ -184,9 +178,10 @@ class CollisionChecker:
         q = np.clip(np.zeros(self.model.nq), self.lower, self.upper)
         pin.computeCollisions(self.model, self.data, self.gm_static, self.gd_static, q, False)
         deep = []
-        for p, r in zip(self.gm_static.collisionPairs, self.gd_static.collisionResults):
+        for p, r in zip(self.gm_static.collisionPairs, self.gd_static.collisionResults, strict=True):
             # coal's penetration_depth is a signed distance: negative inside
-            if r.isCollision() and min(r.getContact(k).penetration_depth for k in range(r.numContacts())) < -STATIC_TOLERANCE:
+            depth = min((r.getContact(k).penetration_depth for k in range(r.numContacts())), default=0.0)
+            if r.isCollision() and depth < -STATIC_TOLERANCE:
                 deep.append(p)
         return self._named(deep)
 
@@ -202,8 +197,9 @@ class CollisionChecker:
 
     def clearance(self, q) -> tuple[float, Contact | None]:
         """Smallest distance over the checked pairs at q (m; a negative value means in collision,
-        not necessarily the deepest penetration), and that pair. Pairs are visited in order of a lower bound (the distance between their world
-        axis-aligned boxes) and the search stops once the bound exceeds the best distance."""
+        not necessarily the deepest penetration), and that pair. Pairs are visited in order of a
+        lower bound (the distance between their world axis-aligned boxes) and the search stops
+        once the bound exceeds the best distance."""
         pin = self.pin
         pin.updateGeometryPlacements(self.model, self.data, self.gm, self.gd, np.asarray(q, float))
         lo = np.empty((len(self.owner), 3))
@@ -212,9 +208,9 @@ class CollisionChecker:
             M = self.gd.oMg[k]
             w = corners @ np.asarray(M.rotation).T + np.asarray(M.translation)
             lo[k], hi[k] = w.min(axis=0), w.max(axis=0)
-        I = np.array([p[0] for p in self.pairs])
-        J = np.array([p[1] for p in self.pairs])
-        gap = np.maximum(0.0, np.maximum(lo[J] - hi[I], lo[I] - hi[J]))
+        first = np.array([p[0] for p in self.pairs])
+        second = np.array([p[1] for p in self.pairs])
+        gap = np.maximum(0.0, np.maximum(lo[second] - hi[first], lo[first] - hi[second]))
         bound = np.sqrt((gap ** 2).sum(axis=1))
         best, which = math.inf, None
         for k in np.argsort(bound, kind="stable"):
@@ -236,7 +232,7 @@ class CollisionChecker:
         n = model.nq
         rho = np.zeros(model.njoints)  # farthest geometry point of each joint's body, from its origin
         for go in gm.geometryObjects:
-            v = _vertices(go.geometry) @ np.asarray(go.placement.rotation).T + np.asarray(go.placement.translation)
+            v = hull_points(go.geometry) @ np.asarray(go.placement.rotation).T + np.asarray(go.placement.translation)
             rho[go.parentJoint] = max(rho[go.parentJoint], float(np.sqrt((v ** 2).sum(axis=1)).max()))
         offset = [float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(model.njoints)]
         R = np.zeros(n)
