@@ -149,6 +149,8 @@ def render(doc: dict) -> str:
               f"   cached compile / xacro:     {verdict('cached')}",
               f"   cold lint / python -c pass: {verdict('lint')}", "",
               f"2. in-process, median over {doc['batches']} batches of {doc['per_batch']} calls (ms of CPU per call)"]
+    if not ip:
+        return "\n".join(lines[:-2])
     w = max(len(k) for k in ip) + 2
     goals = [GOALS["describe_model_ms"], GOALS["evaluate_ms"]]
     for (k, s), goal in zip(ip.items(), goals, strict=True):
@@ -165,6 +167,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="fewer repetitions")
     ap.add_argument("--runs", type=int, help="process runs per command (default 11, quick 5)")
     ap.add_argument("--json", nargs="?", const="-", metavar="PATH", help="JSON to stdout (table to stderr) or to PATH")
+    ap.add_argument("--processes-only", action="store_true",
+                    help="only part 1 (e.g. to measure an older checkout, which has no fast path)")
     args = ap.parse_args(argv)
     runs = args.runs or (5 if args.quick else 11)
     batches, per_batch = (5, 50) if args.quick else (15, 100)
@@ -174,7 +178,7 @@ def main(argv: list[str] | None = None) -> int:
         tmp = Path(t)
         xacro_file = prepare(src, tmp)
         processes = bench_processes(src, xacro_file, runs, tmp)
-    ip = bench_in_process(batches, per_batch)
+    ip = {} if args.processes_only else bench_in_process(batches, per_batch)
     med = {k: v["median"] for k, v in processes.items()}
     cpu = {k: v["cpu"]["median"] for k, v in processes.items()}
     names = list(med)

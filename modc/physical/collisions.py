@@ -40,8 +40,6 @@ the filter's margin keeps near-contacts out of the broad phase's hands).
 """
 from __future__ import annotations
 
-import tempfile
-import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -125,6 +123,9 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
     """Load a URDF and the meshes it references from an output tree held in memory
     ({relative path: content}, as backends produce it): the files are written to a temporary
     directory so that pinocchio resolves relative mesh paths exactly as a user's tools do."""
+    import tempfile
+    import xml.etree.ElementTree as ET
+
     import pinocchio as pin
 
     from ..files import write_files
