@@ -35,6 +35,8 @@ def _bytecode_cache(jinja2):
         directory.mkdir(parents=True, exist_ok=True)
     except OSError:
         return None
+    if not os.access(directory, os.W_OK):  # jinja would fail writing, and a read-only home means no cache
+        return None
     return jinja2.FileSystemBytecodeCache(str(directory))
 
 

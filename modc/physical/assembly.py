@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kinematics import A_J, A_t1, A_t2, transform
-from ..model import Robot
+from ..model import Robot, Transform
 from .inertia import Inertial, combine_groups, local_inertial, sphere
 from .parts import Part, unit_parts
 
@@ -130,6 +130,8 @@ def _unit(lib, variant: str, kind: int, link_length: float, pivot: float, port: 
 
 
 _EYE4 = np.eye(4)
+_FRAME_INERTIAL = sphere(FRAME_MASS, FRAME_RADIUS, (0.0, 0.0, 0.0))  # shared: inertials are never modified
+_NO_TOOL = Transform()
 
 
 def _link_inertials(inertials: list[list[tuple[Inertial, np.ndarray | None]]]) -> list[Inertial]:
@@ -180,9 +182,10 @@ def describe(robot: Robot) -> Description:
     carrying = [link for link, items in zip(links, inertials, strict=True) if items]
     for link, inertial in zip(carrying, _link_inertials(inertials), strict=True):
         link.inertial = inertial
-    links.append(Link("tool0", inertial=sphere(FRAME_MASS, FRAME_RADIUS, (0.0, 0.0, 0.0))))
-    T_flange_tool = transform(robot.tool.xyz, robot.tool.rpy)
-    joints.append(Joint("tool0_joint", "fixed", links[n].name, "tool0", T_prev_unit @ T_flange_tool))
+    links.append(Link("tool0", inertial=_FRAME_INERTIAL))
+    tool = robot.tool
+    T_last_tool = T_prev_unit if tool == _NO_TOOL else T_prev_unit @ transform(tool.xyz, tool.rpy)
+    joints.append(Joint("tool0_joint", "fixed", links[n].name, "tool0", T_last_tool))
     if robot.payload is not None:
         T = np.eye(4)
         T[:3, 3] = robot.payload.com

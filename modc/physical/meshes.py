@@ -134,6 +134,13 @@ def _primitive(prim: Primitive) -> tuple[np.ndarray, np.ndarray, np.ndarray | No
 
 @lru_cache(maxsize=256)
 def _tessellate(prims: tuple[Primitive, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    arrays = _arrays(prims)
+    for a in arrays:  # shared by every caller: read-only
+        a.setflags(write=False)
+    return arrays
+
+
+def _arrays(prims: tuple[Primitive, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     vs, fs, ns = [], [], []
     offset = 0
     for prim in prims:
