@@ -85,3 +85,15 @@ def test_inertias_are_physical():
         ev = np.linalg.eigvalsh(inertia)
         assert ev.min() > 0, link.name
         assert ev[0] + ev[1] >= ev[2] - 1e-15, link.name  # triangle inequality
+
+
+def test_fingerprint_follows_every_input_of_the_description():
+    """The key of the cached collision matrix and torque search: equal for equal arms, different
+    when anything they depend on differs."""
+    base = "robot r {\n    chain H1 - H4(pivot=-90deg) - L3\n%s}\n"
+    variants = ["", "    payload 0.2 kg\n", "    limit joint_2 (-90, 90) deg\n", "    tool at (0.05, 0, 0) m\n"]
+    prints = [describe(checked_ok(base % v).design.robots[0]).fingerprint() for v in variants]
+    prints.append(describe(checked_ok(base.replace("L3", "L3(link=200mm)") % "").design.robots[0]).fingerprint())
+    prints.append(describe(checked_ok(base.replace("-90deg", "-75deg") % "").design.robots[0]).fingerprint())
+    assert len(set(prints)) == len(prints)
+    assert describe(checked_ok(base % "").design.robots[0]).fingerprint() == prints[0]
