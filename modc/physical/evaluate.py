@@ -1,10 +1,12 @@
 """The fast path for design search: one candidate arm, evaluated in memory.
 
-    arm = Candidate(robot)            # Description + pinocchio Model (about 0.2 ms for 6 DoF)
+    arm = Candidate(robot)            # Description + pinocchio Model (~0.3-0.4 ms for 6 DoF)
     arm.tool(q)                       # T_base_tool, 4x4 (FK of tool0)
     arm.gravity(q)                    # g(q): the joint torques holding the arm still, N·m
     arm.collides(q)                   # any self- or environment collision at q
-    evaluate(robot, q)                # all three at once: an Evaluation
+    arm.collision(q)                  # the first colliding pair's names, or None
+    evaluate(robot, q)                # tool pose, g(q) and collision at once: an Evaluation
+                                      # (~1 ms for 6 DoF; benchmarks/bench_compile.py)
 
 Everything comes from the same Description the URDF backend renders (modc.physical.assembly)
 and the same pinocchio model and collision meshes the analyses use (modc.physical.multibody),
@@ -15,8 +17,9 @@ Collisions at one pose are judged as the SRDF judges them without sampling: pair
 joined by a joint (after collapsing links without geometry) never count, nor do pairs that
 touch in the default configuration (MoveIt's default joint values: touching by construction);
 every other pair of links, and every link but base_link against every obstacle of the file,
-does. base_link against the obstacles is fixed (the same in every pose) and left to
-`static_collisions()`.
+does. base_link against an obstacle is the same in every pose, so it is not counted here (the
+planner's CollisionChecker.static_contacts reports it). The collision model is built on the
+first query (about 0.4 ms), so arms rejected on reach or torque never pay for it.
 """
 from __future__ import annotations
 
