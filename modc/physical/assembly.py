@@ -103,9 +103,16 @@ class _Unit:
     A_t1: np.ndarray  # unit base -> twist1
     A_J0: np.ndarray  # twist1 -> joint at q = 0
     A_t2: np.ndarray | None  # joint -> twist2 (units with a link module)
+    # the parts' local inertials as arrays (masses, centres, inertias), input parts then output
+    # parts, and per input part the index of its frame (0 unit, 1 twist1, 2 joint)
+    masses: np.ndarray
+    centres: np.ndarray
+    inertias: np.ndarray
+    input_frames: np.ndarray
 
 
 _UNITS: dict[tuple, tuple[object, _Unit]] = {}  # per library (by identity) and unit settings
+_FRAMES = ("unit", "twist1", "joint")
 
 
 def _unit(lib, variant: str, kind: int, link_length: float, pivot: float, port: float) -> _Unit:
@@ -121,8 +128,11 @@ def _unit(lib, variant: str, kind: int, link_length: float, pivot: float, port: 
             out.append((p, local_inertial(p)))
         else:
             inp.append((p, p.frame, local_inertial(p)))
+    local = [i for _, _, i in inp] + [i for _, i in out]
     unit = _Unit(tuple(out), tuple(inp), A_t1(pivot, t.x01, t.z01), A_J(0.0, t.z12),
-                 A_t2(port, link_length) if t.link else None)
+                 A_t2(port, link_length) if t.link else None, np.array([i.mass for i in local]),
+                 np.array([i.com for i in local]), np.array([i.inertia for i in local]),
+                 np.array([_FRAMES.index(f) for _, f, _ in inp]))
     if len(_UNITS) >= 4096:
         _UNITS.clear()
     _UNITS[key] = (lib, unit)
@@ -134,20 +144,27 @@ _FRAME_INERTIAL = sphere(FRAME_MASS, FRAME_RADIUS, (0.0, 0.0, 0.0))  # shared: i
 _NO_TOOL = Transform()
 
 
-def _link_inertials(inertials: list[list[tuple[Inertial, np.ndarray | None]]]) -> list[Inertial]:
-    """Each link's parts combined (links without parts skipped): every part moved into its link
-    frame and every link combined in a few array operations for the whole arm."""
-    items = [it for group in inertials for it in group]
-    m = np.array([local.mass for local, _ in items])
-    C = np.array([local.com for local, _ in items])
-    inertia = np.array([local.inertia for local, _ in items])
-    moving = [k for k, (_, T) in enumerate(items) if T is not None]
+def _link_inertials(units: list[_Unit], frames: list[np.ndarray]) -> list[Inertial]:
+    """Every link's inertial (base_link, link_1 … link_n): each unit's input parts moved into
+    the link before it (by frames[3 i + k], k its frame index; unit 0's own frame is base_link's,
+    so those parts stay), its output parts kept in its joint frame, all links combined at once."""
+    m = np.concatenate([u.masses for u in units])
+    C = np.concatenate([u.centres for u in units])
+    inertia = np.concatenate([u.inertias for u in units])
+    moving, which, starts, k = [], [], [0], 0
+    for i, u in enumerate(units):
+        n_in = len(u.input_frames)
+        for j, f in enumerate(u.input_frames.tolist()):
+            if i or f:
+                moving.append(k + j)
+                which.append(3 * i + f)
+        starts.append(k + n_in)  # the next link starts with this unit's output parts
+        k += len(u.masses)
     if moving:
-        T = np.array([items[k][1] for k in moving])
+        T = np.array(frames)[which]
         R = T[:, :3, :3]
         C[moving] = (R @ C[moving][:, :, None])[:, :, 0] + T[:, :3, 3]
         inertia[moving] = R @ inertia[moving] @ R.transpose(0, 2, 1)
-    starts = np.cumsum([0] + [len(g) for g in inertials if g])[:-1].tolist()
     return combine_groups(m, C, inertia, starts)
 
 
@@ -158,7 +175,8 @@ def describe(robot: Robot) -> Description:
     n = robot.dof
     links = [Link("base_link")] + [Link(f"link_{i}") for i in range(1, n + 1)]
     joints: list[Joint] = []
-    inertials: list[list[tuple[Inertial, np.ndarray | None]]] = [[] for _ in range(n + 1)]  # (local, T or None)
+    units: list[_Unit] = []
+    frames: list[np.ndarray] = []  # per unit: its base, twist1 and joint (q = 0) frames in the link before it
     T_prev_unit = _EYE4  # unit i's base frame in the link before it
     for i, u in enumerate(robot.units):
         unit = _unit(lib, u.variant, u.kind, robot.link_length(u), u.pivot, u.port if lib.units[u.kind].link else 0.0)
@@ -166,22 +184,21 @@ def describe(robot: Robot) -> Description:
         T_prev_twist1 = T_prev_unit @ unit.A_t1
         T_prev_joint0 = T_prev_twist1 @ unit.A_J0
         input_side = {"unit": T_prev_unit, "twist1": T_prev_twist1, "joint": T_prev_joint0}
-        for p, frame, local in unit.input:
-            T = input_side[frame]
-            links[i].visuals.append(Visual(p, T))
-            inertials[i].append((local, None if T is _EYE4 else T))
-        for p, local in unit.output:
+        units.append(unit)
+        frames += [T_prev_unit, T_prev_twist1, T_prev_joint0]
+        for p, frame, _ in unit.input:
+            links[i].visuals.append(Visual(p, input_side[frame]))
+        for p, _ in unit.output:
             links[i + 1].visuals.append(Visual(p, _EYE4))
-            inertials[i + 1].append((local, None))
         v = lib.variants[u.variant]
         lo, hi = robot.joint_range(i + 1)
         joints.append(Joint(
             f"joint_{i + 1}", "revolute", links[i].name, links[i + 1].name, T_prev_joint0,
             Limits(lo, hi, v.actuator.torque_peak, v.actuator.velocity), u.variant))
         T_prev_unit = _EYE4 if unit.A_t2 is None else unit.A_t2
-    carrying = [link for link, items in zip(links, inertials, strict=True) if items]
-    for link, inertial in zip(carrying, _link_inertials(inertials), strict=True):
-        link.inertial = inertial
+    if units:
+        for link, inertial in zip(links, _link_inertials(units, frames), strict=True):
+            link.inertial = inertial
     links.append(Link("tool0", inertial=_FRAME_INERTIAL))
     tool = robot.tool
     T_last_tool = T_prev_unit if tool == _NO_TOOL else T_prev_unit @ transform(tool.xyz, tool.rpy)
