@@ -8,7 +8,8 @@ description of the URDF the urdf backend emits.
     group_state     "home" (Robot.home: the pose named home, else MoveIt's default values), then every
                     other named pose
     disable_collisions   the self-collision matrix of modc.physical.collisions: seeded and
-                    deterministic, computed on the emitted URDF and meshes with pinocchio + coal
+                    deterministic, computed with pinocchio + coal on the collision meshes the URDF references
+                    (built in memory from the same Description)
 
 Options, read from the Build when present (the CLI sets them), else the defaults:
     build.collision_samples   random configurations for Never/Always (default 10,000; 0 = only
@@ -45,28 +46,13 @@ def options(build: Build) -> tuple[int, int]:
     return samples, seed
 
 
-def robot_files(build: Build, robot: Robot) -> dict[str, str | bytes]:
-    """The emitted URDF and the meshes it references, as they appear in the output tree
-    (taken from earlier backends' output when present, else generated the same way)."""
-    from ..physical.meshes import stl_bytes
-    from .urdf import urdf_text
-
-    rel = f"urdf/{robot.file_stem}.urdf"
-    files: dict[str, str | bytes] = {rel: build.files.get(rel) or urdf_text(build, robot)}
-    for name, part in build.description(robot).parts.items():
-        mesh = f"meshes/{name}.stl"
-        files[mesh] = build.files.get(mesh) or stl_bytes(part)
-    return files
-
-
 def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
     """The robot's self-collision matrix, computed once per build (emit and warnings share it)."""
     samples, seed = options(build)
     cache = build.__dict__.setdefault(_CACHE, {})
     key = (robot.name, samples, seed)
     if key not in cache:
-        files = robot_files(build, robot)
-        cache[key] = collisions.cached_compute(files, f"urdf/{robot.file_stem}.urdf", samples, seed)
+        cache[key] = collisions.cached_matrix(build.description(robot), samples, seed)
     return cache[key]
 
 
