@@ -67,3 +67,112 @@ def test_pre_commit_hook_is_declared():
     hooks = yaml.safe_load((ROOT / ".pre-commit-hooks.yaml").read_text())
     lint_hook = next(h for h in hooks if h["id"] == "modc-lint")
     assert lint_hook["entry"] == "modc lint" and lint_hook["language"] == "python" and lint_hook["files"] == r"\.mod$"
+
+
+# --- SARIF for code scanning -------------------------------------------------------------------
+
+BAD = "robot a {\n    chain H1 - L4(port=40deg)\n}\n"
+
+
+def _sarif(cwd, *args: str) -> dict:
+    r = subprocess.run([sys.executable, "-m", "modc", "lint", "--format", "sarif", *args], capture_output=True,
+                       text=True, cwd=cwd)
+    assert r.returncode == 1, r.stderr
+    return json.loads(r.stdout)
+
+
+def _uris(doc: dict) -> list[dict]:
+    return [r["locations"][0]["physicalLocation"]["artifactLocation"] for r in doc["runs"][0]["results"]]
+
+
+def test_sarif_uris_are_percent_encoded_references_under_srcroot(tmp_path):
+    from urllib.parse import unquote, urlsplit
+
+    odd = tmp_path / "my arms" / "#2 bräu"
+    odd.mkdir(parents=True)
+    (odd / "farm:ä 1.mod").write_text(BAD, encoding="utf-8")
+    doc = _sarif(tmp_path, "my arms")
+    (loc,) = _uris(doc)
+    assert loc == {"uri": "my%20arms/%232%20br%C3%A4u/farm%3A%C3%A4%201.mod", "uriBaseId": "SRCROOT"}
+    parts = urlsplit(loc["uri"])  # a relative reference: no scheme, no fragment, the whole path kept
+    assert parts.scheme == "" and parts.fragment == "" and unquote(parts.path) == "my arms/#2 bräu/farm:ä 1.mod"
+    assert "SRCROOT" in doc["runs"][0]["originalUriBaseIds"]
+
+
+def test_sarif_root_and_files_outside_it(tmp_path):
+    repo, elsewhere = tmp_path / "repo", tmp_path / "elsewhere"
+    (repo / "arms").mkdir(parents=True)
+    elsewhere.mkdir()
+    (repo / "arms" / "a.mod").write_text(BAD, encoding="utf-8")
+    (elsewhere / "b.mod").write_text(BAD, encoding="utf-8")
+    # run from a subdirectory with --sarif-root at the repository: paths relative to the root
+    doc = _sarif(repo / "arms", "a.mod", "--sarif-root", str(repo))
+    assert _uris(doc) == [{"uri": "arms/a.mod", "uriBaseId": "SRCROOT"}]
+    # an absolute path and a file outside the root: an absolute file: URI, no uriBaseId
+    doc = _sarif(repo, str(repo / "arms" / "a.mod"), str(elsewhere / "b.mod"))
+    assert {json.dumps(u, sort_keys=True) for u in _uris(doc)} == {
+        json.dumps({"uri": "arms/a.mod", "uriBaseId": "SRCROOT"}, sort_keys=True),
+        json.dumps({"uri": (elsewhere / "b.mod").as_uri()}, sort_keys=True),
+    }
+
+
+def test_sarif_rules_carry_their_meaning_and_help():
+    from modc.diagnostics import REGISTRY
+
+    doc = json.loads(lint(BROKEN, "--format", "sarif").stdout)
+    rules = doc["runs"][0]["tool"]["driver"]["rules"]
+    assert [r["id"] for r in rules] == list(REGISTRY)
+    for rule in rules:
+        code = REGISTRY[rule["id"]]
+        assert rule["fullDescription"]["text"].startswith(code.summary)
+        assert rule["help"]["text"] and rule["help"]["markdown"]
+        assert "{" not in rule["fullDescription"]["text"].replace("{ ", "").replace("NAME {", "")
+    twist = next(r for r in rules if r["id"] == "twist-not-realisable")
+    assert "nearest realisable value" in twist["help"]["text"]
+
+
+def test_sarif_fingerprints_survive_moved_lines(tmp_path):
+    (tmp_path / "a.mod").write_text(BAD, encoding="utf-8")
+    before = _sarif(tmp_path, "a.mod")["runs"][0]["results"]
+    (tmp_path / "a.mod").write_text("# a comment moves everything down\n\n" + BAD, encoding="utf-8")
+    after = _sarif(tmp_path, "a.mod")["runs"][0]["results"]
+    assert before[0]["locations"] != after[0]["locations"]
+    assert before[0]["partialFingerprints"] == after[0]["partialFingerprints"]
+    (tmp_path / "a.mod").write_text(BAD.replace("40deg", "35deg"), encoding="utf-8")
+    changed = _sarif(tmp_path, "a.mod")["runs"][0]["results"]
+    assert changed[0]["partialFingerprints"] != before[0]["partialFingerprints"]
+
+
+def test_sarif_multitool_validates(tmp_path):
+    """Microsoft's Sarif.Multitool (npm @microsoft/sarif-multitool), where installed: no error or
+    warning (its notes are advice, such as a help URI per rule). Set SARIF_MULTITOOL to its path."""
+    import os
+    import shutil
+
+    tool = os.environ.get("SARIF_MULTITOOL") or shutil.which("sarif-multitool")
+    if tool is None:
+        pytest.skip("Sarif.Multitool not installed (npm install @microsoft/sarif-multitool; SARIF_MULTITOOL=path)")
+    sarif, out = tmp_path / "broken.sarif", tmp_path / "validation.sarif"
+    sarif.write_text(lint(BROKEN, "--format", "sarif").stdout, encoding="utf-8")
+    r = subprocess.run([tool, "validate", str(sarif), "-o", str(out), "--level", "Error", "Warning"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    findings = json.loads(out.read_text(encoding="utf-8"))["runs"][0]["results"]
+    assert findings == [], findings
+
+
+# --- text ----------------------------------------------------------------------------------------
+
+
+def test_caret_under_double_width_characters():
+    from modc.diagnostics import Span
+    from modc.diagnostics.codes import SYNTAX_ERROR
+    from modc.diagnostics.render import display_width, excerpt
+
+    line = "    pose 準備 (0, 0) dég"
+    col = line.index("dég") + 1  # columns count code points; a terminal shows 準 and 備 two cells wide
+    d = SYNTAX_ERROR.at(Span("t.mod", 1, col, 1, col + 3, col - 1, col + 2), found="x", expected="y", hint="")
+    src, caret = excerpt(line, d)
+    assert caret.index("^") - len("     | ") == display_width(line[:col - 1]) == (col - 1) + 2
+    assert caret.endswith(" ^^^")
+    assert display_width("準備") == 4 and display_width("é") == 1 and display_width("e\u0301") == 1

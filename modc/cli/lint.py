@@ -33,6 +33,9 @@ def lint_cmd(
     format: Annotated[LintFormat, typer.Option("--format", "-f", help="output format")] = LintFormat.text,
     library: LibraryOpt = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
+    sarif_root: Annotated[str, typer.Option("--sarif-root", metavar="DIR",
+                                            help="with --format sarif: the repository root that paths are "
+                                                 "relative to (files outside it get absolute file: URIs)")] = ".",
 ):
     """Check files without writing anything."""
     from ..compiler import InputError, check_file
@@ -57,7 +60,7 @@ def lint_cmd(
         if shown:
             print(render_github(shown))
     elif format is LintFormat.sarif:
-        print(render_sarif(shown, __version__))
+        print(render_sarif(shown, __version__, root=sarif_root, sources=sources))
     else:
         _print_diagnostics(diags, sources)
         if not quiet:
