@@ -7,9 +7,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from enum import Enum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
-import click
 import typer
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
@@ -121,20 +120,17 @@ def route(args: list[str], commands: list[str]) -> list[str] | str:
     return f"modc: no command or file '{word}': {suggestion}"
 
 
-def _metavar(param: click.Parameter) -> str:
+def _metavar(param: Any) -> str:
     """A plain metavar: the choices, N for a number, else the parameter's name (FILE, OUT)."""
-    desc = getattr(param, "type_descriptor", None)  # Typer >= 0.17 describes types itself
-    choices = desc.choices if desc is not None else getattr(param.type, "choices", None)
-    if choices:
-        return "|".join(str(getattr(c, "value", c)) for c in choices)
-    annotation = desc.annotation if desc is not None else None
-    if annotation in (int, float) or isinstance(getattr(param, "type", None), (click.types.IntParamType,
-                                                                                 click.types.FloatParamType)):
+    desc = param.type_descriptor  # Typer describes parameter types itself (it vendors click)
+    if desc.choices:
+        return "|".join(str(getattr(c, "value", c)) for c in desc.choices)
+    if desc.annotation in (int, float):
         return "N"
     return (param.name or "value").upper()
 
 
-def _plain_help(command: click.Command) -> None:
+def _plain_help(command: Any) -> None:
     """Help without Typer's `<str>` types and `{file}` braces: every parameter gets a metavar."""
     for param in command.params:
         if getattr(param, "is_flag", False) or param.name == "help":
@@ -144,8 +140,8 @@ def _plain_help(command: click.Command) -> None:
         if param.param_type_name == "argument":
             name = param.metavar + ("..." if param.nargs != 1 else "")
             usage = name if param.required else f"[{name}]"
-            param.display_type_rich = lambda ctx: None  # type: ignore[method-assign]
-            param._usage_display_name = lambda usage=usage: usage  # type: ignore[attr-defined]
+            param.display_type_rich = lambda ctx: None
+            param._usage_display_name = lambda usage=usage: usage
     for sub in getattr(command, "commands", {}).values():
         _plain_help(sub)
 
