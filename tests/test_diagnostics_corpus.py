@@ -7,8 +7,11 @@ further cases for one code are named ``<code>--<what>.mod`` (codes never contain
 
 Expectation comments (``#`` comments in all three formats):
 
-    # expect: SEVERITY[code]                 a diagnostic reported on THIS line
-    # expect: error[a], warning[b]           several on one line, comma separated
+    # expect: SEVERITY[code] message text    a diagnostic reported on THIS line, with exactly
+                                             this message (mypy's habit: the text is pinned,
+                                             not only the code)
+    # expect: error[a] text, warning[b] text several on one line, separated by ", " before
+                                             each SEVERITY[
     # expect-line N: SEVERITY[code], ...     reported on line N (1-based), written anywhere: for
                                              diagnostics where a trailing comment cannot sit, e.g.
                                              unclosed-block, reported where the file ends (one
@@ -18,6 +21,11 @@ Expectation comments (``#`` comments in all three formats):
                                              expectations are xfail(strict=False)
     # corpus-analyses: torque                check with these analyses on (as compile and
                                              `modc check` do; `modc lint` does not run them)
+
+The message text may be left out (``# expect: error[code]``) while writing a case; then
+``pytest tests/test_diagnostics_corpus.py --update-golden`` writes every reported message into
+the comments (the refresh path; review the diff), and ``test_every_expectation_pins_its_message``
+fails until it is there.
 
 "Reported on line L" means ``diagnostic.span.line == L``. Each case is checked the way the
 product checks it (``check_file`` for .mod/.yaml, ``convert_table`` for .csv) and the set of
@@ -53,7 +61,8 @@ CASES = sorted([*CORPUS_DIR.glob("*.mod"), *CORPUS_DIR.glob("*.yaml"), *CORPUS_D
 
 SEVERITIES = ("error", "warning", "note")
 _EXPECT = re.compile(r"#\s*expect(?:-line\s+(?P<n>\d+))?\s*:(?P<items>[^#]*)")
-_ITEM = re.compile(r"^\s*(?P<sev>[a-z]+)\[(?P<code>[a-z0-9-]+)\]\s*$")
+_ITEM = re.compile(r"^\s*(?P<sev>[a-z]+)\[(?P<code>[a-z0-9-]+)\](?:\s+(?P<msg>.*?))?\s*$")
+_ITEM_SEP = re.compile(r",\s*(?=(?:error|warning|note)\[)")
 _XFAIL = re.compile(r"#\s*corpus-xfail:\s*(?P<reason>.+)")
 _ANALYSES = re.compile(r"#\s*corpus-analyses:\s*(?P<names>[a-z, -]+)")
 # Codes only the analyses report (compile and `modc check`, not `modc lint`).
@@ -80,17 +89,52 @@ def source_text(path: Path) -> str:
     return path.read_bytes().decode("utf-8-sig", errors="replace")
 
 
-def expectations(path: Path) -> set[tuple[int, str, str]]:
-    """{(line, severity, code)} written in the file's `# expect` comments."""
-    out = set()
+def pinned(path: Path) -> list[tuple[int, str, str, str | None]]:
+    """[(line, severity, code, message or None)] written in the file's `# expect` comments."""
+    out = []
     for i, line in enumerate(source_text(path).split("\n"), start=1):
         for m in _EXPECT.finditer(line):
             at = int(m.group("n")) if m.group("n") else i
-            for item in m.group("items").split(","):
+            for item in _ITEM_SEP.split(m.group("items")):
                 im = _ITEM.match(item)
-                assert im, f"{path.name}:{i}: malformed expectation {item!r} (write severity[code])"
-                out.add((at, im.group("sev"), im.group("code")))
+                assert im, f"{path.name}:{i}: malformed expectation {item!r} (write severity[code] message)"
+                out.append((at, im.group("sev"), im.group("code"), im.group("msg") or None))
     return out
+
+
+def expectations(path: Path) -> set[tuple[int, str, str]]:
+    """{(line, severity, code)} written in the file's `# expect` comments."""
+    return {(at, sev, code) for at, sev, code, _ in pinned(path)}
+
+
+def refresh_messages(path: Path, diags: list[Diagnostic]) -> None:
+    """Rewrite the `# expect` comments with the messages reported (--update-golden). Only the
+    comment is rewritten: the bytes before it (maybe not UTF-8, on purpose) are kept."""
+    by_key: dict[tuple[int, str, str], list[str]] = {}
+    for d in sorted(diags, key=lambda d: (d.span.line, d.span.col)):
+        by_key.setdefault((d.span.line, d.severity.value, d.code), []).append(d.message)
+    raw = path.read_bytes().split(b"\n")
+    for i, chunk in enumerate(raw):
+        line = chunk.decode("utf-8", errors="replace")
+        first = _EXPECT.search(line)
+        if first is None:
+            continue
+        tail = line[first.start():]
+
+        def items(m: re.Match, i: int = i, tail: str = tail) -> str:
+            at = int(m.group("n")) if m.group("n") else i + 1
+            out = []
+            for item in _ITEM_SEP.split(m.group("items")):
+                im = _ITEM.match(item)
+                assert im is not None
+                msgs = by_key.get((at, im.group("sev"), im.group("code")), [im.group("msg") or ""])
+                out += [f"{im.group('sev')}[{im.group('code')}] {msg}".rstrip() for msg in dict.fromkeys(msgs)]
+            head = m.group(0)[:m.start("items") - m.start(0)]
+            return head + " " + ", ".join(out) + ("  " if m.end(0) < len(tail) else "")
+
+        if chunk.endswith(tail.encode("utf-8")):
+            raw[i] = chunk[:len(chunk) - len(tail.encode("utf-8"))] + _EXPECT.sub(items, tail).encode("utf-8")
+    path.write_bytes(b"\n".join(raw))
 
 
 def xfail_reason(path: Path) -> str | None:
@@ -157,15 +201,32 @@ def test_corpus_is_not_empty():
 
 
 @pytest.mark.parametrize("path", [case_param(p) for p in CASES])
-def test_corpus(path: Path):
+def test_corpus(path: Path, update_golden):
     expected = expectations(path)
     assert expected, f"{path.name} has no `# expect` comment"
-    got = reported(run_case(path))
+    diags = run_case(path)
+    got = reported(diags)
     missing, extra = expected - got, got - expected
     assert not missing and not extra, (
         f"{path.name}:\n  missing (expected, not reported):\n{_show(missing)}\n"
         f"  extra (reported, not expected):\n{_show(extra)}"
     )
+    if update_golden:
+        refresh_messages(path, diags)
+    messages = {(d.span.line, d.severity.value, d.code, d.message) for d in diags}
+    wrong = [p for p in pinned(path) if p[3] is not None and p not in messages]
+    assert not wrong, (
+        f"{path.name}: messages changed:\n" + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in wrong)
+        + "\n  reported:\n" + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in sorted(messages))
+        + "\n  refresh with: pytest tests/test_diagnostics_corpus.py --update-golden (and review the diff)"
+    )
+
+
+@pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES])
+def test_every_expectation_pins_its_message(path: Path):
+    bare = [(ln, sev, code) for ln, sev, code, msg in pinned(path) if msg is None]
+    assert not bare, (f"{path.name}: expectations without their message text {bare}; write them with "
+                      "pytest tests/test_diagnostics_corpus.py --update-golden")
 
 
 @pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES])
@@ -548,3 +609,16 @@ def test_plan_errors(tmp_path, capsys):
     d = e.value.diagnostics[0]
     assert d.code == "no-path" and e.value.exit_code == 1 and d.hint
     assert d.code in REGISTRY and d.severity == REGISTRY[d.code].severity
+
+
+def test_pinned_messages_are_read_and_compared(tmp_path):
+    """Messages may contain commas; a changed message is caught; the refresh writes it back."""
+    case = tmp_path / "missing-dash.mod"
+    case.write_text("robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] expected '-', found nothing\n}\n",
+                    encoding="utf-8")
+    assert pinned(case) == [(2, "error", "missing-dash", "expected '-', found nothing")]
+    diags = run_case(case)
+    assert (2, "error", "missing-dash", diags[0].message) != pinned(case)[0]
+    refresh_messages(case, diags)
+    assert pinned(case) == [(2, "error", "missing-dash", diags[0].message)]
+    assert case.read_text(encoding="utf-8").startswith("robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] ")
