@@ -282,3 +282,24 @@ def test_textmate_grammar_tests_catch_a_wrong_scope(tmp_path):
     r = _run_grammar_tests(broken)
     assert r.returncode != 0
     assert "missing required scopes: keyword.other.at.mod" in r.stdout, r.stdout + r.stderr
+
+
+def test_vsce_packages_the_extension(tmp_path):
+    """`vsce package` (pinned in package-lock.json, through editors/vscode/package.sh) makes a
+    .vsix: no relative README link, a repository field, a LICENSE; the runtime dependency and the
+    grammar inside, the grammar tests and scripts left out."""
+    import zipfile
+
+    if shutil.which("npm") is None or shutil.which("node") is None:
+        pytest.skip("npm/node not installed: packaging the VS Code extension needs them")
+    vsix = tmp_path / "modc.vsix"
+    r = subprocess.run(["bash", str(VSCODE / "package.sh"), "-o", str(vsix)], capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stdout + r.stderr
+    names = set(zipfile.ZipFile(vsix).namelist())
+    assert {"extension/package.json", "extension/extension.js", "extension/syntaxes/mod.tmLanguage.json",
+            "extension/language-configuration.json", "extension/readme.md", "extension.vsixmanifest"} <= {
+        n if not n.lower().endswith("readme.md") else n.lower() for n in names}
+    assert any(n.lower().startswith("extension/license") for n in names)
+    assert any(n.startswith("extension/node_modules/vscode-languageclient/") for n in names)
+    assert not any(n.startswith(("extension/tests/", "extension/node_modules/@vscode/vsce")) for n in names)
+    assert "extension/test.sh" not in names and "extension/package.sh" not in names
