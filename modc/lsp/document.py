@@ -6,9 +6,10 @@ Two views of a document are used side by side:
 
 - the checked one (modc.compiler.check_text: the AST's spans and the model), exact but only
   there when the file parses;
-- a token view (a small lexer over the raw text and an outline of `robot NAME { statement … }`
-  blocks), which needs no parse and so keeps completion, hover, symbols and definitions
-  working while a file is half typed.
+- the error-tolerant parse (tolerant.py: the same grammar, restarted after errors and closed
+  with placeholders), which keeps completion, symbols and definitions working while a file is
+  half typed; and a token view of the raw text (`lex`: words, numbers, comments) that tells
+  hover what is under the cursor.
 
 Every position conversion goes through convert.LineIndex; the server (server.py) only
 converts LSP positions to offsets and back.
@@ -22,6 +23,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import NamedTuple
 
+from lark import Token, Tree
 from lsprotocol import types
 
 from ..compiler import YAML_SUFFIXES, Checked, check_text
@@ -29,8 +31,7 @@ from ..model.library import Library
 from ..model.library import default as default_library
 from ..model.library import load as load_library
 from ..syntax import ast
-from . import convert
-from .language import DECLARING, NAME_TAKERS, STATEMENTS
+from . import convert, language, tolerant
 
 # --- tokens and outline ---------------------------------------------------------------------------
 
@@ -69,108 +70,74 @@ def lex(text: str) -> list[Tok]:
 
 
 @dataclass
-class Stmt:
-    keyword: Tok
-    toks: list[Tok] = field(default_factory=list)
-
-    @property
-    def end(self) -> int:
-        return self.toks[-1].end if self.toks else self.keyword.end
-
-    @property
-    def declared(self) -> Tok | None:
-        """The name a pose, target or obstacle statement declares."""
-        if self.keyword.text in DECLARING and self.toks and self.toks[0].kind == "word":
-            return self.toks[0]
-        return None
-
-
-@dataclass
 class Block:
-    """`robot NAME { … }` as tokens: what survives a half-typed file."""
+    """A block (`robot NAME { … }`) of the error-tolerant parse: what survives a half-typed file.
+    Statements are parse trees whose tokens carry offsets into the document."""
 
-    robot: Tok
-    name: Tok | None = None
-    start: int = 0
-    end: int = 0
-    closed: bool = False
-    depth: int = 0  # brace depth reached at the end of the tokens seen (0 = header not opened)
-    stmts: list[Stmt] = field(default_factory=list)
+    keyword: str
+    name: Token | None
+    start: int
+    end: int
+    stmts: list[Tree] = field(default_factory=list)
 
-    def find(self, keyword: str) -> list[Stmt]:
-        return [s for s in self.stmts if s.keyword.text == keyword]
+    def find(self, kind: str) -> list[Tree]:
+        return [s for s in self.stmts if s.data == kind]
 
 
-def outline(toks: list[Tok], text_len: int) -> list[Block]:
+def tokens_of(node: Tree | Token) -> list[Token]:
+    """The document's own tokens of a tree (placeholders left out), in order."""
+    if isinstance(node, Token):
+        return [node] if tolerant.real(node) else []
+    return [t for t in node.scan_values(lambda v: isinstance(v, Token)) if tolerant.real(t)]
+
+
+def extent(node: Tree | Token) -> tuple[int, int] | None:
+    toks = tokens_of(node)
+    return (toks[0].start_pos, toks[-1].end_pos) if toks else None
+
+
+def declared(stmt: Tree) -> Token | None:
+    """The name a statement declares (pose, target, obstacles: keywords that take a NAME)."""
+    if stmt.data in language.name_takers() - language.REFERS and stmt.children:
+        first = stmt.children[0]
+        if isinstance(first, Token) and first.type == "NAME" and tolerant.real(first):
+            return first
+    return None
+
+
+def outline(text: str) -> list[Block]:
+    """The blocks of the tolerant parse; statements after an error inside a block stay in it."""
     blocks: list[Block] = []
-    cur: Block | None = None
-    paren = 0
-    prev: Tok | None = None
-    for t in toks:
-        if t.kind == "comment":
+    for base, inside, tree in tolerant.outline(text):
+        for tok in tree.scan_values(lambda v: isinstance(v, Token)):
+            if tolerant.real(tok):
+                tok.start_pos += base
+                tok.end_pos += base
+        name = tree.children[0] if tree.children and isinstance(tree.children[0], Token) else None
+        stmts = [c for c in tree.children if isinstance(c, Tree)]
+        if inside is not None and blocks and (name is None or not tolerant.real(name)):
+            blocks[-1].stmts += stmts
             continue
-        takes_name = prev is not None and prev.text in NAME_TAKERS
-        if t.bol and t.kind == "word" and t.text in (*STATEMENTS, "robot") and not takes_name:
-            paren = 0  # a keyword first on its line starts afresh, whatever was left open before
-        if t.kind == "word" and t.text == "robot" and not takes_name and paren == 0 and (cur is None or cur.depth <= 1 or t.bol):
-            if cur is not None:  # a robot inside an unclosed robot: the old one ends here
-                cur.end = t.start
-            cur = Block(robot=t, start=t.start, end=text_len)
-            blocks.append(cur)
-            paren = 0
-        elif cur is None:
-            pass  # top-level junk
-        elif cur.depth == 0:
-            if t.text == "{":
-                cur.depth = 1
-            elif cur.name is None and t.kind in ("word", "code"):
-                cur.name = t
-        else:
-            if t.text == "(":
-                paren += 1
-            elif t.text == ")":
-                paren = max(0, paren - 1)
-            if t.text == "}" and cur.depth == 1:
-                cur.end, cur.closed, cur.depth = t.end, True, 0
-                cur = None
-                paren = 0
-                prev = t
-                continue
-            if t.text == "{":
-                cur.depth += 1
-            elif t.text == "}":
-                cur.depth -= 1
-            if t.kind == "word" and t.text in STATEMENTS and cur.depth == 1 and paren == 0 and not takes_name:
-                cur.stmts.append(Stmt(t))
-                paren = 0
-            elif cur.stmts:
-                cur.stmts[-1].toks.append(t)
-        prev = t
+        span = extent(tree)
+        start = name.start_pos if name is not None and tolerant.real(name) else (span[0] if span else base)
+        start = max(0, text.rfind(language.keyword_of(tree.data) or tree.data, 0, start + 1))
+        blocks.append(Block(tree.data, name if name is not None and tolerant.real(name) else None, start,
+                            len(text), stmts))
+    for a, b in zip(blocks, blocks[1:]):
+        a.end = b.start
     return blocks
-
-
-def unit_words(toks: list[Tok]) -> list[Tok]:
-    """Unit-name tokens of a chain statement's body (words outside parentheses)."""
-    out, paren = [], 0
-    for t in toks:
-        if t.text == "(":
-            paren += 1
-        elif t.text == ")":
-            paren = max(0, paren - 1)
-        elif paren == 0 and t.kind == "word":
-            out.append(t)
-    return out
 
 
 def block_joints(block: Block) -> list[tuple[str, tuple[int, int]]] | None:
     """(unit text, offsets) of the joints of a block's first chain (its units) or dh table (its
     rows); None when it has neither."""
     for st in block.stmts:
-        if st.keyword.text == "chain":
-            return [(t.text, (t.start, t.end)) for t in unit_words(st.toks)]
-        if st.keyword.text == "dh":
-            rows = [t for t in st.toks if t.text == "row"]
-            return [(f"row {i}", (t.start, t.end)) for i, t in enumerate(rows, 1)]
+        if st.data == "chain":
+            units = [t for t in tokens_of(st) if t.type == "UNIT_NAME"]
+            return [(str(t), (t.start_pos, t.end_pos)) for t in units]
+        if st.data == "dh":
+            rows = [r for r in st.children if isinstance(r, Tree) and r.data == "dh_row" and extent(r)]
+            return [(f"row {i}", extent(r) or (0, 0)) for i, r in enumerate(rows, 1)]
     return None
 
 
@@ -230,7 +197,7 @@ class Analysis:
 
     @cached_property
     def blocks(self) -> list[Block]:
-        return [] if self.is_yaml else outline(self.tokens, len(self.text))
+        return [] if self.is_yaml else outline(self.text)
 
     def offsets(self, span) -> tuple[int, int]:
         return self.index.span_offsets(span)
@@ -273,7 +240,7 @@ class Analysis:
         return None
 
     def blocks_named(self, robot: str | None) -> list[Block]:
-        return [b for b in self.blocks if b.name is not None and b.name.text == robot]
+        return [b for b in self.blocks if b.name is not None and b.name == robot]
 
     def robot_at(self, offset: int) -> str | None:
         for r in self.tree.robots:
@@ -281,7 +248,7 @@ class Analysis:
             if a <= offset <= b:
                 return r.name.text
         b = self.block_at(offset)
-        return b.name.text if b is not None and b.name is not None else None
+        return str(b.name) if b is not None and b.name is not None else None
 
     @cached_property
     def model_robots(self) -> tuple:
@@ -314,7 +281,8 @@ class Analysis:
         block = next(iter(self.blocks_named(robot)), None)
         if block is not None:
             for st in block.find("library"):
-                if st.toks and (lib := self.library_ref(st.toks[0].text)) is not None:
+                ref = tokens_of(st)
+                if ref and (lib := self.library_ref(str(ref[0]))) is not None:
                     return lib
         return default_library()
 
@@ -336,11 +304,15 @@ class Analysis:
         for b in self.blocks:
             if b.name is None:
                 continue
-            out.append(Decl("robot", b.name.text, None, (b.name.start, b.name.end), (b.start, b.end)))
+            out.append(Decl(b.keyword, str(b.name), None, (b.name.start_pos, b.name.end_pos), (b.start, b.end)))
             for st in b.stmts:
-                if (n := st.declared) is not None:
-                    out.append(Decl(st.keyword.text, n.text, b.name.text, (n.start, n.end), (st.keyword.start, st.end)))
+                if (n := declared(st)) is not None and (rng := extent(st)) is not None:
+                    out.append(Decl(st.data, str(n), str(b.name), (n.start_pos, n.end_pos), self.stmt_range(st, rng)))
         return out
+
+    def stmt_range(self, st: Tree, rng: tuple[int, int]) -> tuple[int, int]:
+        """A statement's offsets from its keyword (which the tree leaves out) to its last token."""
+        return max(0, self.text.rfind(language.keyword_of(st.data) or st.data, 0, rng[0] + 1)), rng[1]
 
     def units_of(self, robot: str) -> list[tuple[str, tuple[int, int]]]:
         """(unit text, offsets) of a robot's joints in order: chain units, or dh rows."""

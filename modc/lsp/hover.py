@@ -10,7 +10,8 @@ from lsprotocol import types
 from ..diagnostics import REGISTRY
 from ..model.library import Library
 from .document import Analysis, Tok, joint_number
-from .language import KEYWORDS, MEASURES, NAME_TAKERS, PARAMS, UNIT_PARAMS
+from .language import MEASURES, PARAMS, REFERS, UNIT_PARAMS, keyword_doc, name_takers
+from .language import all_keywords as language_keywords
 
 
 def _g(x: float) -> str:
@@ -74,7 +75,7 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
     robot = an.robot_at(tok.start)
     lib = an.library_for(robot)
     md = None
-    if prev is not None and prev.text in NAME_TAKERS - {"limit"} and tok.kind == "word":
+    if prev is not None and prev.text in name_takers() - REFERS and tok.kind == "word":
         md = _decl_markdown(an, text, robot, prev.text)
     elif text in PARAMS and nxt is not None and nxt.text in ("=", ":"):
         md = param_markdown(text, lib)
@@ -86,8 +87,8 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
         md = _joint_markdown(an, robot, n)
     elif tok.kind == "word" and lib.split(text) is not None:
         md = unit_markdown(lib, text, _unit_spec_at(an, robot, tok))
-    elif text in KEYWORDS:
-        md = KEYWORDS[text]
+    elif text in language_keywords():
+        md = keyword_doc(text)
     elif text in MEASURES and prev is not None and (prev.kind == "number" or prev.text == ")"):
         kind, word = MEASURES[text]
         md = f"**{text}**: {word} ({kind})"

@@ -9,7 +9,7 @@ from lsprotocol import types
 from ..model.library import resolve as resolve_library
 from ..syntax import ast
 from . import convert
-from .document import DECL_KINDS, Analysis, Tok, joint_number, unit_words
+from .document import DECL_KINDS, Analysis, Tok, declared, extent, joint_number, tokens_of
 
 SYMBOL_KIND = {
     "robot": types.SymbolKind.Class, "chain": types.SymbolKind.Array, "unit": types.SymbolKind.Module,
@@ -51,16 +51,21 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
             continue
         children = []
         for st in b.stmts:
-            kw = st.keyword.text
-            rng = (st.keyword.start, st.end)
-            if kw == "chain":
-                units = [_sym(an, t.text, "unit", (t.start, t.end), (t.start, t.end), f"joint_{i}") for i, t in enumerate(unit_words(st.toks), 1)]
-                children.append(_sym(an, "chain", "chain", rng, (st.keyword.start, st.keyword.end), "", units))
-            elif kw == "dh":
-                children.append(_sym(an, "dh", "dh", rng, (st.keyword.start, st.keyword.end)))
-            elif (n := st.declared) is not None:
-                children.append(_sym(an, n.text, kw, rng, (n.start, n.end), kw))
-        out.append(_sym(an, b.name.text, "robot", (b.start, b.end), (b.name.start, b.name.end), "robot", children))
+            if (rng := extent(st)) is None:
+                continue
+            rng = an.stmt_range(st, rng)
+            keyword = (rng[0], rng[0] + len(st.data))
+            if st.data == "chain":
+                units = [_sym(an, str(t), "unit", (t.start_pos, t.end_pos), (t.start_pos, t.end_pos), f"joint_{i}")
+                         for i, t in enumerate((t for t in tokens_of(st) if t.type == "UNIT_NAME"), 1)]
+                children.append(_sym(an, "chain", "chain", rng, keyword, "", units))
+            elif st.data == "dh":
+                children.append(_sym(an, "dh", "dh", rng, keyword))
+            elif (n := declared(st)) is not None and st.data in SYMBOL_KIND:
+                children.append(_sym(an, str(n), st.data, rng, (n.start_pos, n.end_pos), st.data))
+        name = (b.name.start_pos, b.name.end_pos)
+        out.append(_sym(an, str(b.name), b.keyword if b.keyword in SYMBOL_KIND else "robot", (b.start, b.end), name,
+                        b.keyword, children))
     return out
 
 
