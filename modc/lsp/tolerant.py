@@ -59,6 +59,7 @@ def _restart() -> re.Pattern[str]:
     return re.compile(r"^[ \t]*(" + "|".join(map(re.escape, words)) + r")(?![\w-])", re.M)
 
 
+@cache
 def _block_for(keyword: str) -> str | None:
     """The block keyword whose body accepts `keyword` (None: it is accepted at the top level)."""
     if keyword in language.declaration_keywords():
@@ -87,11 +88,11 @@ def _open_block(stack: list[Any]) -> str | None:
     return None
 
 
-def _segments(text: str):
-    """Yield (segment, interactive parser at its end, error offset or None) over the whole text.
-    After an error the parse restarts at the next line that begins with a keyword; failing that,
-    at the end of the text when the error's line is over (so that a new line may start afresh)."""
-    pos, inside = 0, None
+def _segments(text: str, pos: int = 0, inside: str | None = None):
+    """Yield (segment, interactive parser at its end, error offset or None) over the text from
+    pos (inside a block of that kind). After an error the parse restarts at the next line that
+    begins with a keyword; failing that, at the end of the text when the error's line is over
+    (so that a new line may start afresh)."""
     while True:
         ip = _lark().parse_interactive(text[pos:], start="start")
         if inside is not None:
@@ -120,7 +121,16 @@ def _segments(text: str):
 
 def stand_at(text: str) -> Stand:
     """The parser at the end of text (errors before it skipped as described above)."""
-    *_, (_seg, ip, err) = _segments(text)
+    # Only the last statement matters: start at the last line that begins with a keyword whose
+    # block is known (not `row`, whose `dh { … }` may span lines), so the cost does not grow
+    # with the file.
+    pos, inside = 0, None
+    for m in reversed(list(_restart().finditer(text))):
+        word = m.group(1)
+        if word in language.declaration_keywords() or (block := _block_for(word)) is not None:
+            pos, inside = m.start(1), (None if word in language.declaration_keywords() else block)
+            break
+    *_, (_seg, ip, err) = _segments(text, pos, inside)
     if err is not None:  # an error on the cursor's own line: nothing is known at the cursor
         return Stand(frozenset(), [], ok=False)
     return Stand(frozenset(ip.accepts()), list(ip.parser_state.value_stack))
