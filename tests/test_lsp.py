@@ -591,3 +591,82 @@ def test_each_version_is_parsed_once(monkeypatch, path, text):
         hover(an, off)
         definition(an, off, "file://" + path)
     assert len(calls) == 1
+
+
+# --- the language described once: read from the grammar ---------------------------------------------
+
+def test_keyword_classes_are_read_from_the_grammar():
+    from modc.lsp import language
+
+    assert language.declaration_keywords() == {"robot"}
+    assert language.statements() == ("chain", "dh", "library", "base", "tool", "payload", "pose", "limit", "box",
+                                      "sphere", "cylinder", "target", "allow")
+    assert language.statements("dh") == ("row",)
+    assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links"}
+    assert language.name_takers() == {"robot", "pose", "limit", "box", "sphere", "cylinder", "target"}
+    assert language.syntax_of("cylinder") == "cylinder NAME radius QUANTITY length QUANTITY at (…) rpy (…)"
+
+
+def test_every_value_keyword_has_a_quantity_kind():
+    """A keyword followed by a quantity or vector in the grammar needs its kind (length, angle,
+    mass) in language.QUANTITY_KINDS, so that completion offers the right units of measure."""
+    from modc.lsp import language
+
+    assert language.value_keywords() <= set(language.QUANTITY_KINDS), sorted(
+        language.value_keywords() - set(language.QUANTITY_KINDS))
+
+
+GRAMMAR_PLUS = {
+    # a new statement: grammar only
+    '     | allow\n': '     | allow\n     | gripper\n',
+    'allow: "allow"': 'gripper: "gripper" NAME at\nallow: "allow"',
+    # a new top-level block with its own statement
+    'start: robot*': 'start: (robot | design)*\ndesign: "design" NAME "{" use* "}"\nuse: "use" NAME',
+}
+
+
+@pytest.fixture
+def grammar_plus(monkeypatch, tmp_path):
+    """The real grammar with a new statement (`gripper NAME at (…)`) and a new top-level block
+    (`design NAME { use NAME }`): nothing else changed."""
+    from lark import Lark
+
+    import modc.syntax.parser as parser
+    from modc.lsp import language
+    from modc.resources import data_dir
+
+    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
+    for old, new in GRAMMAR_PLUS.items():
+        assert old in text
+        text = text.replace(old, new)
+    lark = Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True,
+                start=["start", "unit_text", "quantity_text", "vector_text"])
+    monkeypatch.setattr(parser, "_lark", lambda: lark)
+    language.reset()
+    yield
+    monkeypatch.undo()
+    language.reset()
+
+
+def _labels(items) -> list[str]:
+    return [i.label for i in items]
+
+
+def test_a_new_statement_needs_no_language_server_change(grammar_plus):
+    from modc.lsp import language
+
+    assert "gripper" in language.statements() and "gripper" in language.name_takers()
+    assert language.declaration_keywords() == {"robot", "design"} and language.statements("design") == ("use",)
+    got = _labels(complete(Analysis("robot a {\n    chain H1 - L1\n    ", "/x/a.mod"), 33))
+    assert got[-1] == "gripper" and got[:-1] == list(language.statements())[:-1]
+    text = "robot a {\n    chain H1 - L1\n    gripper g "
+    assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["at"]
+    text += "at (0, 0, 0.1) "
+    assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["m", "cm", "mm"]
+    assert set(_labels(complete(Analysis("", "/x/a.mod"), 0))) == {"robot", "design"}
+    text = "design d {\n    "
+    assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["use"]
+    # the half-typed outline declares the new statement's name
+    an = Analysis("robot a {\n    chain H1 - L1\n    gripper g at (0, 0", "/x/a.mod")
+    assert [(d.kind, d.name) for d in an.blocks and an.decls] == [("robot", "a"), ("gripper", "g")]
+    assert hover(an, an.text.index("gripper") + 1) is not None

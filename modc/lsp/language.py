@@ -14,10 +14,14 @@ from ..model import quantities
 
 # --- read from the grammar ---------------------------------------------------------------------
 
-def _lark():
-    from ..syntax.parser import _lark as lark
+def grammar():
+    """The Lark parser of grammar/modc.lark (looked up on every call: tests swap it)."""
+    from ..syntax import parser
 
-    return lark()
+    return parser._lark()
+
+
+_lark = grammar
 
 
 @cache
@@ -146,6 +150,17 @@ def syntax_of(keyword: str) -> str:
         else:
             words.append({"LBRACE": "{", "RBRACE": "}", "LPAR": "(", "RPAR": ")", "MINUS": "-", "COMMA": ","}.get(sym, sym))
     return " ".join(words)
+
+
+def reset() -> None:
+    """Forget what was read from the grammar (tests that swap the grammar call this)."""
+    for fn in (_literals, _blocks, declaration_keywords, statement_keywords, clause_keywords, name_takers,
+               value_keywords):
+        fn.cache_clear()
+    from . import tolerant
+
+    tolerant._restart.cache_clear()
+    tolerant._block_for.cache_clear()
 
 
 def statements(block: str = "robot") -> tuple[str, ...]:

@@ -24,7 +24,6 @@ from typing import Any
 from lark import Token, Tree
 from lark.exceptions import UnexpectedInput
 
-from ..syntax.parser import _lark
 from . import language
 
 END = "$END"
@@ -65,7 +64,7 @@ def _block_for(keyword: str) -> str | None:
     if keyword in language.declaration_keywords():
         return None
     for block in sorted(language.declaration_keywords()):
-        ip = _lark().parse_interactive("", start="start")
+        ip = language.grammar().parse_interactive("", start="start")
         try:
             for tok in _opening(block):
                 ip.feed_token(tok)
@@ -94,7 +93,7 @@ def _segments(text: str, pos: int = 0, inside: str | None = None):
     begins with a keyword; failing that, at the end of the text when the error's line is over
     (so that a new line may start afresh)."""
     while True:
-        ip = _lark().parse_interactive(text[pos:], start="start")
+        ip = language.grammar().parse_interactive(text[pos:], start="start")
         if inside is not None:
             for tok in _opening(inside):
                 ip.feed_token(tok)
