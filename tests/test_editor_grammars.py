@@ -97,13 +97,40 @@ def keyword_classes() -> dict[str, set[str]]:
             "CLAUSES": set(language.clause_keywords())}
 
 
-def test_textmate_keywords_match_the_lark_grammar(tmlanguage):
+def _keyword_rule(name: str, kind: str, words: list[str]) -> str:
+    """A TextMate repository entry matching words, as written in mod.tmLanguage.json."""
+    alternatives = "|".join(f"({w})" for w in words)
+    captures = ",\n".join(f'        "{i}": {{ "name": "keyword.{kind}.{w}.mod" }}' for i, w in enumerate(words, 1))
+    return (f'    "{name}": {{\n      "match": "(?<![\\\\w-])(?:{alternatives})(?![\\\\w-])",\n'
+            f'      "captures": {{\n{captures}\n      }}\n    }}')
+
+
+def refresh_textmate(tmlanguage: dict, missing: dict[str, set[str]], path: Path = TMLANGUAGE) -> None:
+    """Add keywords the TextMate grammar lacks to its generic rules: statements to `placement`,
+    clauses to `clause` (keywords with a structure of their own need a hand-written rule)."""
+    text = path.read_text(encoding="utf-8")
+    for name, kind in (("placement", "control"), ("clause", "other")):
+        rule = tmlanguage["repository"][name]
+        words = [c["name"].split(".")[2] for _, c in sorted(rule["captures"].items(), key=lambda kv: int(kv[0]))]
+        words += sorted(missing[kind] - set(words))
+        m = re.search(rf'^    "{name}": \{{\n(?:.*\n)*?    \}}', text, re.M)
+        assert m, name
+        text = text[:m.start()] + _keyword_rule(name, kind, words) + text[m.end():]
+    json.loads(text)
+    path.write_text(text, encoding="utf-8")
+
+
+def test_textmate_keywords_match_the_lark_grammar(tmlanguage, update_golden):
     scopes = scope_names(tmlanguage)
     got = {kind: {m.group(1) for s in scopes if (m := re.fullmatch(rf"keyword\.{kind}\.([a-z]+(?:-[a-z]+)*)\.mod", s))}
            for kind in ("control", "other")}
     got["other"] -= {"unit"}
     want = keyword_classes()
     expected = {"control": want["DECLARATIONS"] | want["STATEMENTS"], "other": want["CLAUSES"]}
+    if update_golden and any(expected[k] - got[k] for k in got):
+        refresh_textmate(tmlanguage, {k: expected[k] - got[k] for k in got})
+        pytest.skip("editors/vscode/syntaxes/mod.tmLanguage.json: keywords added to its generic rules; add "
+                    "assertions for them in editors/vscode/tests/*.mod")
     for kind in ("control", "other"):
         assert got[kind] == expected[kind], (
             f"editors/vscode/syntaxes/mod.tmLanguage.json: keyword.{kind} lacks {sorted(expected[kind] - got[kind])}, "
@@ -111,6 +138,15 @@ def test_textmate_keywords_match_the_lark_grammar(tmlanguage):
             "keyword.control.<kw>.mod (block or statement) or keyword.other.<kw>.mod (clause) and an assertion in "
             "editors/vscode/tests/*.mod"
         )
+
+
+def test_textmate_refresh_adds_a_new_keyword(tmlanguage, tmp_path):
+    copy = tmp_path / "mod.tmLanguage.json"
+    copy.write_text(TMLANGUAGE.read_text(encoding="utf-8"), encoding="utf-8")
+    refresh_textmate(tmlanguage, {"control": {"gripper"}, "other": {"grip"}}, copy)
+    scopes = scope_names(json.loads(copy.read_text(encoding="utf-8")))
+    assert {"keyword.control.gripper.mod", "keyword.other.grip.mod"} <= scopes
+    assert scope_names(tmlanguage) <= scopes
 
 
 def test_textmate_units_of_measure_match_the_model(tmlanguage):
