@@ -1,5 +1,6 @@
 """The command line as people meet it: the light install (lint, fmt, lsp without the heavy
 extras), a clear line when a command needs `modc[full]`, a mistyped command, the help text."""
+
 from __future__ import annotations
 
 import json
@@ -9,12 +10,11 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from conftest import ROOT
 
 # Blocks the `full` extra's modules on import, as if they were not installed: the light install
 # tested without building a second venv (which is too slow for CI).
-BLOCKER = '''
+BLOCKER = """
 import sys
 BLOCKED = {"pinocchio", "coal", "hppfcl", "pybullet", "pybullet_data", "ompl", "trimesh", "PIL", "mujoco"}
 class _Blocker:
@@ -23,17 +23,26 @@ class _Blocker:
             raise ModuleNotFoundError(f"No module named {name!r}", name=name)
         return None
 sys.meta_path.insert(0, _Blocker())
-'''
+"""
 FARM = ROOT / "examples" / "farm.mod"
 
 
-def modc(*args: str, cwd: Path = ROOT, light: Path | None = None, stdin: str | None = None) -> subprocess.CompletedProcess:
+def modc(
+    *args: str, cwd: Path = ROOT, light: Path | None = None, stdin: str | None = None
+) -> subprocess.CompletedProcess:
     env = dict(os.environ)
     if light is not None:  # a sitecustomize on PYTHONPATH runs before modc
         (light / "sitecustomize.py").write_text(BLOCKER, encoding="utf-8")
         env["PYTHONPATH"] = os.pathsep.join([str(light), str(ROOT), env.get("PYTHONPATH", "")])
-    return subprocess.run([sys.executable, "-m", "modc", *args], capture_output=True, text=True, cwd=cwd, env=env,
-                          input=stdin, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "modc", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env=env,
+        input=stdin,
+        timeout=300,
+    )
 
 
 @pytest.fixture
@@ -80,12 +89,15 @@ def test_lsp_works_from_the_light_install(light):
     assert b"Traceback" not in b"".join(c.stderr)
 
 
-@pytest.mark.parametrize("command", [
-    [str(FARM), "-o", "OUT"],  # compile (meshes: trimesh)
-    ["sim", str(FARM)],
-    ["plan", str(FARM), "--to", "plant"],
-    ["check", str(FARM)],
-])
+@pytest.mark.parametrize(
+    "command",
+    [
+        [str(FARM), "-o", "OUT"],  # compile (meshes: trimesh)
+        ["sim", str(FARM)],
+        ["plan", str(FARM), "--to", "plant"],
+        ["check", str(FARM)],
+    ],
+)
 def test_a_command_that_needs_the_full_extra_says_so(light, tmp_path, command):
     command = [str(tmp_path / "out") if a == "OUT" else a for a in command]
     r = modc(*command, light=light)
@@ -131,7 +143,9 @@ def test_a_file_is_still_compiled_without_the_command(tmp_path):
     assert "did you mean" not in r.stderr
 
 
-@pytest.mark.parametrize("command", ["", "compile", "lint", "fmt", "check", "plan", "sim", "render", "play", "dh2mod", "dh"])
+@pytest.mark.parametrize(
+    "command", ["", "compile", "lint", "fmt", "check", "plan", "sim", "render", "play", "dh2mod", "dh"]
+)
 def test_help_has_plain_metavars_and_defaults(command):
     r = modc(*([command] if command else []), "--help")
     assert r.returncode == 0, r.stderr

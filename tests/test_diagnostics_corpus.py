@@ -40,6 +40,7 @@ Codes that are not about the text of a file (file-not-found, output-not-modc, â€
 the test functions named in ``FUNCTION_CASES``; ``test_every_code_is_covered`` checks that every
 code in the registry has a corpus file (that is not a known failure) or such a function.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -76,14 +77,25 @@ FUNCTION_CASES = {
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
     "traj-invalid": "test_traj_invalid",
-    **{code: "test_plan_errors" for code in ("target-unknown", "pose-unknown", "robot-unknown", "start-in-collision",
-                                             "target-unreachable", "target-in-collision", "no-path")},
+    **{
+        code: "test_plan_errors"
+        for code in (
+            "target-unknown",
+            "pose-unknown",
+            "robot-unknown",
+            "start-in-collision",
+            "target-unreachable",
+            "target-in-collision",
+            "no-path",
+        )
+    },
 }
 
 YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
 
 
 # --- reading expectations ----------------------------------------------------------------------
+
 
 def source_text(path: Path) -> str:
     return path.read_bytes().decode("utf-8-sig", errors="replace")
@@ -119,7 +131,7 @@ def refresh_messages(path: Path, diags: list[Diagnostic]) -> None:
         first = _EXPECT.search(line)
         if first is None:
             continue
-        tail = line[first.start():]
+        tail = line[first.start() :]
 
         def items(m: re.Match, i: int = i, tail: str = tail) -> str:
             at = int(m.group("n")) if m.group("n") else i + 1
@@ -129,11 +141,11 @@ def refresh_messages(path: Path, diags: list[Diagnostic]) -> None:
                 assert im is not None
                 msgs = by_key.get((at, im.group("sev"), im.group("code")), [im.group("msg") or ""])
                 out += [f"{im.group('sev')}[{im.group('code')}] {msg}".rstrip() for msg in dict.fromkeys(msgs)]
-            head = m.group(0)[:m.start("items") - m.start(0)]
+            head = m.group(0)[: m.start("items") - m.start(0)]
             return head + " " + ", ".join(out) + ("  " if m.end(0) < len(tail) else "")
 
         if chunk.endswith(tail.encode("utf-8")):
-            raw[i] = chunk[:len(chunk) - len(tail.encode("utf-8"))] + _EXPECT.sub(items, tail).encode("utf-8")
+            raw[i] = chunk[: len(chunk) - len(tail.encode("utf-8"))] + _EXPECT.sub(items, tail).encode("utf-8")
     path.write_bytes(b"\n".join(raw))
 
 
@@ -196,6 +208,7 @@ def _show(items) -> str:
 
 # --- the corpus ----------------------------------------------------------------------------------
 
+
 def test_corpus_is_not_empty():
     assert len(CASES) >= 30
 
@@ -216,8 +229,10 @@ def test_corpus(path: Path, update_golden):
     messages = {(d.span.line, d.severity.value, d.code, d.message) for d in diags}
     wrong = [p for p in pinned(path) if p[3] is not None and p not in messages]
     assert not wrong, (
-        f"{path.name}: messages changed:\n" + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in wrong)
-        + "\n  reported:\n" + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in sorted(messages))
+        f"{path.name}: messages changed:\n"
+        + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in wrong)
+        + "\n  reported:\n"
+        + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in sorted(messages))
         + "\n  refresh with: pytest tests/test_diagnostics_corpus.py --update-golden (and review the diff)"
     )
 
@@ -225,8 +240,10 @@ def test_corpus(path: Path, update_golden):
 @pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES])
 def test_every_expectation_pins_its_message(path: Path):
     bare = [(ln, sev, code) for ln, sev, code, msg in pinned(path) if msg is None]
-    assert not bare, (f"{path.name}: expectations without their message text {bare}; write them with "
-                      "pytest tests/test_diagnostics_corpus.py --update-golden")
+    assert not bare, (
+        f"{path.name}: expectations without their message text {bare}; write them with "
+        "pytest tests/test_diagnostics_corpus.py --update-golden"
+    )
 
 
 @pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES])
@@ -240,13 +257,14 @@ def test_expectations_name_registered_codes_with_their_severity():
     for path in CASES:
         for line, sev, code in expectations(path):
             assert code in REGISTRY, f"{path.name}:{line}: unknown code {code!r}"
-            assert sev == REGISTRY[code].severity.value, f"{path.name}:{line}: {code} is a {REGISTRY[code].severity.value}"
+            assert sev == REGISTRY[code].severity.value, (
+                f"{path.name}:{line}: {code} is a {REGISTRY[code].severity.value}"
+            )
 
 
 def _covered_by_corpus() -> set[str]:
     """Codes with a corpus case that is not a known failure."""
-    return {case_code(p) for p in CASES
-            if case_code(p) in {c for _, _, c in expectations(p)} and not xfail_reason(p)}
+    return {case_code(p) for p in CASES if case_code(p) in {c for _, _, c in expectations(p)} and not xfail_reason(p)}
 
 
 def test_every_code_is_covered():
@@ -343,7 +361,9 @@ def test_corpus_json_offsets_match_lines(path: Path):
 
 # --- the command line over the corpus ----------------------------------------------------------
 
-_HEAD = re.compile(r"^(?P<file>.+?):(?P<line>\d+):(?P<col>\d+): (?P<sev>error|warning|note)\[(?P<code>[a-z0-9-]+)\]: ", re.M)
+_HEAD = re.compile(
+    r"^(?P<file>.+?):(?P<line>\d+):(?P<col>\d+): (?P<sev>error|warning|note)\[(?P<code>[a-z0-9-]+)\]: ", re.M
+)
 
 
 def run_cli(capsys, *args: str) -> tuple[int, str, str]:
@@ -362,7 +382,9 @@ def run_lint(capsys, *args: str) -> tuple[int, str, str]:
 
 def text_heads(stderr: str, path: Path) -> set[tuple[int, str, str]]:
     """(line, severity, code) of the rendered diagnostics in a text report about one file."""
-    return {(int(m["line"]), m["sev"], m["code"]) for m in _HEAD.finditer(stderr) if m["file"] in (str(path), "<unknown>")}
+    return {
+        (int(m["line"]), m["sev"], m["code"]) for m in _HEAD.finditer(stderr) if m["file"] in (str(path), "<unknown>")
+    }
 
 
 def _exit_code_for(path: Path, got: set) -> int:
@@ -403,6 +425,7 @@ def test_corpus_through_the_command_line(path: Path, capsys):
 
 
 # --- codes that are not about the text of a file -------------------------------------------------------
+
 
 def test_file_not_found(tmp_path, capsys):
     missing = tmp_path / "nope.mod"
@@ -460,7 +483,9 @@ def test_output_not_modc_from_the_command_line(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     (out / "notes.txt").write_text("mine", encoding="utf-8")
-    p = subprocess.run([sys.executable, "-m", "modc", str(src), "-o", str(out)], capture_output=True, text=True, timeout=120)
+    p = subprocess.run(
+        [sys.executable, "-m", "modc", str(src), "-o", str(out)], capture_output=True, text=True, timeout=120
+    )
     assert p.returncode == 2, p.stderr
     assert "error[output-not-modc]" in p.stderr and "Traceback" not in p.stderr
     assert [x.name for x in out.iterdir()] == ["notes.txt"]
@@ -537,9 +562,13 @@ def test_utf8_bom_is_accepted(tmp_path):
 
 # --- rendering details ---------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("sep", ["\f", "\v", "\x1c", "\x85", "\u2028", "\u2029"], ids=repr)
 def test_excerpt_uses_the_same_lines_as_the_parser(sep):
-    text = f"# a comment with a {sep} in it\nrobot farm {{\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 30) deg\n}}\n"
+    text = (
+        f"# a comment with a {sep} in it\nrobot farm {{\n    chain H1 - L4(port=45deg) - L1\n"
+        "    pose home (0, 30) deg\n}\n"
+    )
     c = check_text(text, "t.mod")
     assert [(d.span.line, d.code) for d in c.diagnostics] == [(4, "pose-arity")]
     check_rendered(c.diagnostics[0], text, "t.mod")
@@ -557,8 +586,11 @@ def test_traj_invalid(tmp_path):
     traj = tmp_path / "t.json"
     traj.write_text(json.dumps({"joint_names": ["joint_1", "joint_9"], "points": [{"t": 0, "q": [0, 0]}]}))
     src = HERE.parent / "examples" / "quickstart.mod"
-    r = subprocess.run([sys.executable, "-m", "modc", "play", str(src), "--traj", str(traj), "--headless"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", "play", str(src), "--traj", str(traj), "--headless"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 1, r.stderr
     assert f"{traj}:1:1: error[traj-invalid]:" in r.stderr and "= hint:" in r.stderr and "Traceback" not in r.stderr
 
@@ -587,9 +619,13 @@ def test_plan_errors(tmp_path, capsys):
     cell = tmp_path / "cell.mod"
     cell.write_text(PLAN_CELL, encoding="utf-8")
     blocked = tmp_path / "blocked.mod"
-    blocked.write_text(PLAN_CELL.replace("    pose home (0, 0, 0) deg\n",
-                                         "    pose home (0, 0, 0) deg\n    box shelf size (0.3, 0.3, 0.02) m at (-0.1, 0, 0.33) m\n"),
-                       encoding="utf-8")
+    blocked.write_text(
+        PLAN_CELL.replace(
+            "    pose home (0, 0, 0) deg\n",
+            "    pose home (0, 0, 0) deg\n    box shelf size (0.3, 0.3, 0.02) m at (-0.1, 0, 0.33) m\n",
+        ),
+        encoding="utf-8",
+    )
     cases = [  # (arguments, exit code, code, where it points)
         (["plan", str(cell), "--to", "tomato", "--robot", "farm"], 2, "target-unknown", "<command line>:1:1"),
         (["plan", str(cell), "--to", "inside", "--start", "nowhere"], 2, "pose-unknown", "<command line>:1:1"),
@@ -614,11 +650,15 @@ def test_plan_errors(tmp_path, capsys):
 def test_pinned_messages_are_read_and_compared(tmp_path):
     """Messages may contain commas; a changed message is caught; the refresh writes it back."""
     case = tmp_path / "missing-dash.mod"
-    case.write_text("robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] expected '-', found nothing\n}\n",
-                    encoding="utf-8")
+    case.write_text(
+        "robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] expected '-', found nothing\n}\n",
+        encoding="utf-8",
+    )
     assert pinned(case) == [(2, "error", "missing-dash", "expected '-', found nothing")]
     diags = run_case(case)
     assert (2, "error", "missing-dash", diags[0].message) != pinned(case)[0]
     refresh_messages(case, diags)
     assert pinned(case) == [(2, "error", "missing-dash", diags[0].message)]
-    assert case.read_text(encoding="utf-8").startswith("robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] ")
+    assert case.read_text(encoding="utf-8").startswith(
+        "robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] "
+    )

@@ -9,6 +9,7 @@ Units of measure come from modc.model.quantities. The
 TextMate grammar's own assertions (editors/vscode/tests/*.mod) run under vscode-tmgrammar-test
 through editors/vscode/test.sh, which needs node and npm (skipped, saying so, without npm).
 """
+
 from __future__ import annotations
 
 import json
@@ -93,16 +94,21 @@ def keyword_classes() -> dict[str, set[str]]:
     """The keyword lists as the grammar gives them."""
     from modc.lsp import language
 
-    return {"DECLARATIONS": set(language.declaration_keywords()), "STATEMENTS": set(language.statement_keywords()),
-            "CLAUSES": set(language.clause_keywords())}
+    return {
+        "DECLARATIONS": set(language.declaration_keywords()),
+        "STATEMENTS": set(language.statement_keywords()),
+        "CLAUSES": set(language.clause_keywords()),
+    }
 
 
 def _keyword_rule(name: str, kind: str, words: list[str]) -> str:
     """A TextMate repository entry matching words, as written in mod.tmLanguage.json."""
     alternatives = "|".join(f"({w})" for w in words)
     captures = ",\n".join(f'        "{i}": {{ "name": "keyword.{kind}.{w}.mod" }}' for i, w in enumerate(words, 1))
-    return (f'    "{name}": {{\n      "match": "(?<![\\\\w-])(?:{alternatives})(?![\\\\w-])",\n'
-            f'      "captures": {{\n{captures}\n      }}\n    }}')
+    return (
+        f'    "{name}": {{\n      "match": "(?<![\\\\w-])(?:{alternatives})(?![\\\\w-])",\n'
+        f'      "captures": {{\n{captures}\n      }}\n    }}'
+    )
 
 
 def refresh_textmate(tmlanguage: dict, missing: dict[str, set[str]], path: Path = TMLANGUAGE) -> None:
@@ -115,22 +121,26 @@ def refresh_textmate(tmlanguage: dict, missing: dict[str, set[str]], path: Path 
         words += sorted(missing[kind] - set(words))
         m = re.search(rf'^    "{name}": \{{\n(?:.*\n)*?    \}}', text, re.M)
         assert m, name
-        text = text[:m.start()] + _keyword_rule(name, kind, words) + text[m.end():]
+        text = text[: m.start()] + _keyword_rule(name, kind, words) + text[m.end() :]
     json.loads(text)
     path.write_text(text, encoding="utf-8")
 
 
 def test_textmate_keywords_match_the_lark_grammar(tmlanguage, update_golden):
     scopes = scope_names(tmlanguage)
-    got = {kind: {m.group(1) for s in scopes if (m := re.fullmatch(rf"keyword\.{kind}\.([a-z]+(?:-[a-z]+)*)\.mod", s))}
-           for kind in ("control", "other")}
+    got = {
+        kind: {m.group(1) for s in scopes if (m := re.fullmatch(rf"keyword\.{kind}\.([a-z]+(?:-[a-z]+)*)\.mod", s))}
+        for kind in ("control", "other")
+    }
     got["other"] -= {"unit"}
     want = keyword_classes()
     expected = {"control": want["DECLARATIONS"] | want["STATEMENTS"], "other": want["CLAUSES"]}
     if update_golden and any(expected[k] - got[k] for k in got):
         refresh_textmate(tmlanguage, {k: expected[k] - got[k] for k in got})
-        pytest.skip("editors/vscode/syntaxes/mod.tmLanguage.json: keywords added to its generic rules; add "
-                    "assertions for them in editors/vscode/tests/*.mod")
+        pytest.skip(
+            "editors/vscode/syntaxes/mod.tmLanguage.json: keywords added to its generic rules; add "
+            "assertions for them in editors/vscode/tests/*.mod"
+        )
     for kind in ("control", "other"):
         assert got[kind] == expected[kind], (
             f"editors/vscode/syntaxes/mod.tmLanguage.json: keyword.{kind} lacks {sorted(expected[kind] - got[kind])}, "
@@ -172,8 +182,13 @@ def test_pygments_keywords_match_the_lark_grammar(update_golden):
         text = LEXER_FILE.read_text(encoding="utf-8")
         for name, words in want.items():
             listed = ", ".join(f'"{w}"' for w in sorted(words)) + ("," if len(words) == 1 else "")
-            line = textwrap.fill(f"{name} = ({listed})", width=110, subsequent_indent=" " * (len(name) + 4),
-                                 break_long_words=False, break_on_hyphens=False)
+            line = textwrap.fill(
+                f"{name} = ({listed})",
+                width=110,
+                subsequent_indent=" " * (len(name) + 4),
+                break_long_words=False,
+                break_on_hyphens=False,
+            )
             text = re.sub(rf"^{name} = \((?:[^()]*)\)", lambda _m, line=line: line, text, count=1, flags=re.M)
         LEXER_FILE.write_text(text, encoding="utf-8")
         pytest.skip("modc/pygments_lexer.py keyword lists rewritten from the grammar: review the diff")
@@ -276,7 +291,14 @@ def test_pygments_lexer_loads_from_its_file():
 
     lexer = load_lexer_from_file(str(LEXER_FILE), "ModLexer")
     assert lexer.name == "modc"
-    assert [v for _, v in lexer.get_tokens("robot r { chain H1 }") if v.strip()] == ["robot", "r", "{", "chain", "H1", "}"]
+    assert [v for _, v in lexer.get_tokens("robot r { chain H1 }") if v.strip()] == [
+        "robot",
+        "r",
+        "{",
+        "chain",
+        "H1",
+        "}",
+    ]
 
 
 def test_pyproject_registers_the_lexer():
@@ -330,7 +352,9 @@ def test_grammar_tests_have_the_header():
 def _run_grammar_tests(*files: Path) -> subprocess.CompletedProcess:
     if shutil.which("npm") is None or shutil.which("node") is None:
         pytest.skip("npm/node not installed: the TextMate grammar tests (editors/vscode/test.sh) need them")
-    return subprocess.run(["bash", str(VSCODE / "test.sh"), *map(str, files)], capture_output=True, text=True, timeout=600)
+    return subprocess.run(
+        ["bash", str(VSCODE / "test.sh"), *map(str, files)], capture_output=True, text=True, timeout=600
+    )
 
 
 def test_textmate_grammar_tests_pass():
@@ -343,7 +367,9 @@ def test_textmate_grammar_tests_pass():
 def test_textmate_grammar_tests_catch_a_wrong_scope(tmp_path):
     """The harness really fails: a test file asserting a wrong scope makes test.sh exit non-zero."""
     broken = tmp_path / "broken.mod"
-    broken.write_text('# SYNTAX TEST "source.mod"\nrobot r { chain H1 }\n#         ^^^^^ keyword.other.at.mod\n', encoding="utf-8")
+    broken.write_text(
+        '# SYNTAX TEST "source.mod"\nrobot r { chain H1 }\n#         ^^^^^ keyword.other.at.mod\n', encoding="utf-8"
+    )
     r = _run_grammar_tests(broken)
     assert r.returncode != 0
     assert "missing required scopes: keyword.other.at.mod" in r.stdout, r.stdout + r.stderr
@@ -358,12 +384,19 @@ def test_vsce_packages_the_extension(tmp_path):
     if shutil.which("npm") is None or shutil.which("node") is None:
         pytest.skip("npm/node not installed: packaging the VS Code extension needs them")
     vsix = tmp_path / "modc.vsix"
-    r = subprocess.run(["bash", str(VSCODE / "package.sh"), "-o", str(vsix)], capture_output=True, text=True, timeout=900)
+    r = subprocess.run(
+        ["bash", str(VSCODE / "package.sh"), "-o", str(vsix)], capture_output=True, text=True, timeout=900
+    )
     assert r.returncode == 0, r.stdout + r.stderr
     names = set(zipfile.ZipFile(vsix).namelist())
-    assert {"extension/package.json", "extension/extension.js", "extension/syntaxes/mod.tmLanguage.json",
-            "extension/language-configuration.json", "extension/readme.md", "extension.vsixmanifest"} <= {
-        n if not n.lower().endswith("readme.md") else n.lower() for n in names}
+    assert {
+        "extension/package.json",
+        "extension/extension.js",
+        "extension/syntaxes/mod.tmLanguage.json",
+        "extension/language-configuration.json",
+        "extension/readme.md",
+        "extension.vsixmanifest",
+    } <= {n if not n.lower().endswith("readme.md") else n.lower() for n in names}
     assert any(n.lower().startswith("extension/license") for n in names)
     assert any(n.startswith("extension/node_modules/vscode-languageclient/") for n in names)
     assert not any(n.startswith(("extension/tests/", "extension/node_modules/@vscode/vsce")) for n in names)

@@ -1,4 +1,5 @@
 """`modc lint --format text|json|github|sarif`: golden outputs, SARIF validated against its schema."""
+
 from __future__ import annotations
 
 import json
@@ -6,7 +7,6 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import ROOT
 
 LINT = ROOT / "tests" / "lint"
@@ -30,8 +30,11 @@ def test_format_golden(fmt, update_golden):
 
 def test_github_annotations_are_workflow_commands():
     lines = lint(BROKEN, "--format", "github").stdout.splitlines()
-    assert lines and all(l.startswith("::error file=tests/lint/broken.mod,line=") for l in lines)
-    assert "::error file=tests/lint/broken.mod,line=3,col=19,endLine=3,endColumn=29,title=modc twist-not-realisable::" in lines[0]
+    assert lines and all(line.startswith("::error file=tests/lint/broken.mod,line=") for line in lines)
+    assert (
+        "::error file=tests/lint/broken.mod,line=3,col=19,endLine=3,endColumn=29,title=modc twist-not-realisable::"
+        in lines[0]
+    )
 
 
 def test_sarif_is_valid_sarif_2_1_0():
@@ -44,7 +47,13 @@ def test_sarif_is_valid_sarif_2_1_0():
     jsonschema.validate(doc, schema)
     results = doc["runs"][0]["results"]
     rules = doc["runs"][0]["tool"]["driver"]["rules"]
-    assert {r["ruleId"] for r in results} == {"twist-not-realisable", "missing-unit", "illegal-succession", "last-variant", "pose-arity"}
+    assert {r["ruleId"] for r in results} == {
+        "twist-not-realisable",
+        "missing-unit",
+        "illegal-succession",
+        "last-variant",
+        "pose-arity",
+    }
     assert all(rules[r["ruleIndex"]]["id"] == r["ruleId"] for r in results)
 
 
@@ -52,7 +61,12 @@ def test_globs_and_directories(tmp_path):
     (tmp_path / "a").mkdir()
     (tmp_path / "a" / "x.mod").write_text("robot x { chain H1 - L1 }\n")
     (tmp_path / "a" / "y.mod").write_text("robot y { chain H1 - H1 }\n")
-    r = subprocess.run([sys.executable, "-m", "modc", "lint", "**/*.mod", "--format", "json"], capture_output=True, text=True, cwd=tmp_path)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", "lint", "**/*.mod", "--format", "json"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert r.returncode == 1
     assert {d["file"] for d in json.loads(r.stdout)["diagnostics"]} == {"a/y.mod"}
     r = subprocess.run([sys.executable, "-m", "modc", "lint", "a"], capture_output=True, text=True, cwd=tmp_path)
@@ -75,8 +89,9 @@ BAD = "robot a {\n    chain H1 - L4(port=40deg)\n}\n"
 
 
 def _sarif(cwd, *args: str) -> dict:
-    r = subprocess.run([sys.executable, "-m", "modc", "lint", "--format", "sarif", *args], capture_output=True,
-                       text=True, cwd=cwd)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", "lint", "--format", "sarif", *args], capture_output=True, text=True, cwd=cwd
+    )
     assert r.returncode == 1, r.stderr
     return json.loads(r.stdout)
 
@@ -154,8 +169,12 @@ def test_sarif_multitool_validates(tmp_path):
         pytest.skip("Sarif.Multitool not installed (npm install @microsoft/sarif-multitool; SARIF_MULTITOOL=path)")
     sarif, out = tmp_path / "broken.sarif", tmp_path / "validation.sarif"
     sarif.write_text(lint(BROKEN, "--format", "sarif").stdout, encoding="utf-8")
-    r = subprocess.run([tool, "validate", str(sarif), "-o", str(out), "--level", "Error", "Warning"],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [tool, "validate", str(sarif), "-o", str(out), "--level", "Error", "Warning"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stdout + r.stderr
     findings = json.loads(out.read_text(encoding="utf-8"))["runs"][0]["results"]
     assert findings == [], findings
@@ -173,6 +192,6 @@ def test_caret_under_double_width_characters():
     col = line.index("dég") + 1  # columns count code points; a terminal shows 準 and 備 two cells wide
     d = SYNTAX_ERROR.at(Span("t.mod", 1, col, 1, col + 3, col - 1, col + 2), found="x", expected="y", hint="")
     src, caret = excerpt(line, d)
-    assert caret.index("^") - len("     | ") == display_width(line[:col - 1]) == (col - 1) + 2
+    assert caret.index("^") - len("     | ") == display_width(line[: col - 1]) == (col - 1) + 2
     assert caret.endswith(" ^^^")
     assert display_width("準備") == 4 and display_width("é") == 1 and display_width("e\u0301") == 1

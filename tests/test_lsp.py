@@ -1,6 +1,7 @@
 """The language server (`python -m modc.lsp`, i.e. `modc lsp`), driven as a real process over
 stdio by modc.lsp.client (JSON-RPC with Content-Length framing over pipes), plus in-process
 tests of the position conversions and the completion heuristics."""
+
 from __future__ import annotations
 
 import statistics
@@ -12,13 +13,13 @@ import pytest
 from modc.compiler import check_text
 from modc.diagnostics import REGISTRY
 from modc.lsp import convert
+from modc.lsp.client import Client
 from modc.lsp.completion import complete
 from modc.lsp.document import Analysis
 from modc.lsp.formatting import formatting
 from modc.lsp.hover import hover
 from modc.lsp.language import keyword_doc, statements
 from modc.lsp.symbols import definition, symbols
-from modc.lsp.client import Client
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT / "tests" / "diagnostics"
@@ -68,9 +69,14 @@ def server():
     c = start_server()
     yield c
     code = c.shutdown()
-    errors = [m for _, m in c.notifications if m.get("method") in ("window/logMessage", "window/showMessage")
-              and m["params"]["type"] == 1 and "modc:" in m["params"]["message"]
-              and not m["params"]["message"].startswith("modc: checking")]  # compiler bugs: see the corpus test
+    errors = [
+        m
+        for _, m in c.notifications
+        if m.get("method") in ("window/logMessage", "window/showMessage")
+        and m["params"]["type"] == 1
+        and "modc:" in m["params"]["message"]
+        and not m["params"]["message"].startswith("modc: checking")
+    ]  # compiler bugs: see the corpus test
     assert code == 0
     assert not errors, errors  # no handler of ours failed during the whole module
 
@@ -89,6 +95,7 @@ def open_doc(server: Client, text: str, name: str = "t.mod", directory: Path | N
 
 
 # --- lifecycle and capabilities ----------------------------------------------------------------------
+
 
 def test_initialize_advertises_features():
     with Client([sys.executable, "-m", "modc.lsp"], cwd=str(ROOT)) as c:
@@ -115,18 +122,27 @@ def test_exit_without_shutdown_and_closed_stdin_end_the_process():
 
 # --- diagnostics ------------------------------------------------------------------------------------
 
+
 def test_diagnostics_on_open_and_cleared_by_a_fix(server):
     text = "robot a {\n    chain H1 - L4(port=40deg) - L1\n}\n"
     uri = open_doc(server, text)
     [d] = server._last_diags
     assert d["code"] == "twist-not-realisable" and d["source"] == "modc" and d["severity"] == 1
     line, col = pos(text, "port=40deg")
-    assert d["range"] == {"start": {"line": line, "character": col}, "end": {"line": line, "character": col + len("port=40deg")}}
-    assert d["message"].startswith("L4 port 40deg cannot be set") and "\nhint: nearest realisable value: 45deg" in d["message"]
+    assert d["range"] == {
+        "start": {"line": line, "character": col},
+        "end": {"line": line, "character": col + len("port=40deg")},
+    }
+    assert (
+        d["message"].startswith("L4 port 40deg cannot be set")
+        and "\nhint: nearest realisable value: 45deg" in d["message"]
+    )
     assert d["data"]["hint"] == "nearest realisable value: 45deg"
     # an incremental edit: 40 -> 45
     line, col = pos(text, "40deg")
-    server.change(uri, 2, rng={"start": {"line": line, "character": col}, "end": {"line": line, "character": col + 2}}, new="45")
+    server.change(
+        uri, 2, rng={"start": {"line": line, "character": col}, "end": {"line": line, "character": col + 2}}, new="45"
+    )
     assert server.diagnostics(uri, version=2) == []
     # and breaking it again with a full-text change
     server.change(uri, 3, text="robot a {\n    chain H1 L4\n}\n")
@@ -165,17 +181,22 @@ def test_diagnostics_are_the_cli_diagnostics(server):
         try:
             want = check_text(text, str(path)).diagnostics
         except Exception as e:  # a compiler bug: the editor says so instead of going quiet
-            assert len(got) == 1 and "internal error" in got[0]["message"] and type(e).__name__ in got[0]["message"], path.name
+            assert len(got) == 1 and "internal error" in got[0]["message"] and type(e).__name__ in got[0]["message"], (
+                path.name
+            )
             continue
         assert [d["code"] for d in got] == [d.code for d in want], path.name
-        for g, w in zip(got, want):
+        for g, w in zip(got, want, strict=True):
             sev = {"error": 1, "warning": 2, "note": 3}[w.severity.value]
             assert g["severity"] == sev and g["message"].split("\nhint: ")[0].endswith(w.message), path.name
             assert g["data"]["hint"] == w.hint
             if w.span.file == str(path) and text.isascii():
                 lines = text.split("\n")
                 line = w.span.line - 1
-                assert g["range"]["start"] == {"line": line, "character": min(w.span.col - 1, len(lines[line]) if line < len(lines) else 0)}, path.name
+                assert g["range"]["start"] == {
+                    "line": line,
+                    "character": min(w.span.col - 1, len(lines[line]) if line < len(lines) else 0),
+                }, path.name
             seen.add(w.code)
     assert len(seen) > 30  # the corpus covers most codes
 
@@ -197,6 +218,7 @@ def test_no_torque_analysis_in_the_editor(server):
 
 
 # --- hover ------------------------------------------------------------------------------------------
+
 
 def hover_text(server, uri, text, needle, nth=0, delta=1):
     h = server.at("textDocument/hover", uri, *pos(text, needle, nth, delta))
@@ -242,6 +264,7 @@ def test_every_keyword_has_a_hover():
 
 # --- completion -------------------------------------------------------------------------------------
 
+
 def complete_at_end(server, text, name="t.mod"):
     uri = open_doc(server, text, name)
     lines = text.split("\n")
@@ -269,7 +292,10 @@ def test_completion_of_allowable_codes(server):
     text = "robot a {\n    chain L1\n    allow first-v"
     items = complete_at_end(server, text)
     edit = next(i for i in items if i["label"] == "first-variant")["textEdit"]
-    assert edit["range"]["start"] == {"line": 2, "character": 10} and edit["range"]["end"] == {"line": 2, "character": 17}
+    assert edit["range"]["start"] == {"line": 2, "character": 10} and edit["range"]["end"] == {
+        "line": 2,
+        "character": 17,
+    }
 
 
 def test_completion_of_parameters_and_measures(server):
@@ -292,7 +318,11 @@ def test_completion_of_statements_and_clauses(server):
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf ")) == ["size"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf size (1, 1, 1) m ")) == ["at"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    library ")) == ["mark2", "mark2-strict"]
-    assert labels(complete_at_end(server, "robot a { chain H1 - L4(port=45deg) - L1\n    limit ")) == ["joint_1", "joint_2", "joint_3"]
+    assert labels(complete_at_end(server, "robot a { chain H1 - L4(port=45deg) - L1\n    limit ")) == [
+        "joint_1",
+        "joint_2",
+        "joint_3",
+    ]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ")) == ["home"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose home (0,0,0) deg\n    pose ")) == []
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ready ")) == ["(0, 0, 0) deg"]
@@ -301,13 +331,16 @@ def test_completion_of_statements_and_clauses(server):
 
 def test_completion_in_yaml(server):
     assert "L4" in labels(complete_at_end(server, "robots:\n  - name: a\n    chain:\n      - H1\n      - ", "a.yaml"))
-    assert "first-variant" in labels(complete_at_end(server, "robots:\n  - name: a\n    chain: [L1]\n    allow: [", "a.yaml"))
+    assert "first-variant" in labels(
+        complete_at_end(server, "robots:\n  - name: a\n    chain: [L1]\n    allow: [", "a.yaml")
+    )
     items = complete_at_end(server, "robots:\n  - name: a\n    chain:\n      - H1\n      - L", "a.yaml")
     edit = next(i for i in items if i["label"] == "L4")["textEdit"]  # the typed "L" is replaced
     assert edit["range"] == {"start": {"line": 4, "character": 8}, "end": {"line": 4, "character": 9}}
 
 
 # --- symbols, definition, formatting ----------------------------------------------------------------
+
 
 def test_document_symbols(server):
     uri = open_doc(server, FARM)
@@ -317,7 +350,11 @@ def test_document_symbols(server):
     kids = {(c["name"], c["detail"]) for c in farm["children"]}
     assert {("chain", "H1-L4-L3"), ("ready", "pose"), ("floor", "box"), ("plant", "target")} <= kids
     chain = next(c for c in farm["children"] if c["name"] == "chain")
-    assert [(u["name"], u["detail"]) for u in chain["children"]] == [("H1", "joint_1"), ("L4", "joint_2"), ("L3", "joint_3")]
+    assert [(u["name"], u["detail"]) for u in chain["children"]] == [
+        ("H1", "joint_1"),
+        ("L4", "joint_2"),
+        ("L3", "joint_3"),
+    ]
     assert farm["selectionRange"]["start"] == {"line": 0, "character": 6}
 
 
@@ -340,8 +377,10 @@ def test_definition(server):
     uri = open_doc(server, FARM)
 
     def where(needle, nth=0, delta=1):
-        return [(loc["uri"], loc["range"]["start"]["line"], loc["range"]["start"]["character"])
-                for loc in server.at("textDocument/definition", uri, *pos(FARM, needle, nth, delta))]
+        return [
+            (loc["uri"], loc["range"]["start"]["line"], loc["range"]["start"]["character"])
+            for loc in server.at("textDocument/definition", uri, *pos(FARM, needle, nth, delta))
+        ]
 
     # joint_2 in `limit` -> the second unit of the chain
     assert where("joint_2") == [(uri, *pos(FARM, "L4(pivot"))]
@@ -369,7 +408,9 @@ def test_definition_in_a_half_typed_file(server):
 def test_formatting(server):
     text = "robot a {\nchain H1 -   L1\n}\n"
     uri = open_doc(server, text)
-    edits = server.result("textDocument/formatting", {"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": True}})
+    edits = server.result(
+        "textDocument/formatting", {"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": True}}
+    )
     try:
         from modc.syntax.format import format_text
     except ImportError:
@@ -405,6 +446,7 @@ def test_formatting_calls_format_text(monkeypatch):
 
 # --- robustness -------------------------------------------------------------------------------------
 
+
 def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     uri = open_doc(server, FARM)
 
@@ -417,7 +459,13 @@ def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     assert r["error"]["code"] == -32601
     alive()
     # bad params -> an error response (invalid params), not a crash
-    for params in ({"textDocument": 5}, {"position": {"line": "x"}}, [], None, {"textDocument": {"uri": uri}, "position": {"line": -1, "character": 0}}):
+    for params in (
+        {"textDocument": 5},
+        {"position": {"line": "x"}},
+        [],
+        None,
+        {"textDocument": {"uri": uri}, "position": {"line": -1, "character": 0}},
+    ):
         r = server.request("textDocument/hover", params)
         assert "error" in r or r.get("result") is None
         alive()
@@ -426,9 +474,15 @@ def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     alive()
     # positions out of range are clamped: no error
     for line, col in ((1000, 0), (0, 10_000), (10_000, 10_000)):
-        assert "result" in server.request("textDocument/hover", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
-        assert "result" in server.request("textDocument/completion", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
-        assert "result" in server.request("textDocument/definition", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
+        assert "result" in server.request(
+            "textDocument/hover", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}}
+        )
+        assert "result" in server.request(
+            "textDocument/completion", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}}
+        )
+        assert "result" in server.request(
+            "textDocument/definition", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}}
+        )
     alive()
     # a document that was never opened: empty answers, and the file is not read
     other = "file:///dev/zero"
@@ -459,7 +513,7 @@ HALF_TYPED = [
     "robot a { chain H1 - L4(pivot=-90deg,",
     "robot a { chain H1 - L4 } }",
     "robot a { dh { row a=",
-    "robot a { library \"unterminated",
+    'robot a { library "unterminated',
     "robot a { pose",
     "robot a { allow",
     "}}}}((((",
@@ -486,7 +540,10 @@ def test_half_typed_files_never_break_a_feature(server):
             for method in ("textDocument/hover", "textDocument/completion", "textDocument/definition"):
                 r = server.request(method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
                 assert "result" in r, (method, text, r)
-        for method, extra in (("textDocument/documentSymbol", {}), ("textDocument/formatting", {"options": {"tabSize": 4, "insertSpaces": True}})):
+        for method, extra in (
+            ("textDocument/documentSymbol", {}),
+            ("textDocument/formatting", {"options": {"tabSize": 4, "insertSpaces": True}}),
+        ):
             r = server.request(method, {"textDocument": {"uri": uri}, **extra})
             assert "result" in r, (method, text, r)
     # one error per unparsable text, as the CLI
@@ -510,12 +567,15 @@ def test_diagnostics_latency_smoke(server):
     times = []
     for v in range(2, 22):
         t0 = server.change(uri, v, text=text + f"\n# edit {v}\n")
-        t1, _ = server.wait_notification("textDocument/publishDiagnostics", lambda p: p["uri"] == uri and p["version"] == v)
+        t1, _ = server.wait_notification(
+            "textDocument/publishDiagnostics", lambda p, v=v: p["uri"] == uri and p["version"] == v
+        )
         times.append(t1 - t0)
     assert statistics.median(times) < 0.25
 
 
 # --- in-process: conversions ------------------------------------------------------------------------
+
 
 def test_positions_count_utf16_code_units():
     text = "# 🤖 é\nrobot a { chain H1 - L4 }  # ℍ 🤖 x"
@@ -569,10 +629,20 @@ def test_lexer_and_outline_survive_anything():
             definition(an, off, "file:///x/a.mod")
 
 
-@pytest.mark.parametrize("path, text", [
-    ("/x/a.mod", "robot a {\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 10, 0) deg\n    target p at (0.2, 0, 0.3) m\n}\n"),
-    ("/x/a.yaml", "robots:\n  - name: a\n    chain: [H1, {unit: L4, port: 45deg}, L1]\n    poses: {home: \"(0, 10, 0) deg\"}\n"),
-])
+@pytest.mark.parametrize(
+    "path, text",
+    [
+        (
+            "/x/a.mod",
+            "robot a {\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 10, 0) deg\n"
+            "    target p at (0.2, 0, 0.3) m\n}\n",
+        ),
+        (
+            "/x/a.yaml",
+            'robots:\n  - name: a\n    chain: [H1, {unit: L4, port: 45deg}, L1]\n    poses: {home: "(0, 10, 0) deg"}\n',
+        ),
+    ],
+)
 def test_each_version_is_parsed_once(monkeypatch, path, text):
     """Diagnostics, symbols, hover, completion and definitions all use the check's own parse."""
     import modc.syntax
@@ -595,12 +665,26 @@ def test_each_version_is_parsed_once(monkeypatch, path, text):
 
 # --- the language described once: read from the grammar ---------------------------------------------
 
+
 def test_keyword_classes_are_read_from_the_grammar():
     from modc.lsp import language
 
     assert language.declaration_keywords() == {"robot"}
-    assert language.statements() == ("chain", "dh", "library", "base", "tool", "payload", "pose", "limit", "box",
-                                      "sphere", "cylinder", "target", "allow")
+    assert language.statements() == (
+        "chain",
+        "dh",
+        "library",
+        "base",
+        "tool",
+        "payload",
+        "pose",
+        "limit",
+        "box",
+        "sphere",
+        "cylinder",
+        "target",
+        "allow",
+    )
     assert language.statements("dh") == ("row",)
     assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links"}
     assert language.name_takers() == {"robot", "pose", "limit", "box", "sphere", "cylinder", "target"}
@@ -613,15 +697,16 @@ def test_every_value_keyword_has_a_quantity_kind():
     from modc.lsp import language
 
     assert language.value_keywords() <= set(language.QUANTITY_KINDS), sorted(
-        language.value_keywords() - set(language.QUANTITY_KINDS))
+        language.value_keywords() - set(language.QUANTITY_KINDS)
+    )
 
 
 GRAMMAR_PLUS = {
     # a new statement: grammar only
-    '     | allow\n': '     | allow\n     | gripper\n',
+    "     | allow\n": "     | allow\n     | gripper\n",
     'allow: "allow"': 'gripper: "gripper" NAME at\nallow: "allow"',
     # a new top-level block with its own statement
-    'start: robot*': 'start: (robot | design)*\ndesign: "design" NAME "{" use* "}"\nuse: "use" NAME',
+    "start: robot*": 'start: (robot | design)*\ndesign: "design" NAME "{" use* "}"\nuse: "use" NAME',
 }
 
 
@@ -639,8 +724,13 @@ def grammar_plus(monkeypatch, tmp_path):
     for old, new in GRAMMAR_PLUS.items():
         assert old in text
         text = text.replace(old, new)
-    lark = Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True,
-                start=["start", "unit_text", "quantity_text", "vector_text"])
+    lark = Lark(
+        text,
+        parser="lalr",
+        propagate_positions=True,
+        maybe_placeholders=True,
+        start=["start", "unit_text", "quantity_text", "vector_text"],
+    )
     monkeypatch.setattr(parser, "_lark", lambda: lark)
     language.reset()
     yield

@@ -1,4 +1,5 @@
 """The Typer app and what every command shares: output, exit codes, common options."""
+
 from __future__ import annotations
 
 import difflib
@@ -11,11 +12,15 @@ from typing import Annotated, Any
 
 import typer
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, rich_markup_mode=None,
-                  context_settings={"show_default": True},
-                  help="modc: compile .mod files describing MOIRs Mark-2 modular arms into URDF and friends.\n\n"
-                       "\b\n`modc FILE -o OUT` is `modc compile FILE -o OUT`: check FILE (.mod or its YAML form)\n"
-                       "and write URDF, meshes, xacro, SRDF and a ROS package into OUT.")
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    rich_markup_mode=None,
+    context_settings={"show_default": True},
+    help="modc: compile .mod files describing MOIRs Mark-2 modular arms into URDF and friends.\n\n"
+    "\b\n`modc FILE -o OUT` is `modc compile FILE -o OUT`: check FILE (.mod or its YAML form)\n"
+    "and write URDF, meshes, xacro, SRDF and a ROS package into OUT.",
+)
 
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -44,7 +49,14 @@ class TorqueLevel(str, Enum):
     off = "off"
 
 
-LibraryOpt = Annotated[str | None, typer.Option("--library", metavar="NAME|FILE", help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file")]
+LibraryOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--library",
+        metavar="NAME|FILE",
+        help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file",
+    ),
+]
 
 
 def _expand(paths: list[str]) -> list[str]:
@@ -76,22 +88,29 @@ def usage_errors(prog: str, usage: tuple[type[Exception], ...] = (), writing: st
         yield
     except (InputError, RobotChoiceError) as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     except usage as e:
         _err(f"modc {prog}: {e}")
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     except OSError as e:
         if writing is None:
             raise
         _err(f"modc {prog}: cannot write {writing}: {e.strerror or e}")
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
 
 
 # --- the command line as a whole: routing, help, missing extras -------------------------------------
 
 # Modules of the `full` extra, by the pip package that provides them.
-HEAVY = {"pinocchio": "pin", "coal": "pin", "pybullet": "pybullet", "pybullet_data": "pybullet",
-         "ompl": "ompl", "trimesh": "trimesh", "PIL": "pillow"}
+HEAVY = {
+    "pinocchio": "pin",
+    "coal": "pin",
+    "pybullet": "pybullet",
+    "pybullet_data": "pybullet",
+    "ompl": "ompl",
+    "trimesh": "trimesh",
+    "PIL": "pillow",
+}
 SOURCE_SUFFIXES = (".mod", ".yaml", ".yml")
 
 

@@ -1,4 +1,5 @@
 """Render diagnostics for people (text with a caret excerpt) and for machines (JSON)."""
+
 from __future__ import annotations
 
 import hashlib
@@ -27,13 +28,13 @@ def excerpt(source: str, d: Diagnostic) -> list[str]:
     text = lines[d.span.line - 1].rstrip("\r").expandtabs(1)
     if len(text) > 200:  # a minified or binary "line": show a window around the column
         lo = max(0, d.span.col - 60)
-        text, col = text[lo:lo + 120], d.span.col - lo
+        text, col = text[lo : lo + 120], d.span.col - lo
     else:
         col = d.span.col
     end = d.span.end_col if d.span.end_line == d.span.line else len(text) + 1
     end = min(end, len(text) + 1)
-    lead = display_width(text[:col - 1])
-    width = max(1, display_width(text[col - 1:end - 1]))
+    lead = display_width(text[: col - 1])
+    width = max(1, display_width(text[col - 1 : end - 1]))
     gutter = f"{d.span.line:>4} | "
     return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * lead + "^" * width]
 
@@ -78,7 +79,10 @@ def render_github(diags: Iterable[Diagnostic]) -> str:
     lines = []
     for d in sorted(diags, key=sort_key):
         s = d.span
-        props = f"file={_gh_escape(s.file, True)},line={s.line},col={s.col},endLine={s.end_line},endColumn={s.end_col},title={_gh_escape('modc ' + d.code, True)}"
+        props = (
+            f"file={_gh_escape(s.file, True)},line={s.line},col={s.col},endLine={s.end_line},endColumn={s.end_col},"
+            f"title={_gh_escape('modc ' + d.code, True)}"
+        )
         body = d.message + (f" (hint: {d.hint})" if d.hint else "")
         lines.append(f"::{level[d.severity.value]} {props}::{_gh_escape(body)}")
     return "\n".join(lines)
@@ -113,8 +117,12 @@ def _fingerprint(d: Diagnostic, uri: str, sources: Mapping[str, str]) -> str:
     return hashlib.sha256(key.encode("utf-8")).hexdigest()[:32]
 
 
-def render_sarif(diags: Iterable[Diagnostic], version: str, root: str | os.PathLike | None = None,
-                 sources: Mapping[str, str] | None = None) -> str:
+def render_sarif(
+    diags: Iterable[Diagnostic],
+    version: str,
+    root: str | os.PathLike | None = None,
+    sources: Mapping[str, str] | None = None,
+) -> str:
     """SARIF 2.1.0, one run; every registered code is a rule (so rule indices are stable), with
     its meaning as fullDescription and its hint as help. Paths are relative to root (default the
     working directory)."""
@@ -129,41 +137,63 @@ def render_sarif(diags: Iterable[Diagnostic], version: str, root: str | os.PathL
         help_text = c.summary[:1].upper() + c.summary[1:] + "." + (f" Fix: {hint}." if hint.strip("…") else "")
         if c.allowable:
             help_text += f" An assembly rule: `allow {c.name}` inside the robot block silences it on purpose."
-        rules.append({
-            "id": c.name,
-            "name": "".join(w.capitalize() for w in c.name.split("-")),
-            "shortDescription": {"text": c.summary},
-            "fullDescription": {"text": f"{c.summary}: {_template_text(c.message)}"},
-            "help": {"text": help_text, "markdown": help_text},
-            "defaultConfiguration": {"level": level[c.severity.value]},
-        })
+        rules.append(
+            {
+                "id": c.name,
+                "name": "".join(w.capitalize() for w in c.name.split("-")),
+                "shortDescription": {"text": c.summary},
+                "fullDescription": {"text": f"{c.summary}: {_template_text(c.message)}"},
+                "help": {"text": help_text, "markdown": help_text},
+                "defaultConfiguration": {"level": level[c.severity.value]},
+            }
+        )
     results = []
     for d in sorted(diags, key=sort_key):
         s = d.span
         location = sarif_location(s.file, base)
-        results.append({
-            "ruleId": d.code,
-            "ruleIndex": names.index(d.code),
-            "level": level[d.severity.value],
-            "message": {"text": d.message + (f"\nhint: {d.hint}" if d.hint else "")},
-            "locations": [{"physicalLocation": {
-                "artifactLocation": location,
-                "region": {"startLine": s.line, "startColumn": s.col, "endLine": s.end_line,
-                           "endColumn": max(s.end_col, s.col + 1)},
-            }}],
-            "partialFingerprints": {"modc/v1": _fingerprint(d, location["uri"], sources or {})},
-        })
+        results.append(
+            {
+                "ruleId": d.code,
+                "ruleIndex": names.index(d.code),
+                "level": level[d.severity.value],
+                "message": {"text": d.message + (f"\nhint: {d.hint}" if d.hint else "")},
+                "locations": [
+                    {
+                        "physicalLocation": {
+                            "artifactLocation": location,
+                            "region": {
+                                "startLine": s.line,
+                                "startColumn": s.col,
+                                "endLine": s.end_line,
+                                "endColumn": max(s.end_col, s.col + 1),
+                            },
+                        }
+                    }
+                ],
+                "partialFingerprints": {"modc/v1": _fingerprint(d, location["uri"], sources or {})},
+            }
+        )
     doc = {
         "$schema": "https://json.schemastore.org/sarif-2.1.0.json",
         "version": "2.1.0",
-        "runs": [{
-            "tool": {"driver": {"name": "modc", "version": version, "informationUri": "https://pypi.org/project/modc/",
-                                "rules": rules}},
-            # No uri: the root is wherever the consumer checked the repository out (and the
-            # output stays the same on every machine).
-            "originalUriBaseIds": {SARIF_ROOT: {"description": {"text": "the repository root (modc lint --sarif-root)"}}},
-            "columnKind": "unicodeCodePoints",
-            "results": results,
-        }],
+        "runs": [
+            {
+                "tool": {
+                    "driver": {
+                        "name": "modc",
+                        "version": version,
+                        "informationUri": "https://pypi.org/project/modc/",
+                        "rules": rules,
+                    }
+                },
+                # No uri: the root is wherever the consumer checked the repository out (and the
+                # output stays the same on every machine).
+                "originalUriBaseIds": {
+                    SARIF_ROOT: {"description": {"text": "the repository root (modc lint --sarif-root)"}}
+                },
+                "columnKind": "unicodeCodePoints",
+                "results": results,
+            }
+        ],
     }
     return json.dumps(doc, indent=2)

@@ -7,6 +7,7 @@ Used by tests/test_lsp.py and benchmarks/bench_lsp.py; standard library only.
         c.open("file:///tmp/a.mod", "robot a { chain H1 - L1 }")
         c.diagnostics("file:///tmp/a.mod")
 """
+
 from __future__ import annotations
 
 import itertools
@@ -25,8 +26,9 @@ class ServerGone(Exception):
 class Client:
     def __init__(self, cmd: list[str] | None = None, cwd: str | None = None, env: dict | None = None):
         self.cmd = cmd or [sys.executable, "-m", "modc.lsp"]
-        self.proc = subprocess.Popen(self.cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     cwd=cwd, env=env)
+        self.proc = subprocess.Popen(
+            self.cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd, env=env
+        )
         self._ids = itertools.count(1)
         self._cond = threading.Condition()
         self.responses: dict = {}
@@ -144,20 +146,32 @@ class Client:
 
     # --- LSP conveniences -------------------------------------------------------------------
     def initialize(self, capabilities: dict | None = None) -> dict:
-        caps = capabilities if capabilities is not None else {
-            "textDocument": {"completion": {"completionItem": {"snippetSupport": True}},
-                             "hover": {"contentFormat": ["markdown", "plaintext"]},
-                             "documentSymbol": {"hierarchicalDocumentSymbolSupport": True}}}
+        caps = (
+            capabilities
+            if capabilities is not None
+            else {
+                "textDocument": {
+                    "completion": {"completionItem": {"snippetSupport": True}},
+                    "hover": {"contentFormat": ["markdown", "plaintext"]},
+                    "documentSymbol": {"hierarchicalDocumentSymbolSupport": True},
+                }
+            }
+        )
         result = self.result("initialize", {"processId": None, "rootUri": None, "capabilities": caps})
         self.notify("initialized", {})
         return result
 
     def open(self, uri: str, text: str, version: int = 1, language: str = "modc") -> float:
-        return self.notify("textDocument/didOpen", {"textDocument": {"uri": uri, "languageId": language, "version": version, "text": text}})
+        return self.notify(
+            "textDocument/didOpen",
+            {"textDocument": {"uri": uri, "languageId": language, "version": version, "text": text}},
+        )
 
     def change(self, uri: str, version: int, text: str | None = None, rng: dict | None = None, new: str = "") -> float:
         change = {"text": text} if rng is None else {"range": rng, "text": new}
-        return self.notify("textDocument/didChange", {"textDocument": {"uri": uri, "version": version}, "contentChanges": [change]})
+        return self.notify(
+            "textDocument/didChange", {"textDocument": {"uri": uri, "version": version}, "contentChanges": [change]}
+        )
 
     def diagnostics(self, uri: str, version: int | None = None, timeout: float = 10.0) -> list[dict]:
         def match(p):
@@ -166,7 +180,9 @@ class Client:
         return self.wait_notification("textDocument/publishDiagnostics", match, timeout)[1]["diagnostics"]
 
     def at(self, method: str, uri: str, line: int, character: int, **extra):
-        return self.result(method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": character}, **extra})
+        return self.result(
+            method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": character}, **extra}
+        )
 
     def shutdown(self, timeout: float = 10.0) -> int:
         """shutdown, exit; the server's exit code."""
@@ -194,7 +210,7 @@ class Client:
             except OSError:
                 pass
 
-    def __enter__(self) -> "Client":
+    def __enter__(self) -> Client:
         return self
 
     def __exit__(self, *exc) -> None:

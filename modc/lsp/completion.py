@@ -4,6 +4,7 @@ accepts there say what to offer: keywords (statements and clauses exactly where 
 allows them), unit names (the ones the assembly rules allow first), parameter names, units of
 measure (of the kind the value takes), `allow` codes, libraries, `joint_N`, a pose's vector.
 For YAML: unit names and `allow` codes."""
+
 from __future__ import annotations
 
 import re
@@ -38,7 +39,7 @@ class Completion:
 def complete(an: Analysis, offset: int, snippets: bool = True) -> list[types.CompletionItem]:
     offset = max(0, min(offset, len(an.text)))
     if an.is_yaml:
-        word = re.search(r"[A-Za-z0-9_-]*$", an.text[an.line_start(offset):offset]).group()
+        word = re.search(r"[A-Za-z0-9_-]*$", an.text[an.line_start(offset) : offset]).group()
         items, start, end = _complete_yaml(an, offset), offset - len(word), offset
     else:
         items, start, end = _complete_mod(an, offset, snippets)
@@ -46,16 +47,18 @@ def complete(an: Analysis, offset: int, snippets: bool = True) -> list[types.Com
     out = []
     for i, c in enumerate(items):
         new_text = c.insert if c.insert is not None else c.label
-        out.append(types.CompletionItem(
-            label=c.label,
-            kind=c.kind,
-            detail=c.detail or None,
-            documentation=types.MarkupContent(kind=types.MarkupKind.Markdown, value=c.doc) if c.doc else None,
-            sort_text=c.sort or f"{i:04d}",
-            filter_text=c.label,
-            insert_text_format=types.InsertTextFormat.Snippet if c.snippet else types.InsertTextFormat.PlainText,
-            text_edit=types.TextEdit(range=rng, new_text=new_text),
-        ))
+        out.append(
+            types.CompletionItem(
+                label=c.label,
+                kind=c.kind,
+                detail=c.detail or None,
+                documentation=types.MarkupContent(kind=types.MarkupKind.Markdown, value=c.doc) if c.doc else None,
+                sort_text=c.sort or f"{i:04d}",
+                filter_text=c.label,
+                insert_text_format=types.InsertTextFormat.Snippet if c.snippet else types.InsertTextFormat.PlainText,
+                text_edit=types.TextEdit(range=rng, new_text=new_text),
+            )
+        )
     return out
 
 
@@ -65,7 +68,9 @@ def _in_comment_or_string(an: Analysis, offset: int) -> bool:
             break
         if t.kind == "comment" and offset <= t.end:
             return True
-        if t.kind == "string" and (offset < t.end or (offset == t.end and (len(t.text) == 1 or not t.text.endswith('"')))):
+        if t.kind == "string" and (
+            offset < t.end or (offset == t.end and (len(t.text) == 1 or not t.text.endswith('"')))
+        ):
             return True
     return False
 
@@ -95,7 +100,7 @@ def _statement(stack: list[Any]) -> tuple[str | None, list[Any]]:
     for i in range(len(stack) - 1, -1, -1):
         item = stack[i]
         if isinstance(item, Token) and item.value in keywords and item.type == language.terminal_of(item.value):
-            return str(item.value), stack[i + 1:]
+            return str(item.value), stack[i + 1 :]
         if isinstance(item, Token) and item.type == "LBRACE":
             break
     return None, []
@@ -120,27 +125,46 @@ def _offer(an: Analysis, stand: tolerant.Stand, robot: str | None, snippets: boo
     if "LPAR" in accepts and stmt == "pose" and isinstance(last, Token) and last.type == "NAME":
         n = len(_block_units(an, robot))
         if n:
-            items.append(Completion("(" + ", ".join(["0"] * n) + ") deg", types.CompletionItemKind.Value,
-                                    f"{n} joint angles"))
+            items.append(
+                Completion("(" + ", ".join(["0"] * n) + ") deg", types.CompletionItemKind.Value, f"{n} joint angles")
+            )
     return items + _keywords(accepts, snippets)
 
 
 def _keywords(accepts: frozenset[str], snippets: bool) -> list[Completion]:
     """The keywords the grammar accepts here: clauses first, then statements in grammar order."""
-    order = {w: i for i, w in enumerate(w for b in ("robot", *sorted(language.declaration_keywords()))
-                                        for w in language.statements(b))}
+    order = {
+        w: i
+        for i, w in enumerate(
+            w for b in ("robot", *sorted(language.declaration_keywords())) for w in language.statements(b)
+        )
+    }
     out = []
     for word in sorted(filter(None, map(language.literal_of, accepts)), key=lambda w: (w in order, order.get(w, 0), w)):
         if word in language.declaration_keywords():
             body = SNIPPETS.get(word, word + " ${1:name} {\n    $0\n}") if snippets else word + " "
-            out.append(Completion(word, types.CompletionItemKind.Keyword, language.syntax_of(word), keyword_doc(word),
-                                  body, snippets))
+            out.append(
+                Completion(
+                    word, types.CompletionItemKind.Keyword, language.syntax_of(word), keyword_doc(word), body, snippets
+                )
+            )
         elif word in order:
-            out.append(Completion(word, types.CompletionItemKind.Keyword, "statement", keyword_doc(word), word + " ",
-                                  sort=f"5{order[word]:03d}"))
+            out.append(
+                Completion(
+                    word,
+                    types.CompletionItemKind.Keyword,
+                    "statement",
+                    keyword_doc(word),
+                    word + " ",
+                    sort=f"5{order[word]:03d}",
+                )
+            )
         else:
-            out.append(Completion(word, types.CompletionItemKind.Keyword, "clause", keyword_doc(word), word + " ",
-                                  sort=f"4{word}"))
+            out.append(
+                Completion(
+                    word, types.CompletionItemKind.Keyword, "clause", keyword_doc(word), word + " ", sort=f"4{word}"
+                )
+            )
     return out
 
 
@@ -152,20 +176,32 @@ def _names(an: Analysis, robot: str | None, stmt: str | None, body: list[Any], l
     after a statement that refers to a joint, `home` after `pose`; else a new name (nothing)."""
     for i in range(len(body) - 1, -1, -1):
         item = body[i]
-        if isinstance(item, Token) and item.type == "LPAR" and i > 0 and isinstance(body[i - 1], Token) \
-                and body[i - 1].type == "UNIT_NAME":
-            return _unit_params(lib, str(body[i - 1]), _assigned(body[i + 1:]))
+        if (
+            isinstance(item, Token)
+            and item.type == "LPAR"
+            and i > 0
+            and isinstance(body[i - 1], Token)
+            and body[i - 1].type == "UNIT_NAME"
+        ):
+            return _unit_params(lib, str(body[i - 1]), _assigned(body[i + 1 :]))
     if stmt == "row":
         return _params(DH_PARAMS, _assigned(body), lib)
     if body:
         return []
     if stmt in language.REFERS:
-        return [Completion(f"joint_{i}", types.CompletionItemKind.Variable, f"unit {i}: {u}")
-                for i, u in enumerate(_block_units(an, robot), 1)]
+        return [
+            Completion(f"joint_{i}", types.CompletionItemKind.Variable, f"unit {i}: {u}")
+            for i, u in enumerate(_block_units(an, robot), 1)
+        ]
     if stmt == "pose" and not any(d.kind == "pose" and d.name == "home" and d.robot == robot for d in an.decls):
-        return [Completion("home", types.CompletionItemKind.Constant, "the home pose",
-                           "the pose the robot starts in (when absent: 0 per joint, or mid-range where a limit "
-                           "excludes 0)")]
+        return [
+            Completion(
+                "home",
+                types.CompletionItemKind.Constant,
+                "the home pose",
+                "the pose the robot starts in (when absent: 0 per joint, or mid-range where a limit excludes 0)",
+            )
+        ]
     return []
 
 
@@ -173,7 +209,7 @@ def _assigned(items: list[Any]) -> set[str]:
     """The parameters a `name=value, …` group has already set."""
     out = {str(t.children[0]) for t in items if isinstance(t, Tree) and t.data == "param" and t.children}
     toks = [t for t in items if isinstance(t, Token)]
-    out |= {str(a) for a, b in zip(toks, toks[1:]) if a.type == "NAME" and b.type == "EQUAL"}
+    out |= {str(a) for a, b in zip(toks, toks[1:], strict=False) if a.type == "NAME" and b.type == "EQUAL"}
     return out
 
 
@@ -195,8 +231,10 @@ def _value_kind(stack: list[Any]) -> str | None:
 
 def _measures(kind: str | None) -> list[Completion]:
     names = KIND_MEASURES.get(kind, list(quantities.ALL)) if kind else list(quantities.ALL)
-    return [Completion(u, types.CompletionItemKind.Unit, MEASURES[u][1], f"{MEASURES[u][1]} ({MEASURES[u][0]})")
-            for u in names]
+    return [
+        Completion(u, types.CompletionItemKind.Unit, MEASURES[u][1], f"{MEASURES[u][1]} ({MEASURES[u][0]})")
+        for u in names
+    ]
 
 
 def _libraries() -> list[Completion]:
@@ -231,8 +269,15 @@ def _unit_names(lib: Library, before: list[str]) -> list[Completion]:
         v, k = lib.split(name)
         a, t = lib.variants[v].actuator, lib.units[k]
         detail = f"{a.model}, type {k} ({t.port}, {'link' if t.link else 'no link'})"
-        out.append(Completion(name, types.CompletionItemKind.Module, detail, unit_markdown(lib, name) or "",
-                              sort=("0" if v in allowed else "1") + name))
+        out.append(
+            Completion(
+                name,
+                types.CompletionItemKind.Module,
+                detail,
+                unit_markdown(lib, name) or "",
+                sort=("0" if v in allowed else "1") + name,
+            )
+        )
     return out
 
 
@@ -242,14 +287,20 @@ def _unit_params(lib: Library, unit: str, used: set[str]) -> list[Completion]:
 
 
 def _params(names: tuple[str, ...], used: set[str], lib: Library) -> list[Completion]:
-    return [Completion(p, types.CompletionItemKind.Property, PARAMS[p][0], param_markdown(p, lib), p + "=")
-            for p in names if p not in used]
+    return [
+        Completion(p, types.CompletionItemKind.Property, PARAMS[p][0], param_markdown(p, lib), p + "=")
+        for p in names
+        if p not in used
+    ]
 
 
 def _allow_codes(listed: Collection[str] = ()) -> list[Completion]:
     """The diagnostic codes `allow` may silence, but those already listed."""
-    return [Completion(c.name, types.CompletionItemKind.EnumMember, f"{c.severity.value}, allowable", c.summary)
-            for c in REGISTRY.values() if c.allowable and c.name not in listed]
+    return [
+        Completion(c.name, types.CompletionItemKind.EnumMember, f"{c.severity.value}, allowable", c.summary)
+        for c in REGISTRY.values()
+        if c.allowable and c.name not in listed
+    ]
 
 
 def _complete_yaml(an: Analysis, offset: int) -> list[Completion]:
@@ -262,7 +313,11 @@ def _complete_yaml(an: Analysis, offset: int) -> list[Completion]:
     for m in re.finditer(r"^\s*(?:-\s+)?([A-Za-z_]+):", before, re.M):
         key = m.group(1)
     lib = an.library_for(an.robot_at(offset))
-    if re.search(r"\bunit:\s*\S*$", line) or (key == "chain" and re.fullmatch(r"\s*-\s*\S*", line)) or re.search(r"chain:\s*\[[^\]]*$", line):
+    if (
+        re.search(r"\bunit:\s*\S*$", line)
+        or (key == "chain" and re.fullmatch(r"\s*-\s*\S*", line))
+        or re.search(r"chain:\s*\[[^\]]*$", line)
+    ):
         return _unit_names(lib, [])
     if (key == "allow" and re.fullmatch(r"\s*-\s*\S*", line)) or re.search(r"allow:\s*\[[^\]]*$", line):
         return _allow_codes()

@@ -14,6 +14,7 @@ Two views of a document are used side by side:
 Every position conversion goes through convert.LineIndex; the server (server.py) only
 converts LSP positions to offsets and back.
 """
+
 from __future__ import annotations
 
 import bisect
@@ -44,7 +45,8 @@ class Tok(NamedTuple):
     bol: bool = False  # first token on its line
 
 
-_TOKEN = re.compile(r"""
+_TOKEN = re.compile(
+    r"""
    (?P<ws>\s+)
   |(?P<comment>\#[^\n]*)
   |(?P<string>"[^"\n]*"?)
@@ -53,7 +55,9 @@ _TOKEN = re.compile(r"""
   |(?P<word>[A-Za-z_][A-Za-z0-9_]*)
   |(?P<punct>[{}(),=\-])
   |(?P<other>.)
-""", re.X | re.S)
+""",
+    re.X | re.S,
+)
 
 
 def lex(text: str) -> list[Tok]:
@@ -121,9 +125,10 @@ def outline(text: str) -> list[Block]:
         span = extent(tree)
         start = name.start_pos if name is not None and tolerant.real(name) else (span[0] if span else base)
         start = max(0, text.rfind(language.keyword_of(tree.data) or tree.data, 0, start + 1))
-        blocks.append(Block(tree.data, name if name is not None and tolerant.real(name) else None, start,
-                            len(text), stmts))
-    for a, b in zip(blocks, blocks[1:]):
+        blocks.append(
+            Block(tree.data, name if name is not None and tolerant.real(name) else None, start, len(text), stmts)
+        )
+    for a, b in zip(blocks, blocks[1:], strict=False):
         a.end = b.start
     return blocks
 
@@ -299,7 +304,9 @@ class Analysis:
                 out.append(Decl("robot", r.name.text, None, self.offsets(r.name.span), self.offsets(r.span)))
                 for st in r.body:
                     if kind := DECL_KINDS.get(type(st)):
-                        out.append(Decl(kind, st.name.text, r.name.text, self.offsets(st.name.span), self.offsets(st.span)))
+                        out.append(
+                            Decl(kind, st.name.text, r.name.text, self.offsets(st.name.span), self.offsets(st.span))
+                        )
             return out
         for b in self.blocks:
             if b.name is None:

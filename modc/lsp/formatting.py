@@ -1,4 +1,5 @@
 """Formatting: the document in `modc fmt`'s canonical form."""
+
 from __future__ import annotations
 
 from lsprotocol import types

@@ -6,6 +6,7 @@ the model knows is written here, in words: the hover text of keywords, parameter
 measure, and which kind of quantity follows a keyword. Tests check that every keyword and every
 value-taking keyword of the grammar has its entry.
 """
+
 from __future__ import annotations
 
 from ..model import quantities
@@ -40,28 +41,42 @@ def reset() -> None:
 # --- what the model knows ----------------------------------------------------------------------
 
 # The kind of quantity after a value keyword (value_keywords(); a test keeps them in step).
-QUANTITY_KINDS = {"at": "a length", "size": "a length", "radius": "a length", "length": "a length",
-                  "rpy": "an angle", "pose": "an angle", "limit": "an angle", "payload": "a mass"}
+QUANTITY_KINDS = {
+    "at": "a length",
+    "size": "a length",
+    "radius": "a length",
+    "length": "a length",
+    "rpy": "an angle",
+    "pose": "an angle",
+    "limit": "an angle",
+    "payload": "a mass",
+}
 # Name-taking statements whose name refers to something (a joint) rather than declaring one.
 REFERS = frozenset({"limit"})
 
 KEYWORDS = {
     "robot": "`robot NAME { … }` — one arm; a file holds one or more robot blocks.",
-    "chain": "`chain H1 - H4(pivot=-90deg) - L4` — the modular units, base first (required unless a `dh` table is given).",
-    "dh": "`dh [fit-links] { row a=…, alpha=…, d=… … }` — a standard DH table that modc turns into a chain of units (paper section 4.2).",
+    "chain": "`chain H1 - H4(pivot=-90deg) - L4` — the modular units, base first (required unless a `dh` table is "
+    "given).",
+    "dh": "`dh [fit-links] { row a=…, alpha=…, d=… … }` — a standard DH table that modc turns into a chain of "
+    "units (paper section 4.2).",
     "row": "`row a=0.3 m, alpha=-90deg, d=0 m[, theta=0deg]` — one row of a `dh` table (standard DH), base first.",
     "fit-links": "`dh fit-links { … }` — print link modules whose length realises each row's `a` exactly.",
-    "library": "`library mark2` | `library mark2-strict` | `library \"path.yaml\"` — the module library this robot is built from (default mark2).",
+    "library": '`library mark2` | `library mark2-strict` | `library "path.yaml"` — '
+    "the module library this robot is built from (default mark2).",
     "base": "`base at (x, y, z) m rpy (r, p, y) deg` — where base_link sits in the cell (for simulation and planning).",
     "tool": "`tool at (x, y, z) m rpy (r, p, y) deg` — tool0 relative to the last unit's last frame.",
     "payload": "`payload 0.2 kg at (x, y, z) m` — a payload's mass and its centre of mass in tool0.",
     "pose": "`pose NAME (q1, …, qn) deg` — a named joint pose, one angle per joint; `home` is the robot's home pose.",
     "limit": "`limit joint_N (lower, upper) deg` — narrow joint N's range (within the library's).",
-    "box": "`box NAME size (x, y, z) m at (x, y, z) m [rpy (…) deg]` — a box obstacle in base_link (size = full edge lengths).",
+    "box": "`box NAME size (x, y, z) m at (x, y, z) m [rpy (…) deg]` — a box obstacle in base_link (size = full "
+    "edge lengths).",
     "sphere": "`sphere NAME radius R m at (x, y, z) m` — a sphere obstacle in base_link.",
-    "cylinder": "`cylinder NAME radius R m length L m at (x, y, z) m [rpy (…) deg]` — a cylinder obstacle in base_link, axis along z before rpy.",
+    "cylinder": "`cylinder NAME radius R m length L m at (x, y, z) m [rpy (…) deg]` — a cylinder obstacle in "
+    "base_link, axis along z before rpy.",
     "target": "`target NAME at (x, y, z) m` — a position for tool0, in base_link.",
-    "allow": "`allow first-variant, …` — silence one of the paper's assembly rules for this robot on purpose (e.g. for a wrist).",
+    "allow": "`allow first-variant, …` — silence one of the paper's assembly rules for this robot on purpose (e.g. "
+    "for a wrist).",
     "at": "`at (x, y, z) m` — a position (in base_link for obstacles and targets, in tool0 for a payload).",
     "rpy": "`rpy (roll, pitch, yaw) deg` — an orientation as fixed-axis roll, pitch, yaw (as in URDF).",
     "size": "`size (x, y, z) m` — a box's full edge lengths.",
@@ -70,10 +85,16 @@ KEYWORDS = {
 }
 
 PARAMS = {
-    "pivot": ("an angle", "turns the joint axis in the adaptive twist unit: a rotation about y before the joint "
-              "(intersecting axes, the paper's type III twist)."),
-    "port": ("an angle", "turns the next module where it meets the end of the link: a rotation about x (skew axes, "
-             "the paper's type II twist). Only units with a link module (types 3 and 4)."),
+    "pivot": (
+        "an angle",
+        "turns the joint axis in the adaptive twist unit: a rotation about y before the joint "
+        "(intersecting axes, the paper's type III twist).",
+    ),
+    "port": (
+        "an angle",
+        "turns the next module where it meets the end of the link: a rotation about x (skew axes, "
+        "the paper's type II twist). Only units with a link module (types 3 and 4).",
+    ),
     "link": ("a length", "the printed link module's length (x23). Only units with a link module (types 3 and 4)."),
     "a": ("a length", "DH `a`: length of the common normal, along x_i (standard DH: Rz(θ) Tz(d) Tx(a) Rx(α))."),
     "alpha": ("an angle", "DH `alpha`: twist about x_i between consecutive joint axes."),
@@ -91,9 +112,6 @@ assert set(MEASURES) == set(quantities.ALL)
 KIND_MEASURES = {kind: list(table) for kind, table in quantities.KINDS.items()}
 
 
-
-
 def keyword_doc(keyword: str) -> str:
     """Hover text of a keyword: its prose when written, else its syntax from the grammar."""
     return KEYWORDS.get(keyword) or f"`{syntax_of(keyword)}`"
-

@@ -1,4 +1,5 @@
 """Document symbols (the outline of robots and what they declare) and go-to-definition."""
+
 from __future__ import annotations
 
 import re
@@ -12,17 +13,31 @@ from . import convert
 from .document import DECL_KINDS, Analysis, Tok, declared, extent, joint_number, tokens_of
 
 SYMBOL_KIND = {
-    "robot": types.SymbolKind.Class, "chain": types.SymbolKind.Array, "unit": types.SymbolKind.Module,
-    "dh": types.SymbolKind.Array, "row": types.SymbolKind.Field, "pose": types.SymbolKind.Constant,
-    "target": types.SymbolKind.Variable, "box": types.SymbolKind.Struct, "sphere": types.SymbolKind.Struct,
+    "robot": types.SymbolKind.Class,
+    "chain": types.SymbolKind.Array,
+    "unit": types.SymbolKind.Module,
+    "dh": types.SymbolKind.Array,
+    "row": types.SymbolKind.Field,
+    "pose": types.SymbolKind.Constant,
+    "target": types.SymbolKind.Variable,
+    "box": types.SymbolKind.Struct,
+    "sphere": types.SymbolKind.Struct,
     "cylinder": types.SymbolKind.Struct,
 }
 
 
-def _sym(an: Analysis, name: str, kind: str, rng: tuple[int, int], sel: tuple[int, int], detail: str = "", children=None) -> types.DocumentSymbol:
+def _sym(
+    an: Analysis, name: str, kind: str, rng: tuple[int, int], sel: tuple[int, int], detail: str = "", children=None
+) -> types.DocumentSymbol:
     a, b = min(rng[0], sel[0]), max(rng[1], sel[1])
-    return types.DocumentSymbol(name=name or "?", kind=SYMBOL_KIND[kind], range=an.index.range(a, b),
-                                selection_range=an.index.range(*sel), detail=detail or None, children=children)
+    return types.DocumentSymbol(
+        name=name or "?",
+        kind=SYMBOL_KIND[kind],
+        range=an.index.range(a, b),
+        selection_range=an.index.range(*sel),
+        detail=detail or None,
+        children=children,
+    )
 
 
 def symbols(an: Analysis) -> list[types.DocumentSymbol]:
@@ -35,12 +50,20 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
             for st in r.body:
                 rng = an.offsets(st.span)
                 if isinstance(st, ast.Chain):
-                    units = [_sym(an, u.name.text, "unit", an.offsets(u.span), an.offsets(u.name.span), f"joint_{i}")
-                             for i, u in enumerate(st.units, 1)]
-                    children.append(_sym(an, "chain", "chain", rng, (rng[0], rng[0]), "-".join(u.name.text for u in st.units), units))
+                    units = [
+                        _sym(an, u.name.text, "unit", an.offsets(u.span), an.offsets(u.name.span), f"joint_{i}")
+                        for i, u in enumerate(st.units, 1)
+                    ]
+                    children.append(
+                        _sym(
+                            an, "chain", "chain", rng, (rng[0], rng[0]), "-".join(u.name.text for u in st.units), units
+                        )
+                    )
                 elif isinstance(st, ast.DH):
-                    rows = [_sym(an, f"row {i}", "row", an.offsets(row.span), an.offsets(row.span), f"joint_{i}")
-                            for i, row in enumerate(st.rows, 1)]
+                    rows = [
+                        _sym(an, f"row {i}", "row", an.offsets(row.span), an.offsets(row.span), f"joint_{i}")
+                        for i, row in enumerate(st.rows, 1)
+                    ]
                     children.append(_sym(an, "dh", "dh", rng, (rng[0], rng[0]), f"{len(st.rows)} rows", rows))
                 elif (kind := DECL_KINDS.get(type(st))) is not None:
                     children.append(_sym(an, st.name.text, kind, rng, an.offsets(st.name.span), kind))
@@ -56,16 +79,27 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
             rng = an.stmt_range(st, rng)
             keyword = (rng[0], rng[0] + len(st.data))
             if st.data == "chain":
-                units = [_sym(an, str(t), "unit", (t.start_pos, t.end_pos), (t.start_pos, t.end_pos), f"joint_{i}")
-                         for i, t in enumerate((t for t in tokens_of(st) if t.type == "UNIT_NAME"), 1)]
+                units = [
+                    _sym(an, str(t), "unit", (t.start_pos, t.end_pos), (t.start_pos, t.end_pos), f"joint_{i}")
+                    for i, t in enumerate((t for t in tokens_of(st) if t.type == "UNIT_NAME"), 1)
+                ]
                 children.append(_sym(an, "chain", "chain", rng, keyword, "", units))
             elif st.data == "dh":
                 children.append(_sym(an, "dh", "dh", rng, keyword))
             elif (n := declared(st)) is not None and st.data in SYMBOL_KIND:
                 children.append(_sym(an, str(n), st.data, rng, (n.start_pos, n.end_pos), st.data))
         name = (b.name.start_pos, b.name.end_pos)
-        out.append(_sym(an, str(b.name), b.keyword if b.keyword in SYMBOL_KIND else "robot", (b.start, b.end), name,
-                        b.keyword, children))
+        out.append(
+            _sym(
+                an,
+                str(b.name),
+                b.keyword if b.keyword in SYMBOL_KIND else "robot",
+                (b.start, b.end),
+                name,
+                b.keyword,
+                children,
+            )
+        )
     return out
 
 
@@ -79,7 +113,11 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
         return []
     prev, _ = an.neighbours(tok)
     robot = an.robot_at(tok.start)
-    if prev is not None and prev.text == "library" or (an.is_yaml and prev is not None and prev.text == ":" and _yaml_key_before(an, tok) == "library"):
+    if (
+        prev is not None
+        and prev.text == "library"
+        or (an.is_yaml and prev is not None and prev.text == ":" and _yaml_key_before(an, tok) == "library")
+    ):
         path = resolve_library(tok.text.strip('"'), Path(an.path).parent)
         if path is None:
             return []
@@ -100,5 +138,5 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
 
 
 def _yaml_key_before(an: Analysis, tok: Tok) -> str | None:
-    m = re.match(r"\s*(?:-\s+)?([A-Za-z_]+)\s*:", an.text[an.line_start(tok.start):tok.start])
+    m = re.match(r"\s*(?:-\s+)?([A-Za-z_]+)\s*:", an.text[an.line_start(tok.start) : tok.start])
     return m.group(1) if m else None

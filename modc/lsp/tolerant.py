@@ -14,6 +14,7 @@ language server keeps no grammar of its own:
 A syntax error does not end either: the parse restarts at the next line that begins with a
 keyword, inside the block kind whose body accepts that keyword (`robot _ {` for a statement).
 """
+
 from __future__ import annotations
 
 import re
@@ -109,7 +110,7 @@ def _segments(text: str, pos: int = 0, inside: str | None = None):
                 m = _restart().search(text, m.end())
             if m is not None:
                 pos, inside = m.start(1), _block_for(m.group(1))
-            elif "\n" in text[at:] and not text[text.rindex("\n") + 1:].strip():
+            elif "\n" in text[at:] and not text[text.rindex("\n") + 1 :].strip():
                 pos, inside = len(text), _open_block(list(ip.parser_state.value_stack))
             else:
                 return
@@ -137,8 +138,19 @@ def stand_at(text: str) -> Stand:
 
 # Placeholder tokens that close an unfinished parse, in order of preference: closers first, then
 # values, then openers and required keywords.
-_PLACEHOLDERS = {"NUMBER": "0", "NAME": "_", "UNIT_NAME": "X0", "CODE_NAME": "x", "STRING": '""',
-                 "LIBRARY_REF": "_", "MEASURE": "_", "LPAR": "(", "LBRACE": "{", "COMMA": ",", "EQUAL": "="}
+_PLACEHOLDERS = {
+    "NUMBER": "0",
+    "NAME": "_",
+    "UNIT_NAME": "X0",
+    "CODE_NAME": "x",
+    "STRING": '""',
+    "LIBRARY_REF": "_",
+    "MEASURE": "_",
+    "LPAR": "(",
+    "LBRACE": "{",
+    "COMMA": ",",
+    "EQUAL": "=",
+}
 
 
 def _close(ip) -> Tree | None:

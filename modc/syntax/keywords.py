@@ -3,6 +3,7 @@ no other place lists them: which keywords open a top-level block, start a statem
 block or a clause inside a statement, which take a NAME, which take a value, each keyword's
 syntax. Used by the parser's error labels, the language server and the editor grammars' tests.
 """
+
 from __future__ import annotations
 
 import re
@@ -22,8 +23,11 @@ _lark = grammar
 @cache
 def _literals() -> dict[str, str]:
     """Keyword terminal name -> its word (CHAIN -> chain, DH_FIT -> fit-links)."""
-    return {t.name: t.pattern.value for t in _lark().terminals
-            if t.pattern.type == "str" and re.fullmatch(r"[a-z]+(?:-[a-z]+)*", t.pattern.value)}
+    return {
+        t.name: t.pattern.value
+        for t in _lark().terminals
+        if t.pattern.type == "str" and re.fullmatch(r"[a-z]+(?:-[a-z]+)*", t.pattern.value)
+    }
 
 
 def literal_of(terminal: str) -> str | None:
@@ -70,10 +74,10 @@ def _blocks() -> dict[str, list[str]]:
     for r in _lark().rules:
         exp = [s.name for s in r.expansion]
         if "LBRACE" in exp and (kw := literal_of(exp[0])) is not None:
-            body = exp[exp.index("LBRACE") + 1:]
+            body = exp[exp.index("LBRACE") + 1 :]
             words = out.setdefault(kw, [])
             for sym in body:
-                for item in (_items(sym) if sym.startswith("_") else [sym] if sym.islower() else []):
+                for item in _items(sym) if sym.startswith("_") else [sym] if sym.islower() else []:
                     if (w := _first_keyword(item)) is not None and w not in words:
                         words.append(w)
     return out
@@ -104,8 +108,11 @@ def clause_keywords() -> frozenset[str]:
 @cache
 def name_takers() -> frozenset[str]:
     """Keywords followed by a NAME (so `pose chain (…)` names a pose 'chain')."""
-    return frozenset(w for r in _lark().rules if len(r.expansion) > 1 and r.expansion[1].name == "NAME"
-                     and (w := literal_of(r.expansion[0].name)) is not None)
+    return frozenset(
+        w
+        for r in _lark().rules
+        if len(r.expansion) > 1 and r.expansion[1].name == "NAME" and (w := literal_of(r.expansion[0].name)) is not None
+    )
 
 
 @cache
@@ -128,8 +135,9 @@ _PUNCTUATION = {"LBRACE": "{", "RBRACE": "}", "LPAR": "(", "RPAR": ")", "MINUS":
 
 def syntax_of(keyword: str) -> str:
     """The keyword's rule written out, its longest form: `target NAME at (…)`."""
-    rule = next((r.origin.name for r in _lark().rules if r.expansion and literal_of(r.expansion[0].name) == keyword),
-                None)
+    rule = next(
+        (r.origin.name for r in _lark().rules if r.expansion and literal_of(r.expansion[0].name) == keyword), None
+    )
     if rule is None:
         return keyword
     exp = max(_expansions(rule), key=len)
@@ -150,8 +158,15 @@ def syntax_of(keyword: str) -> str:
 
 def reset() -> None:
     """Forget what was read from the grammar (tests that swap the grammar call this)."""
-    for fn in (_literals, _blocks, declaration_keywords, statement_keywords, clause_keywords, name_takers,
-               value_keywords):
+    for fn in (
+        _literals,
+        _blocks,
+        declaration_keywords,
+        statement_keywords,
+        clause_keywords,
+        name_takers,
+        value_keywords,
+    ):
         fn.cache_clear()
 
 
