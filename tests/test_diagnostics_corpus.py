@@ -181,8 +181,8 @@ def run_case(path: Path) -> list[Diagnostic]:
 
         return list(convert_table(read_source(path), str(path))[1])
     try:
-        extra = {"analyses": analyses(path)} if analyses(path) else {}
-        return list(check_file(path, **extra).diagnostics)
+        checked = check_file(path, analyses=analyses(path)) if analyses(path) else check_file(path)
+        return list(checked.diagnostics)
     except InputError as e:
         return [e.diagnostic]
 
@@ -316,8 +316,8 @@ def check_rendered(d: Diagnostic, text: str, path: str) -> None:
 def _check_each(path: Path, check) -> None:
     text = source_text(path)
     diags = diagnostics_of(path)
-    if not diags and xfail_reason(path):
-        pytest.xfail(xfail_reason(path))
+    if not diags and (reason := xfail_reason(path)):
+        pytest.xfail(reason)
     assert diags
     for d in diags:
         try:
@@ -450,7 +450,7 @@ def test_file_not_found_for_a_directory_given_as_file(tmp_path):
 
 
 def test_output_not_modc(tmp_path):
-    files = {"urdf/x.urdf": "<robot/>", "report.json": "{}"}
+    files: dict[str, str | bytes] = {"urdf/x.urdf": "<robot/>", "report.json": "{}"}
     # a non-empty directory modc did not write
     foreign = tmp_path / "home"
     foreign.mkdir()

@@ -189,7 +189,7 @@ def test_pygments_keywords_match_the_lark_grammar(update_golden):
                 break_long_words=False,
                 break_on_hyphens=False,
             )
-            text = re.sub(rf"^{name} = \((?:[^()]*)\)", lambda _m, line=line: line, text, count=1, flags=re.M)
+            text = re.sub(rf"^{name} = \((?:[^()]*)\)", line.replace("\\", "\\\\"), text, count=1, flags=re.M)
         LEXER_FILE.write_text(text, encoding="utf-8")
         pytest.skip("modc/pygments_lexer.py keyword lists rewritten from the grammar: review the diff")
     for name, words in want.items():

@@ -7,6 +7,7 @@ from __future__ import annotations
 import statistics
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -84,13 +85,16 @@ def server():
 _n = 0
 
 
+LAST_DIAGS: dict[int, list[dict]] = {}  # the first diagnostics open_doc saw, by client
+
+
 def open_doc(server: Client, text: str, name: str = "t.mod", directory: Path | None = None) -> str:
     """Open text under a fresh URI and wait for its first diagnostics; returns the URI."""
     global _n
     _n += 1
     uri = convert.path_to_uri(str((directory or Path("/tmp/modc-lsp-test")) / f"{_n}" / name))
     server.open(uri, text)
-    server._last_diags = server.diagnostics(uri, version=1)
+    LAST_DIAGS[id(server)] = server.diagnostics(uri, version=1)
     return uri
 
 
@@ -115,7 +119,7 @@ def test_exit_without_shutdown_and_closed_stdin_end_the_process():
     c.close()
     c = Client([sys.executable, "-m", "modc.lsp"], cwd=str(ROOT))
     c.initialize()
-    c.proc.stdin.close()
+    c.stdin.close()
     c.proc.wait(10)
     c.close()
 
@@ -126,7 +130,7 @@ def test_exit_without_shutdown_and_closed_stdin_end_the_process():
 def test_diagnostics_on_open_and_cleared_by_a_fix(server):
     text = "robot a {\n    chain H1 - L4(port=40deg) - L1\n}\n"
     uri = open_doc(server, text)
-    [d] = server._last_diags
+    [d] = LAST_DIAGS[id(server)]
     assert d["code"] == "twist-not-realisable" and d["source"] == "modc" and d["severity"] == 1
     line, col = pos(text, "port=40deg")
     assert d["range"] == {
@@ -152,7 +156,7 @@ def test_diagnostics_on_open_and_cleared_by_a_fix(server):
 
 def test_close_clears_diagnostics(server):
     uri = open_doc(server, "robot a { chain L1 }")
-    assert [d["code"] for d in server._last_diags] == ["first-variant"]
+    assert [d["code"] for d in LAST_DIAGS[id(server)]] == ["first-variant"]
     server.notify("textDocument/didClose", {"textDocument": {"uri": uri}})
     assert server.diagnostics(uri) == []
 
@@ -204,17 +208,17 @@ def test_diagnostics_are_the_cli_diagnostics(server):
 def test_yaml_documents_get_diagnostics(server):
     good = (ROOT / "examples" / "quickstart.yaml").read_text()
     open_doc(server, good, "q.yaml")
-    assert server._last_diags == []
+    assert LAST_DIAGS[id(server)] == []
     bad = "robots:\n  - name: a\n    chain: [L1, {unit: L4, port: 40deg}]\n"
     open_doc(server, bad, "b.yml")
-    assert {d["code"] for d in server._last_diags} == {"first-variant", "twist-not-realisable"}
+    assert {d["code"] for d in LAST_DIAGS[id(server)]} == {"first-variant", "twist-not-realisable"}
 
 
 def test_no_torque_analysis_in_the_editor(server):
     # an arm that cannot hold itself: compile reports torque-over-peak, the editor (lint level) does not
     text = "robot weak {\n    chain H1 - L4(link=500mm) - L4(link=500mm) - L4(link=500mm)\n    payload 3 kg\n}\n"
     open_doc(server, text)
-    assert "torque-over-peak" not in {d["code"] for d in server._last_diags}
+    assert "torque-over-peak" not in {d["code"] for d in LAST_DIAGS[id(server)]}
 
 
 # --- hover ------------------------------------------------------------------------------------------
@@ -361,7 +365,7 @@ def test_document_symbols(server):
 def test_document_symbols_of_a_half_typed_file(server):
     text = "robot a {\n    chain H1 - L4(piv\n    pose p (0, 0) deg\nrobot b {\n    target t at (0"
     uri = open_doc(server, text)
-    assert server._last_diags and server._last_diags[0]["severity"] == 1
+    assert LAST_DIAGS[id(server)] and LAST_DIAGS[id(server)][0]["severity"] == 1
     syms = server.result("textDocument/documentSymbol", {"textDocument": {"uri": uri}})
     assert [s["name"] for s in syms] == ["a", "b"]
     assert [c["name"] for c in syms[1]["children"]] == ["t"]
@@ -416,8 +420,7 @@ def test_formatting(server):
     except ImportError:
         assert edits == []  # no formatter yet: no edits
         return
-    want = format_text(text, convert.uri_to_path(uri))
-    want = want[0] if isinstance(want, tuple) else want
+    want, _ = format_text(text, convert.uri_to_path(uri))
     assert want == "robot a {\n    chain H1 - L1\n}\n"
     if want == text:
         assert edits == []
@@ -430,7 +433,7 @@ def test_formatting(server):
 def test_formatting_calls_format_text(monkeypatch):
     import types as pytypes
 
-    fake = pytypes.ModuleType("modc.syntax.format")
+    fake: Any = pytypes.ModuleType("modc.syntax.format")
     fake.format_text = lambda text, path: (text.replace("-   ", "- "), [])
     monkeypatch.setitem(sys.modules, "modc.syntax.format", fake)
     an = Analysis("robot a {\n    chain H1 -   L1\n}", "/x/a.mod")
@@ -459,13 +462,14 @@ def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     assert r["error"]["code"] == -32601
     alive()
     # bad params -> an error response (invalid params), not a crash
-    for params in (
+    bad: tuple[object, ...] = (
         {"textDocument": 5},
         {"position": {"line": "x"}},
         [],
         None,
         {"textDocument": {"uri": uri}, "position": {"line": -1, "character": 0}},
-    ):
+    )
+    for params in bad:
         r = server.request("textDocument/hover", params)
         assert "error" in r or r.get("result") is None
         alive()
@@ -649,9 +653,16 @@ def test_each_version_is_parsed_once(monkeypatch, path, text):
     import modc.syntax.yaml_form
 
     calls = []
+
+    def counting(real):
+        def parse(*args):
+            calls.append(args)
+            return real(*args)
+
+        return parse
+
     for module, name in ((modc.syntax, "parse"), (modc.syntax.yaml_form, "parse_yaml")):
-        real = getattr(module, name)
-        monkeypatch.setattr(module, name, lambda *a, real=real: calls.append(a) or real(*a))
+        monkeypatch.setattr(module, name, counting(getattr(module, name)))
     an = Analysis(text, path)
     an.diagnostics()
     assert an.parsed
@@ -758,5 +769,5 @@ def test_a_new_statement_needs_no_language_server_change(grammar_plus):
     assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["use"]
     # the half-typed outline declares the new statement's name
     an = Analysis("robot a {\n    chain H1 - L1\n    gripper g at (0, 0", "/x/a.mod")
-    assert [(d.kind, d.name) for d in an.blocks and an.decls] == [("robot", "a"), ("gripper", "g")]
+    assert [(d.kind, d.name) for d in an.decls] == [("robot", "a"), ("gripper", "g")]
     assert hover(an, an.text.index("gripper") + 1) is not None

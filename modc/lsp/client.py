@@ -29,6 +29,9 @@ class Client:
         self.proc = subprocess.Popen(
             self.cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd, env=env
         )
+        # PIPE on all three: the streams exist (Popen types them Optional)
+        assert self.proc.stdin is not None and self.proc.stdout is not None and self.proc.stderr is not None
+        self.stdin, self.stdout, self.stderr_pipe = self.proc.stdin, self.proc.stdout, self.proc.stderr
         self._ids = itertools.count(1)
         self._cond = threading.Condition()
         self.responses: dict = {}
@@ -42,7 +45,7 @@ class Client:
 
     # --- wire -------------------------------------------------------------------------------
     def _read(self) -> None:
-        out = self.proc.stdout
+        out = self.stdout
         try:
             while True:
                 length = None
@@ -74,13 +77,13 @@ class Client:
                 self._cond.notify_all()
 
     def _read_stderr(self) -> None:
-        for line in self.proc.stderr:
+        for line in self.stderr_pipe:
             self.stderr.append(line)
 
     def send_bytes(self, data: bytes) -> None:
         try:
-            self.proc.stdin.write(data)
-            self.proc.stdin.flush()
+            self.stdin.write(data)
+            self.stdin.flush()
         except (BrokenPipeError, ValueError, OSError) as e:
             raise ServerGone(str(e)) from None
 
@@ -196,7 +199,7 @@ class Client:
     def close(self) -> None:
         if self.proc.poll() is None:
             try:
-                self.proc.stdin.close()
+                self.stdin.close()
             except OSError:
                 pass
             try:
@@ -204,7 +207,7 @@ class Client:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
-        for f in (self.proc.stdin, self.proc.stdout, self.proc.stderr):
+        for f in (self.stdin, self.stdout, self.stderr_pipe):
             try:
                 f.close()
             except OSError:

@@ -39,7 +39,7 @@ class Completion:
 def complete(an: Analysis, offset: int, snippets: bool = True) -> list[types.CompletionItem]:
     offset = max(0, min(offset, len(an.text)))
     if an.is_yaml:
-        word = re.search(r"[A-Za-z0-9_-]*$", an.text[an.line_start(offset) : offset]).group()
+        word = re.findall(r"[A-Za-z0-9_-]*$", an.text[an.line_start(offset) : offset])[0]
         items, start, end = _complete_yaml(an, offset), offset - len(word), offset
     else:
         items, start, end = _complete_mod(an, offset, snippets)
@@ -266,7 +266,9 @@ def _unit_names(lib: Library, before: list[str]) -> list[Completion]:
     allowed = set(lib.rules.may_follow.get(prev_variant, lib.variants)) if prev_variant else {lib.rules.first_variant}
     out = []
     for name in lib.unit_names():
-        v, k = lib.split(name)
+        split = lib.split(name)
+        assert split is not None  # the library's own names
+        v, k = split
         a, t = lib.variants[v].actuator, lib.units[k]
         detail = f"{a.model}, type {k} ({t.port}, {'link' if t.link else 'no link'})"
         out.append(

@@ -68,7 +68,7 @@ def lex(text: str) -> list[Tok]:
         if kind == "ws":
             bol = bol or "\n" in m.group()
         else:
-            out.append(Tok(kind, m.group(), m.start(), m.end(), bol))
+            out.append(Tok(kind or "other", m.group(), m.start(), m.end(), bol))
             bol = False
     return out
 
@@ -95,9 +95,14 @@ def tokens_of(node: Tree | Token) -> list[Token]:
     return [t for t in node.scan_values(lambda v: isinstance(v, Token)) if tolerant.real(t)]
 
 
+def offsets(tok: Token) -> tuple[int, int]:
+    """A document token's offsets (the tolerant parse gives every one of them positions)."""
+    return tok.start_pos or 0, tok.end_pos or 0
+
+
 def extent(node: Tree | Token) -> tuple[int, int] | None:
     toks = tokens_of(node)
-    return (toks[0].start_pos, toks[-1].end_pos) if toks else None
+    return (offsets(toks[0])[0], offsets(toks[-1])[1]) if toks else None
 
 
 def declared(stmt: Tree) -> Token | None:
@@ -115,15 +120,14 @@ def outline(text: str) -> list[Block]:
     for base, inside, tree in tolerant.outline(text):
         for tok in tree.scan_values(lambda v: isinstance(v, Token)):
             if tolerant.real(tok):
-                tok.start_pos += base
-                tok.end_pos += base
+                tok.start_pos, tok.end_pos = offsets(tok)[0] + base, offsets(tok)[1] + base
         name = tree.children[0] if tree.children and isinstance(tree.children[0], Token) else None
         stmts = [c for c in tree.children if isinstance(c, Tree)]
         if inside is not None and blocks and (name is None or not tolerant.real(name)):
             blocks[-1].stmts += stmts
             continue
         span = extent(tree)
-        start = name.start_pos if name is not None and tolerant.real(name) else (span[0] if span else base)
+        start = offsets(name)[0] if name is not None and tolerant.real(name) else (span[0] if span else base)
         start = max(0, text.rfind(language.keyword_of(tree.data) or tree.data, 0, start + 1))
         blocks.append(
             Block(tree.data, name if name is not None and tolerant.real(name) else None, start, len(text), stmts)
@@ -136,12 +140,11 @@ def outline(text: str) -> list[Block]:
 def block_joints(block: Block) -> list[tuple[str, tuple[int, int]]] | None:
     """(unit text, offsets) of the joints of a block's first chain (its units) or dh table (its
     rows); None when it has neither."""
-    for st in block.stmts:
-        if st.data == "chain":
-            units = [t for t in tokens_of(st) if t.type == "UNIT_NAME"]
-            return [(str(t), (t.start_pos, t.end_pos)) for t in units]
-        if st.data == "dh":
-            rows = [r for r in st.children if isinstance(r, Tree) and r.data == "dh_row" and extent(r)]
+    for node in block.stmts:
+        if node.data == "chain":
+            return [(str(t), offsets(t)) for t in tokens_of(node) if t.type == "UNIT_NAME"]
+        if node.data == "dh":
+            rows = [r for r in node.children if isinstance(r, Tree) and r.data == "dh_row" and extent(r)]
             return [(f"row {i}", extent(r) or (0, 0)) for i, r in enumerate(rows, 1)]
     return None
 
@@ -156,6 +159,7 @@ def joint_number(text: str) -> int | None:
 
 # The AST statements that declare a name, by the kind the token view gives them.
 DECL_KINDS = {ast.Pose: "pose", ast.Target: "target", ast.Box: "box", ast.Sphere: "sphere", ast.Cylinder: "cylinder"}
+DECLARING = (ast.Pose, ast.Target, ast.Box, ast.Sphere, ast.Cylinder)
 
 
 @dataclass
@@ -252,8 +256,8 @@ class Analysis:
             a, b = self.offsets(r.span)
             if a <= offset <= b:
                 return r.name.text
-        b = self.block_at(offset)
-        return str(b.name) if b is not None and b.name is not None else None
+        block = self.block_at(offset)
+        return str(block.name) if block is not None and block.name is not None else None
 
     @cached_property
     def model_robots(self) -> tuple:
@@ -303,7 +307,8 @@ class Analysis:
             for r in self.tree.robots:
                 out.append(Decl("robot", r.name.text, None, self.offsets(r.name.span), self.offsets(r.span)))
                 for st in r.body:
-                    if kind := DECL_KINDS.get(type(st)):
+                    if isinstance(st, DECLARING):
+                        kind = DECL_KINDS[type(st)]
                         out.append(
                             Decl(kind, st.name.text, r.name.text, self.offsets(st.name.span), self.offsets(st.span))
                         )
@@ -311,10 +316,10 @@ class Analysis:
         for b in self.blocks:
             if b.name is None:
                 continue
-            out.append(Decl(b.keyword, str(b.name), None, (b.name.start_pos, b.name.end_pos), (b.start, b.end)))
-            for st in b.stmts:
-                if (n := declared(st)) is not None and (rng := extent(st)) is not None:
-                    out.append(Decl(st.data, str(n), str(b.name), (n.start_pos, n.end_pos), self.stmt_range(st, rng)))
+            out.append(Decl(b.keyword, str(b.name), None, offsets(b.name), (b.start, b.end)))
+            for node in b.stmts:
+                if (n := declared(node)) is not None and (rng := extent(node)) is not None:
+                    out.append(Decl(node.data, str(n), str(b.name), offsets(n), self.stmt_range(node, rng)))
         return out
 
     def stmt_range(self, st: Tree, rng: tuple[int, int]) -> tuple[int, int]:

@@ -10,7 +10,7 @@ from lsprotocol import types
 from ..model.library import resolve as resolve_library
 from ..syntax import ast
 from . import convert
-from .document import DECL_KINDS, Analysis, Tok, declared, extent, joint_number, tokens_of
+from .document import DECL_KINDS, DECLARING, Analysis, Tok, declared, extent, joint_number, offsets, tokens_of
 
 SYMBOL_KIND = {
     "robot": types.SymbolKind.Class,
@@ -65,7 +65,8 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
                         for i, row in enumerate(st.rows, 1)
                     ]
                     children.append(_sym(an, "dh", "dh", rng, (rng[0], rng[0]), f"{len(st.rows)} rows", rows))
-                elif (kind := DECL_KINDS.get(type(st))) is not None:
+                elif isinstance(st, DECLARING):
+                    kind = DECL_KINDS[type(st)]
                     children.append(_sym(an, st.name.text, kind, rng, an.offsets(st.name.span), kind))
             out.append(_sym(an, r.name.text, "robot", an.offsets(r.span), an.offsets(r.name.span), "robot", children))
         return out
@@ -73,22 +74,22 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
         if b.name is None:
             continue
         children = []
-        for st in b.stmts:
-            if (rng := extent(st)) is None:
+        for node in b.stmts:
+            if (span := extent(node)) is None:
                 continue
-            rng = an.stmt_range(st, rng)
-            keyword = (rng[0], rng[0] + len(st.data))
-            if st.data == "chain":
+            rng = an.stmt_range(node, span)
+            keyword = (rng[0], rng[0] + len(node.data))
+            if node.data == "chain":
                 units = [
-                    _sym(an, str(t), "unit", (t.start_pos, t.end_pos), (t.start_pos, t.end_pos), f"joint_{i}")
-                    for i, t in enumerate((t for t in tokens_of(st) if t.type == "UNIT_NAME"), 1)
+                    _sym(an, str(t), "unit", offsets(t), offsets(t), f"joint_{i}")
+                    for i, t in enumerate((t for t in tokens_of(node) if t.type == "UNIT_NAME"), 1)
                 ]
                 children.append(_sym(an, "chain", "chain", rng, keyword, "", units))
-            elif st.data == "dh":
+            elif node.data == "dh":
                 children.append(_sym(an, "dh", "dh", rng, keyword))
-            elif (n := declared(st)) is not None and st.data in SYMBOL_KIND:
-                children.append(_sym(an, str(n), st.data, rng, (n.start_pos, n.end_pos), st.data))
-        name = (b.name.start_pos, b.name.end_pos)
+            elif (n := declared(node)) is not None and node.data in SYMBOL_KIND:
+                children.append(_sym(an, str(n), node.data, rng, offsets(n), node.data))
+        name = offsets(b.name)
         out.append(
             _sym(
                 an,

@@ -148,7 +148,8 @@ def syntax_of(keyword: str) -> str:
         elif sym in ("vector", "params"):
             words.append("(…)")
         elif sym.islower() and not sym.startswith("_"):
-            words.append(syntax_of(_first_keyword(sym)) if _first_keyword(sym) else sym.upper())
+            first = _first_keyword(sym)
+            words.append(syntax_of(first) if first else sym.upper())
         elif sym.startswith("_"):
             words.append("…")
         else:
