@@ -771,3 +771,20 @@ def test_a_new_statement_needs_no_language_server_change(grammar_plus):
     an = Analysis("robot a {\n    chain H1 - L1\n    gripper g at (0, 0", "/x/a.mod")
     assert [(d.kind, d.name) for d in an.decls] == [("robot", "a"), ("gripper", "g")]
     assert hover(an, an.text.index("gripper") + 1) is not None
+
+
+def test_capability_by_dotted_path():
+    from lsprotocol import types
+
+    from modc.lsp.server import capability
+
+    path = "text_document.completion.completion_item.snippet_support"
+    assert capability(types.ClientCapabilities(), path, False) is False
+    caps = types.ClientCapabilities(
+        text_document=types.TextDocumentClientCapabilities(
+            completion=types.CompletionClientCapabilities(
+                completion_item=types.ClientCompletionItemOptions(snippet_support=True)
+            )
+        )
+    )
+    assert capability(caps, path, False) is True

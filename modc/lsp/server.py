@@ -200,19 +200,24 @@ def hover(ls: ModcServer, params: types.HoverParams):
     return hover_at(an, offset) if an is not None else None
 
 
+def capability(capabilities: object, dotted: str, default: object = None) -> object:
+    """One client capability by its dotted path; default where the client leaves any part out."""
+    node = capabilities
+    for name in dotted.split("."):
+        node = getattr(node, name, None)
+        if node is None:
+            return default
+    return node
+
+
 @server.feature(types.TEXT_DOCUMENT_COMPLETION, types.CompletionOptions(trigger_characters=["(", ",", "-", "="]))
 @guarded([])
 def completion(ls: ModcServer, params: types.CompletionParams):
     an, offset = _at(ls, params)
     if an is None:
         return []
-    snippets = bool(
-        ls.client_capabilities.text_document
-        and ls.client_capabilities.text_document.completion
-        and ls.client_capabilities.text_document.completion.completion_item
-        and ls.client_capabilities.text_document.completion.completion_item.snippet_support
-    )
-    return complete(an, offset, snippets)
+    snippets = capability(ls.client_capabilities, "text_document.completion.completion_item.snippet_support", False)
+    return complete(an, offset, bool(snippets))
 
 
 @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)
