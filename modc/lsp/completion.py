@@ -18,6 +18,7 @@ from lsprotocol import types
 from ..diagnostics import REGISTRY
 from ..model import quantities
 from ..model.library import BUILTIN, Library
+from ..model.library import default as default_library
 from ..model.library import load as load_library
 from . import document, language, tolerant
 from .document import Analysis, block_joints
@@ -87,7 +88,7 @@ def _complete_mod(an: Analysis, offset: int, snippets: bool) -> tuple[list[Compl
     stand = tolerant.stand_at(an.text[:start])
     if not stand.ok:
         return [], start, end
-    return _offer(an, stand, an.robot_at(start), snippets), start, end
+    return _offer(an, stand, start, snippets), start, end
 
 
 def _real_tokens(stack: list[Any]) -> list[Token]:
@@ -106,13 +107,17 @@ def _statement(stack: list[Any]) -> tuple[str | None, list[Any]]:
     return None, []
 
 
-def _offer(an: Analysis, stand: tolerant.Stand, robot: str | None, snippets: bool) -> list[Completion]:
+def _offer(an: Analysis, stand: tolerant.Stand, start: int, snippets: bool) -> list[Completion]:
     accepts, stack = stand.accepts, stand.stack
     last = stack[-1] if stack else None
     if "MEASURE" in accepts and isinstance(last, Token) and last.type in ("NUMBER", "RPAR"):
         return _measures(_value_kind(stack))  # a number or vector just typed wants its unit
     stmt, body = _statement(stack)
-    lib = an.library_for(robot)
+    # the robot and its library only where an item depends on them (in a file that does not
+    # parse, finding the robot takes the whole outline)
+    needs_robot = bool(accepts & {"NAME", "UNIT_NAME"}) or (stmt == "pose" and "LPAR" in accepts)
+    robot = an.robot_at(start) if needs_robot else None
+    lib = an.library_for(robot) if needs_robot else default_library()
     items: list[Completion] = []
     if "NAME" in accepts:
         items += _names(an, robot, stmt, body, lib)
