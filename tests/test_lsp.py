@@ -788,3 +788,21 @@ def test_capability_by_dotted_path():
         )
     )
     assert capability(caps, path, False) is True
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "robot a { dh {\n    row a=0.3 m, alpha=0deg, d=0 m\nrow\nrow\nrow x",
+        "row\nrow\n",
+        "chain H1\nchain\n  robot\nrobot a {\n    @@@\n    chain H1 -",
+        "robot a {\n    chain H1 H2\n    pose p (0, 0\n    box\n",
+    ],
+)
+def test_tolerant_parse_always_moves_forward(text):
+    """Restarts that fail on their own first word move on: every prefix finishes."""
+    from modc.lsp import tolerant
+
+    for n in range(len(text) + 1):
+        tolerant.stand_at(text[:n])
+        tolerant.outline(text[:n])

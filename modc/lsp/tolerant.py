@@ -18,7 +18,7 @@ keyword, inside the block kind whose body accepts that keyword (`robot _ {` for 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
@@ -46,7 +46,6 @@ class Segment:
 
     base: int
     inside: str | None
-    trees: list[Tree] = field(default_factory=list)
 
 
 def _token(kind: str, value: str, pos: int = SYNTHETIC) -> Token:
@@ -106,7 +105,8 @@ def _segments(text: str, pos: int = 0, inside: str | None = None):
             at = pos + (getattr(e, "pos_in_stream", None) or 0)
             yield seg, ip, at
             m = _restart().search(text, at)
-            while m is not None and m.start(1) < at:
+            # strictly forward: a restart that fails on its own first word moves on
+            while m is not None and (m.start(1) < at or m.start(1) == pos):
                 m = _restart().search(text, m.end())
             if m is not None:
                 pos, inside = m.start(1), _block_for(m.group(1))
