@@ -806,3 +806,13 @@ def test_tolerant_parse_always_moves_forward(text):
     for n in range(len(text) + 1):
         tolerant.stand_at(text[:n])
         tolerant.outline(text[:n])
+
+
+def test_parameters_are_the_lowerings():
+    """Parameter names and kinds come from the lowering (model/lower.py); every one has its words."""
+    from modc.lsp import language
+    from modc.model import lower
+
+    assert language.UNIT_PARAMS == tuple(lower.UNIT_PARAMS) and language.DH_PARAMS == tuple(lower.DH_PARAMS)
+    assert set(language.PARAM_TEXT) == set(lower.UNIT_PARAMS) | set(lower.DH_PARAMS)
+    assert all(kind in language.KIND_MEASURES for kind, _ in language.PARAMS.values())

@@ -9,7 +9,7 @@ value-taking keyword of the grammar has its entry.
 
 from __future__ import annotations
 
-from ..model import quantities
+from ..model import lower, quantities
 
 # The grammar's facts (keyword classes, name takers, syntax) are read in modc.syntax.keywords.
 from ..syntax.keywords import (  # noqa: F401  (re-exported for the language server's modules)
@@ -84,25 +84,25 @@ KEYWORDS = {
     "length": "`length L m` — a cylinder's length along its axis.",
 }
 
-PARAMS = {
+# What each parameter does, in words; their names and kinds are the lowering's (model/lower.py).
+PARAM_TEXT = {
     "pivot": (
-        "an angle",
         "turns the joint axis in the adaptive twist unit: a rotation about y before the joint "
-        "(intersecting axes, the paper's type III twist).",
+        "(intersecting axes, the paper's type III twist)."
     ),
     "port": (
-        "an angle",
         "turns the next module where it meets the end of the link: a rotation about x (skew axes, "
-        "the paper's type II twist). Only units with a link module (types 3 and 4).",
+        "the paper's type II twist). Only units with a link module (types 3 and 4)."
     ),
-    "link": ("a length", "the printed link module's length (x23). Only units with a link module (types 3 and 4)."),
-    "a": ("a length", "DH `a`: length of the common normal, along x_i (standard DH: Rz(θ) Tz(d) Tx(a) Rx(α))."),
-    "alpha": ("an angle", "DH `alpha`: twist about x_i between consecutive joint axes."),
-    "d": ("a length", "DH `d`: offset along z_(i-1)."),
-    "theta": ("an angle", "DH `theta`: joint angle offset about z_(i-1) (default 0)."),
+    "link": ("the printed link module's length (x23). Only units with a link module (types 3 and 4)."),
+    "a": ("DH `a`: length of the common normal, along x_i (standard DH: Rz(θ) Tz(d) Tx(a) Rx(α))."),
+    "alpha": ("DH `alpha`: twist about x_i between consecutive joint axes."),
+    "d": ("DH `d`: offset along z_(i-1)."),
+    "theta": ("DH `theta`: joint angle offset about z_(i-1) (default 0)."),
 }
-UNIT_PARAMS = ("pivot", "port", "link")
-DH_PARAMS = ("a", "alpha", "d", "theta")
+UNIT_PARAMS = tuple(lower.UNIT_PARAMS)
+DH_PARAMS = tuple(lower.DH_PARAMS)
+PARAMS = {name: (kind, PARAM_TEXT.get(name, "")) for name, kind in {**lower.UNIT_PARAMS, **lower.DH_PARAMS}.items()}
 MEASURES = {
     **{u: ("an angle", n) for u, n in (("deg", "degrees"), ("rad", "radians"))},
     **{u: ("a length", n) for u, n in (("m", "metres"), ("cm", "centimetres"), ("mm", "millimetres"))},
