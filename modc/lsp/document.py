@@ -8,8 +8,8 @@ Two views of a document are used side by side:
   there when the file parses;
 - the error-tolerant parse (tolerant.py: the same grammar, restarted after errors and closed
   with placeholders), which keeps completion, symbols and definitions working while a file is
-  half typed; and a token view of the raw text (`lex`: words, numbers, comments) that tells
-  hover what is under the cursor.
+  half typed; and a token view of the raw text (`lex`: words, numbers, codes, comments, whose
+  shapes are the grammar's own terminals) that tells hover what is under the cursor.
 
 Every position conversion goes through convert.LineIndex; the server (server.py) only
 converts LSP positions to offsets and back.
@@ -20,7 +20,7 @@ from __future__ import annotations
 import bisect
 import re
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 from pathlib import Path
 from typing import NamedTuple
 
@@ -45,29 +45,46 @@ class Tok(NamedTuple):
     bol: bool = False  # first token on its line
 
 
-_TOKEN = re.compile(
-    r"""
-   (?P<ws>\s+)
-  |(?P<comment>\#[^\n]*)
-  |(?P<string>"[^"\n]*"?)
-  |(?P<number>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)
-  |(?P<code>[a-z][a-z0-9]*(?:-[a-z0-9]+)+)
-  |(?P<word>[A-Za-z_][A-Za-z0-9_]*)
-  |(?P<punct>[{}(),=\-])
-  |(?P<other>.)
-""",
-    re.X | re.S,
-)
+@cache
+def _token_re() -> re.Pattern[str]:
+    """The token view's shapes, taken from the grammar's own terminals (so they cannot drift):
+    a comment, a string (also one still being typed), a number, a diagnostic code (with a '-';
+    plain lowercase words are words), a name, the grammar's punctuation."""
+    grammar = language.grammar()
+
+    def pattern(name: str) -> str:
+        return grammar.get_terminal(name).pattern.to_regexp()
+
+    punctuation = sorted(
+        t.pattern.value for t in grammar.terminals if t.pattern.type == "str" and not t.pattern.value[:1].isalpha()
+    )
+    return re.compile(
+        "|".join(
+            (
+                r"(?P<ws>\s+)",
+                f"(?P<comment>{pattern('COMMENT')})",
+                f'(?P<string>(?:{pattern("STRING")})|"[^"\n]*)',
+                f"(?P<number>{pattern('NUMBER')})",
+                f"(?P<code>(?=[a-z0-9]+-)(?:{pattern('CODE_NAME')}))",
+                f"(?P<word>{pattern('NAME')})",
+                "(?P<punct>" + "|".join(map(re.escape, punctuation)) + ")",
+                "(?P<other>.)",
+            )
+        ),
+        re.S,
+    )
 
 
 def lex(text: str) -> list[Tok]:
     out = []
     bol = True
-    for m in _TOKEN.finditer(text):
+    for m in _token_re().finditer(text):
         kind = m.lastgroup
         if kind == "ws":
             bol = bol or "\n" in m.group()
         else:
+            if kind == "code" and "-" not in m.group():  # `a-` before a non-code character
+                kind = "word"
             out.append(Tok(kind or "other", m.group(), m.start(), m.end(), bol))
             bol = False
     return out
