@@ -12,6 +12,7 @@ Name.Class (robot), Name.Function (pose, target), Name.Variable (obstacle, joint
 names Name.Namespace, diagnostic codes after `allow` Name.Constant, comments Comment.Single.
 The keyword lists below are compared with the Lark grammar by tests/test_editor_grammars.py.
 """
+
 from __future__ import annotations
 
 import re
@@ -33,8 +34,22 @@ __all__ = ["ModLexer"]
 #: Keyword that opens a robot block.
 DECLARATIONS = ("robot",)
 #: Keywords that start a statement inside a robot block (`row` starts a row of a `dh` block).
-STATEMENTS = ("allow", "base", "box", "chain", "cylinder", "dh", "library", "limit", "payload", "pose",
-              "row", "sphere", "target", "tool")
+STATEMENTS = (
+    "allow",
+    "base",
+    "box",
+    "chain",
+    "cylinder",
+    "dh",
+    "library",
+    "limit",
+    "payload",
+    "pose",
+    "row",
+    "sphere",
+    "target",
+    "tool",
+)
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
 CLAUSES = ("at", "fit-links", "length", "radius", "rpy", "size")
 #: Every keyword of the language.

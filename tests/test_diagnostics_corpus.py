@@ -7,8 +7,11 @@ further cases for one code are named ``<code>--<what>.mod`` (codes never contain
 
 Expectation comments (``#`` comments in all three formats):
 
-    # expect: SEVERITY[code]                 a diagnostic reported on THIS line
-    # expect: error[a], warning[b]           several on one line, comma separated
+    # expect: SEVERITY[code] message text    a diagnostic reported on THIS line, with exactly
+                                             this message (mypy's habit: the text is pinned,
+                                             not only the code)
+    # expect: error[a] text, warning[b] text several on one line, separated by ", " before
+                                             each SEVERITY[
     # expect-line N: SEVERITY[code], ...     reported on line N (1-based), written anywhere: for
                                              diagnostics where a trailing comment cannot sit, e.g.
                                              unclosed-block, reported where the file ends (one
@@ -21,10 +24,14 @@ Expectation comments (``#`` comments in all three formats):
     # corpus-analyses: torque                check with these analyses on (as compile and
                                              `modc check` do; `modc lint` does not run them)
 
-"Reported on line L" means ``diagnostic.span.line == L`` (and, for ``expect-in``, ``span.file`` is
-FILE). Each case is checked the way the product checks it (``check_file`` for .mod/.yaml,
-``convert_table`` for .csv) and the set of (line, severity, code) reported must equal the set
-expected: nothing missing, nothing extra.
+The message text may be left out (``# expect: error[code]``) while writing a case; then
+``pytest tests/test_diagnostics_corpus.py --update-golden`` writes every reported message into
+the comments (the refresh path; review the diff), and ``test_every_expectation_pins_its_message``
+fails until it is there.
+
+"Reported on line L" means ``diagnostic.span.line == L`` (for ``expect-in``: on line L of FILE). Each case is checked the way the
+product checks it (``check_file`` for .mod/.yaml, ``convert_table`` for .csv) and the set of
+(line, severity, code) reported must equal the set expected: nothing missing, nothing extra.
 A file ``check_file`` rejects with ``InputError`` (bad-encoding) counts as reporting that one
 diagnostic. Lines are counted on the raw bytes decoded with replacement characters, so a corpus
 file need not be valid UTF-8. The same expectations are checked through the command line
@@ -35,6 +42,7 @@ Codes that are not about the text of a file (file-not-found, output-not-modc, â€
 the test functions named in ``FUNCTION_CASES``; ``test_every_code_is_covered`` checks that every
 code in the registry has a corpus file (that is not a known failure) or such a function.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -57,7 +65,8 @@ CASES = sorted([*CORPUS_DIR.glob("*.mod"), *CORPUS_DIR.glob("*.yaml"), *CORPUS_D
 
 SEVERITIES = ("error", "warning", "note")
 _EXPECT = re.compile(r"#\s*expect(?:-line\s+(?P<n>\d+)|-in\s+(?P<file>[^\s:]+):(?P<in>\d+))?\s*:(?P<items>[^#]*)")
-_ITEM = re.compile(r"^\s*(?P<sev>[a-z]+)\[(?P<code>[a-z0-9-]+)\]\s*$")
+_ITEM = re.compile(r"^\s*(?P<sev>[a-z]+)\[(?P<code>[a-z0-9-]+)\](?:\s+(?P<msg>.*?))?\s*$")
+_ITEM_SEP = re.compile(r",\s*(?=(?:error|warning|note)\[)")
 _XFAIL = re.compile(r"#\s*corpus-xfail:\s*(?P<reason>.+)")
 _ANALYSES = re.compile(r"#\s*corpus-analyses:\s*(?P<names>[a-z, -]+)")
 # Codes only the analyses report (compile and `modc check`, not `modc lint`).
@@ -71,8 +80,18 @@ FUNCTION_CASES = {
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
     "traj-invalid": "test_traj_invalid",
-    **{code: "test_plan_errors" for code in ("target-unknown", "pose-unknown", "robot-unknown", "start-in-collision",
-                                             "target-unreachable", "target-in-collision", "no-path")},
+    **{
+        code: "test_plan_errors"
+        for code in (
+            "target-unknown",
+            "pose-unknown",
+            "robot-unknown",
+            "start-in-collision",
+            "target-unreachable",
+            "target-in-collision",
+            "no-path",
+        )
+    },
 }
 
 YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
@@ -80,24 +99,62 @@ YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
 
 # --- reading expectations ----------------------------------------------------------------------
 
+
 def source_text(path: Path) -> str:
     return path.read_bytes().decode("utf-8-sig", errors="replace")
 
 
-def expectations(path: Path) -> set[tuple[int | str, str, str]]:
-    """{(line, severity, code)} written in the file's `# expect` comments; line is "FILE:N" for
-    a line of another file (expect-in)."""
-    out = set()
+def pinned(path: Path) -> list[tuple[int | str, str, str, str | None]]:
+    """[(line, severity, code, message or None)] written in the file's `# expect` comments; line
+    is "FILE:N" for a line of another file (expect-in)."""
+    out = []
     for i, line in enumerate(source_text(path).split("\n"), start=1):
         for m in _EXPECT.finditer(line):
             at: int | str = int(m.group("n")) if m.group("n") else i
             if m.group("file"):
                 at = f"{m.group('file')}:{m.group('in')}"
-            for item in m.group("items").split(","):
+            for item in _ITEM_SEP.split(m.group("items")):
                 im = _ITEM.match(item)
-                assert im, f"{path.name}:{i}: malformed expectation {item!r} (write severity[code])"
-                out.add((at, im.group("sev"), im.group("code")))
+                assert im, f"{path.name}:{i}: malformed expectation {item!r} (write severity[code] message)"
+                out.append((at, im.group("sev"), im.group("code"), im.group("msg") or None))
     return out
+
+
+def expectations(path: Path) -> set[tuple[int | str, str, str]]:
+    """{(line, severity, code)} written in the file's `# expect` comments."""
+    return {(at, sev, code) for at, sev, code, _ in pinned(path)}
+
+
+def refresh_messages(path: Path, diags: list[Diagnostic]) -> None:
+    """Rewrite the `# expect` comments with the messages reported (--update-golden). Only the
+    comment is rewritten: the bytes before it (maybe not UTF-8, on purpose) are kept."""
+    by_key: dict[tuple[int | str, str, str], list[str]] = {}
+    for d in sorted(diags, key=lambda d: (d.span.line, d.span.col)):
+        by_key.setdefault((where(path, d.span.file, d.span.line), d.severity.value, d.code), []).append(d.message)
+    raw = path.read_bytes().split(b"\n")
+    for i, chunk in enumerate(raw):
+        line = chunk.decode("utf-8", errors="replace")
+        first = _EXPECT.search(line)
+        if first is None:
+            continue
+        tail = line[first.start() :]
+
+        def items(m: re.Match, i: int = i, tail: str = tail) -> str:
+            at: int | str = int(m.group("n")) if m.group("n") else i + 1
+            if m.group("file"):
+                at = f"{m.group('file')}:{m.group('in')}"
+            out = []
+            for item in _ITEM_SEP.split(m.group("items")):
+                im = _ITEM.match(item)
+                assert im is not None
+                msgs = by_key.get((at, im.group("sev"), im.group("code")), [im.group("msg") or ""])
+                out += [f"{im.group('sev')}[{im.group('code')}] {msg}".rstrip() for msg in dict.fromkeys(msgs)]
+            head = m.group(0)[: m.start("items") - m.start(0)]
+            return head + " " + ", ".join(out) + ("  " if m.end(0) < len(tail) else "")
+
+        if chunk.endswith(tail.encode("utf-8")):
+            raw[i] = chunk[: len(chunk) - len(tail.encode("utf-8"))] + _EXPECT.sub(items, tail).encode("utf-8")
+    path.write_bytes(b"\n".join(raw))
 
 
 def xfail_reason(path: Path) -> str | None:
@@ -132,8 +189,8 @@ def run_case(path: Path) -> list[Diagnostic]:
 
         return list(convert_table(read_source(path), str(path))[1])
     try:
-        extra = {"analyses": analyses(path)} if analyses(path) else {}
-        return list(check_file(path, **extra).diagnostics)
+        checked = check_file(path, analyses=analyses(path)) if analyses(path) else check_file(path)
+        return list(checked.diagnostics)
     except InputError as e:
         return [e.diagnostic]
 
@@ -166,19 +223,41 @@ def _show(items) -> str:
 
 # --- the corpus ----------------------------------------------------------------------------------
 
+
 def test_corpus_is_not_empty():
     assert len(CASES) >= 30
 
 
 @pytest.mark.parametrize("path", [case_param(p) for p in CASES])
-def test_corpus(path: Path):
+def test_corpus(path: Path, update_golden):
     expected = expectations(path)
     assert expected, f"{path.name} has no `# expect` comment"
-    got = reported(run_case(path), path)
+    diags = run_case(path)
+    got = reported(diags, path)
     missing, extra = expected - got, got - expected
     assert not missing and not extra, (
         f"{path.name}:\n  missing (expected, not reported):\n{_show(missing)}\n"
         f"  extra (reported, not expected):\n{_show(extra)}"
+    )
+    if update_golden:
+        refresh_messages(path, diags)
+    messages = {(where(path, d.span.file, d.span.line), d.severity.value, d.code, d.message) for d in diags}
+    wrong = [p for p in pinned(path) if p[3] is not None and p not in messages]
+    assert not wrong, (
+        f"{path.name}: messages changed:\n"
+        + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in wrong)
+        + "\n  reported:\n"
+        + "\n".join(f"    line {ln}: {sev}[{code}] {msg}" for ln, sev, code, msg in sorted(messages, key=str))
+        + "\n  refresh with: pytest tests/test_diagnostics_corpus.py --update-golden (and review the diff)"
+    )
+
+
+@pytest.mark.parametrize("path", [case_param(p, known_bugs=False) for p in CASES])
+def test_every_expectation_pins_its_message(path: Path):
+    bare = [(ln, sev, code) for ln, sev, code, msg in pinned(path) if msg is None]
+    assert not bare, (
+        f"{path.name}: expectations without their message text {bare}; write them with "
+        "pytest tests/test_diagnostics_corpus.py --update-golden"
     )
 
 
@@ -193,13 +272,14 @@ def test_expectations_name_registered_codes_with_their_severity():
     for path in CASES:
         for line, sev, code in expectations(path):
             assert code in REGISTRY, f"{path.name}:{line}: unknown code {code!r}"
-            assert sev == REGISTRY[code].severity.value, f"{path.name}:{line}: {code} is a {REGISTRY[code].severity.value}"
+            assert sev == REGISTRY[code].severity.value, (
+                f"{path.name}:{line}: {code} is a {REGISTRY[code].severity.value}"
+            )
 
 
 def _covered_by_corpus() -> set[str]:
     """Codes with a corpus case that is not a known failure."""
-    return {case_code(p) for p in CASES
-            if case_code(p) in {c for _, _, c in expectations(p)} and not xfail_reason(p)}
+    return {case_code(p) for p in CASES if case_code(p) in {c for _, _, c in expectations(p)} and not xfail_reason(p)}
 
 
 def test_every_code_is_covered():
@@ -251,8 +331,8 @@ def check_rendered(d: Diagnostic, text: str, path: str) -> None:
 def _check_each(path: Path, check) -> None:
     text = source_text(path)
     diags = diagnostics_of(path)
-    if not diags and xfail_reason(path):
-        pytest.xfail(xfail_reason(path))
+    if not diags and (reason := xfail_reason(path)):
+        pytest.xfail(reason)
     assert diags
     for d in diags:
         try:
@@ -299,7 +379,9 @@ def test_corpus_json_offsets_match_lines(path: Path):
 
 # --- the command line over the corpus ----------------------------------------------------------
 
-_HEAD = re.compile(r"^(?P<file>.+?):(?P<line>\d+):(?P<col>\d+): (?P<sev>error|warning|note)\[(?P<code>[a-z0-9-]+)\]: ", re.M)
+_HEAD = re.compile(
+    r"^(?P<file>.+?):(?P<line>\d+):(?P<col>\d+): (?P<sev>error|warning|note)\[(?P<code>[a-z0-9-]+)\]: ", re.M
+)
 
 
 def run_cli(capsys, *args: str) -> tuple[int, str, str]:
@@ -318,7 +400,9 @@ def run_lint(capsys, *args: str) -> tuple[int, str, str]:
 
 def text_heads(stderr: str, path: Path) -> set[tuple[int, str, str]]:
     """(line, severity, code) of the rendered diagnostics in a text report about one file."""
-    return {(int(m["line"]), m["sev"], m["code"]) for m in _HEAD.finditer(stderr) if m["file"] in (str(path), "<unknown>")}
+    return {
+        (int(m["line"]), m["sev"], m["code"]) for m in _HEAD.finditer(stderr) if m["file"] in (str(path), "<unknown>")
+    }
 
 
 def _exit_code_for(path: Path, got: set) -> int:
@@ -360,6 +444,7 @@ def test_corpus_through_the_command_line(path: Path, capsys):
 
 # --- codes that are not about the text of a file -------------------------------------------------------
 
+
 def test_file_not_found(tmp_path, capsys):
     missing = tmp_path / "nope.mod"
     with pytest.raises(InputError) as e:
@@ -383,7 +468,7 @@ def test_file_not_found_for_a_directory_given_as_file(tmp_path):
 
 
 def test_output_not_modc(tmp_path):
-    files = {"urdf/x.urdf": "<robot/>", "report.json": "{}"}
+    files: dict[str, str | bytes] = {"urdf/x.urdf": "<robot/>", "report.json": "{}"}
     # a non-empty directory modc did not write
     foreign = tmp_path / "home"
     foreign.mkdir()
@@ -416,7 +501,9 @@ def test_output_not_modc_from_the_command_line(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     (out / "notes.txt").write_text("mine", encoding="utf-8")
-    p = subprocess.run([sys.executable, "-m", "modc", str(src), "-o", str(out)], capture_output=True, text=True, timeout=120)
+    p = subprocess.run(
+        [sys.executable, "-m", "modc", str(src), "-o", str(out)], capture_output=True, text=True, timeout=120
+    )
     assert p.returncode == 2, p.stderr
     assert "error[output-not-modc]" in p.stderr and "Traceback" not in p.stderr
     assert [x.name for x in out.iterdir()] == ["notes.txt"]
@@ -493,9 +580,13 @@ def test_utf8_bom_is_accepted(tmp_path):
 
 # --- rendering details ---------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("sep", ["\f", "\v", "\x1c", "\x85", "\u2028", "\u2029"], ids=repr)
 def test_excerpt_uses_the_same_lines_as_the_parser(sep):
-    text = f"# a comment with a {sep} in it\nrobot farm {{\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 30) deg\n}}\n"
+    text = (
+        f"# a comment with a {sep} in it\nrobot farm {{\n    chain H1 - L4(port=45deg) - L1\n"
+        "    pose home (0, 30) deg\n}\n"
+    )
     c = check_text(text, "t.mod")
     assert [(d.span.line, d.code) for d in c.diagnostics] == [(4, "pose-arity")]
     check_rendered(c.diagnostics[0], text, "t.mod")
@@ -513,8 +604,11 @@ def test_traj_invalid(tmp_path):
     traj = tmp_path / "t.json"
     traj.write_text(json.dumps({"joint_names": ["joint_1", "joint_9"], "points": [{"t": 0, "q": [0, 0]}]}))
     src = HERE.parent / "examples" / "quickstart.mod"
-    r = subprocess.run([sys.executable, "-m", "modc", "play", str(src), "--traj", str(traj), "--headless"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", "play", str(src), "--traj", str(traj), "--headless"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 1, r.stderr
     assert f"{traj}:1:1: error[traj-invalid]:" in r.stderr and "= hint:" in r.stderr and "Traceback" not in r.stderr
 
@@ -543,9 +637,13 @@ def test_plan_errors(tmp_path, capsys):
     cell = tmp_path / "cell.mod"
     cell.write_text(PLAN_CELL, encoding="utf-8")
     blocked = tmp_path / "blocked.mod"
-    blocked.write_text(PLAN_CELL.replace("    pose home (0, 0, 0) deg\n",
-                                         "    pose home (0, 0, 0) deg\n    box shelf size (0.3, 0.3, 0.02) m at (-0.1, 0, 0.33) m\n"),
-                       encoding="utf-8")
+    blocked.write_text(
+        PLAN_CELL.replace(
+            "    pose home (0, 0, 0) deg\n",
+            "    pose home (0, 0, 0) deg\n    box shelf size (0.3, 0.3, 0.02) m at (-0.1, 0, 0.33) m\n",
+        ),
+        encoding="utf-8",
+    )
     cases = [  # (arguments, exit code, code, where it points)
         (["plan", str(cell), "--to", "tomato", "--robot", "farm"], 2, "target-unknown", "<command line>:1:1"),
         (["plan", str(cell), "--to", "inside", "--start", "nowhere"], 2, "pose-unknown", "<command line>:1:1"),
@@ -565,3 +663,20 @@ def test_plan_errors(tmp_path, capsys):
     d = e.value.diagnostics[0]
     assert d.code == "no-path" and e.value.exit_code == 1 and d.hint
     assert d.code in REGISTRY and d.severity == REGISTRY[d.code].severity
+
+
+def test_pinned_messages_are_read_and_compared(tmp_path):
+    """Messages may contain commas; a changed message is caught; the refresh writes it back."""
+    case = tmp_path / "missing-dash.mod"
+    case.write_text(
+        "robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] expected '-', found nothing\n}\n",
+        encoding="utf-8",
+    )
+    assert pinned(case) == [(2, "error", "missing-dash", "expected '-', found nothing")]
+    diags = run_case(case)
+    assert (2, "error", "missing-dash", diags[0].message) != pinned(case)[0]
+    refresh_messages(case, diags)
+    assert pinned(case) == [(2, "error", "missing-dash", diags[0].message)]
+    assert case.read_text(encoding="utf-8").startswith(
+        "robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] "
+    )

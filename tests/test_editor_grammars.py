@@ -1,17 +1,22 @@
 """Editor grammars: the VS Code extension (TextMate grammar) and the Pygments lexer.
 
-Both are hand-written highlighting grammars of the language that grammar/modc.lark defines, so
-they are checked against it here: same keywords, same units of measure (modc.model.quantities).
-A keyword added to the Lark grammar fails these tests until both editor grammars know it. The
+Both are highlighting grammars of the language that grammar/modc.lark defines. Their keyword
+lists are regenerated here from the Lark grammar (modc.lsp.language: block, statement and clause
+keywords) and compared: a keyword added to the Lark grammar fails these tests until both editor
+grammars know it, in the right class. `pytest tests/test_editor_grammars.py --update-golden`
+rewrites the Pygments lists; the TextMate grammar needs a rule per keyword (the failure says which).
+Units of measure come from modc.model.quantities. The
 TextMate grammar's own assertions (editors/vscode/tests/*.mod) run under vscode-tmgrammar-test
 through editors/vscode/test.sh, which needs node and npm (skipped, saying so, without npm).
 """
+
 from __future__ import annotations
 
 import json
 import re
 import shutil
 import subprocess
+import textwrap
 from pathlib import Path
 
 import pytest
@@ -85,14 +90,73 @@ def test_lark_keywords_include_the_named_terminal():
     assert grammar_keywords() <= keywords
 
 
-def test_textmate_keywords_match_the_lark_grammar(tmlanguage):
-    textmate = {m.group(1) for s in scope_names(tmlanguage) if (m := KEYWORD_SCOPE.fullmatch(s))}
-    lark = lark_keywords()
-    assert textmate == lark, (
-        f"editors/vscode/syntaxes/mod.tmLanguage.json lacks {sorted(lark - textmate)}, "
-        f"has extra {sorted(textmate - lark)}: give each keyword a rule with scope keyword.control.<kw>.mod "
-        "(statement) or keyword.other.<kw>.mod (clause) and an assertion in editors/vscode/tests/*.mod"
+def keyword_classes() -> dict[str, set[str]]:
+    """The keyword lists as the grammar gives them."""
+    from modc.lsp import language
+
+    return {
+        "DECLARATIONS": set(language.declaration_keywords()),
+        "STATEMENTS": set(language.statement_keywords()),
+        "CLAUSES": set(language.clause_keywords()),
+    }
+
+
+def _keyword_rule(name: str, kind: str, words: list[str]) -> str:
+    """A TextMate repository entry matching words, as written in mod.tmLanguage.json."""
+    alternatives = "|".join(f"({w})" for w in words)
+    captures = ",\n".join(f'        "{i}": {{ "name": "keyword.{kind}.{w}.mod" }}' for i, w in enumerate(words, 1))
+    return (
+        f'    "{name}": {{\n      "match": "(?<![\\\\w-])(?:{alternatives})(?![\\\\w-])",\n'
+        f'      "captures": {{\n{captures}\n      }}\n    }}'
     )
+
+
+def refresh_textmate(tmlanguage: dict, missing: dict[str, set[str]], path: Path = TMLANGUAGE) -> None:
+    """Add keywords the TextMate grammar lacks to its generic rules: statements to `placement`,
+    clauses to `clause` (keywords with a structure of their own need a hand-written rule)."""
+    text = path.read_text(encoding="utf-8")
+    for name, kind in (("placement", "control"), ("clause", "other")):
+        rule = tmlanguage["repository"][name]
+        words = [c["name"].split(".")[2] for _, c in sorted(rule["captures"].items(), key=lambda kv: int(kv[0]))]
+        words += sorted(missing[kind] - set(words))
+        m = re.search(rf'^    "{name}": \{{\n(?:.*\n)*?    \}}', text, re.M)
+        assert m, name
+        text = text[: m.start()] + _keyword_rule(name, kind, words) + text[m.end() :]
+    json.loads(text)
+    path.write_text(text, encoding="utf-8")
+
+
+def test_textmate_keywords_match_the_lark_grammar(tmlanguage, update_golden):
+    scopes = scope_names(tmlanguage)
+    got = {
+        kind: {m.group(1) for s in scopes if (m := re.fullmatch(rf"keyword\.{kind}\.([a-z]+(?:-[a-z]+)*)\.mod", s))}
+        for kind in ("control", "other")
+    }
+    got["other"] -= {"unit"}
+    want = keyword_classes()
+    expected = {"control": want["DECLARATIONS"] | want["STATEMENTS"], "other": want["CLAUSES"]}
+    if update_golden and any(expected[k] - got[k] for k in got):
+        refresh_textmate(tmlanguage, {k: expected[k] - got[k] for k in got})
+        pytest.skip(
+            "editors/vscode/syntaxes/mod.tmLanguage.json: keywords added to its generic rules; add "
+            "assertions for them in editors/vscode/tests/*.mod"
+        )
+    for kind in ("control", "other"):
+        assert got[kind] == expected[kind], (
+            f"editors/vscode/syntaxes/mod.tmLanguage.json: keyword.{kind} lacks {sorted(expected[kind] - got[kind])}, "
+            f"has extra {sorted(got[kind] - expected[kind])}: give each keyword a rule with scope "
+            "keyword.control.<kw>.mod (block or statement) or keyword.other.<kw>.mod (clause) and an assertion in "
+            "editors/vscode/tests/*.mod"
+        )
+
+
+def test_textmate_refresh_adds_a_new_keyword(tmlanguage, tmp_path):
+    copy = tmp_path / "mod.tmLanguage.json"
+    copy.write_text(TMLANGUAGE.read_text(encoding="utf-8"), encoding="utf-8")
+    refresh_textmate(tmlanguage, {"control": {"gripper"}, "other": {"grip"}}, copy)
+    scopes = scope_names(json.loads(copy.read_text(encoding="utf-8")))
+    assert {"keyword.control.gripper.mod", "keyword.other.grip.mod"} <= scopes
+    assert scope_names(tmlanguage) <= scopes
 
 
 def test_textmate_units_of_measure_match_the_model(tmlanguage):
@@ -110,14 +174,30 @@ def test_every_keyword_and_unit_is_asserted_in_the_grammar_tests():
     assert set(MEASURES) <= measures, f"no assertion for {sorted(set(MEASURES) - measures)}"
 
 
-def test_pygments_keywords_match_the_lark_grammar():
+def test_pygments_keywords_match_the_lark_grammar(update_golden):
     from modc import pygments_lexer
 
-    lark = lark_keywords()
-    assert set(pygments_lexer.KEYWORDS) == lark, (
-        f"modc/pygments_lexer.py lacks {sorted(lark - set(pygments_lexer.KEYWORDS))}, "
-        f"has extra {sorted(set(pygments_lexer.KEYWORDS) - lark)}"
-    )
+    want = keyword_classes()
+    if update_golden:  # the refresh path: rewrite the tuples in modc/pygments_lexer.py
+        text = LEXER_FILE.read_text(encoding="utf-8")
+        for name, words in want.items():
+            listed = ", ".join(f'"{w}"' for w in sorted(words)) + ("," if len(words) == 1 else "")
+            line = textwrap.fill(
+                f"{name} = ({listed})",
+                width=110,
+                subsequent_indent=" " * (len(name) + 4),
+                break_long_words=False,
+                break_on_hyphens=False,
+            )
+            text = re.sub(rf"^{name} = \((?:[^()]*)\)", line.replace("\\", "\\\\"), text, count=1, flags=re.M)
+        LEXER_FILE.write_text(text, encoding="utf-8")
+        pytest.skip("modc/pygments_lexer.py keyword lists rewritten from the grammar: review the diff")
+    for name, words in want.items():
+        listed = getattr(pygments_lexer, name)
+        assert list(listed) == sorted(words), (
+            f"modc/pygments_lexer.py {name} = {listed}, the grammar says {tuple(sorted(words))}: "
+            "refresh with pytest tests/test_editor_grammars.py --update-golden"
+        )
     assert set(pygments_lexer.MEASURES) == set(MEASURES)
 
 
@@ -211,7 +291,14 @@ def test_pygments_lexer_loads_from_its_file():
 
     lexer = load_lexer_from_file(str(LEXER_FILE), "ModLexer")
     assert lexer.name == "modc"
-    assert [v for _, v in lexer.get_tokens("robot r { chain H1 }") if v.strip()] == ["robot", "r", "{", "chain", "H1", "}"]
+    assert [v for _, v in lexer.get_tokens("robot r { chain H1 }") if v.strip()] == [
+        "robot",
+        "r",
+        "{",
+        "chain",
+        "H1",
+        "}",
+    ]
 
 
 def test_pyproject_registers_the_lexer():
@@ -265,7 +352,9 @@ def test_grammar_tests_have_the_header():
 def _run_grammar_tests(*files: Path) -> subprocess.CompletedProcess:
     if shutil.which("npm") is None or shutil.which("node") is None:
         pytest.skip("npm/node not installed: the TextMate grammar tests (editors/vscode/test.sh) need them")
-    return subprocess.run(["bash", str(VSCODE / "test.sh"), *map(str, files)], capture_output=True, text=True, timeout=600)
+    return subprocess.run(
+        ["bash", str(VSCODE / "test.sh"), *map(str, files)], capture_output=True, text=True, timeout=600
+    )
 
 
 def test_textmate_grammar_tests_pass():
@@ -278,7 +367,37 @@ def test_textmate_grammar_tests_pass():
 def test_textmate_grammar_tests_catch_a_wrong_scope(tmp_path):
     """The harness really fails: a test file asserting a wrong scope makes test.sh exit non-zero."""
     broken = tmp_path / "broken.mod"
-    broken.write_text('# SYNTAX TEST "source.mod"\nrobot r { chain H1 }\n#         ^^^^^ keyword.other.at.mod\n', encoding="utf-8")
+    broken.write_text(
+        '# SYNTAX TEST "source.mod"\nrobot r { chain H1 }\n#         ^^^^^ keyword.other.at.mod\n', encoding="utf-8"
+    )
     r = _run_grammar_tests(broken)
     assert r.returncode != 0
     assert "missing required scopes: keyword.other.at.mod" in r.stdout, r.stdout + r.stderr
+
+
+def test_vsce_packages_the_extension(tmp_path):
+    """`vsce package` (pinned in package-lock.json, through editors/vscode/package.sh) makes a
+    .vsix: no relative README link, a repository field, a LICENSE; the runtime dependency and the
+    grammar inside, the grammar tests and scripts left out."""
+    import zipfile
+
+    if shutil.which("npm") is None or shutil.which("node") is None:
+        pytest.skip("npm/node not installed: packaging the VS Code extension needs them")
+    vsix = tmp_path / "modc.vsix"
+    r = subprocess.run(
+        ["bash", str(VSCODE / "package.sh"), "-o", str(vsix)], capture_output=True, text=True, timeout=900
+    )
+    assert r.returncode == 0, r.stdout + r.stderr
+    names = set(zipfile.ZipFile(vsix).namelist())
+    assert {
+        "extension/package.json",
+        "extension/extension.js",
+        "extension/syntaxes/mod.tmLanguage.json",
+        "extension/language-configuration.json",
+        "extension/readme.md",
+        "extension.vsixmanifest",
+    } <= {n if not n.lower().endswith("readme.md") else n.lower() for n in names}
+    assert any(n.lower().startswith("extension/license") for n in names)
+    assert any(n.startswith("extension/node_modules/vscode-languageclient/") for n in names)
+    assert not any(n.startswith(("extension/tests/", "extension/node_modules/@vscode/vsce")) for n in names)
+    assert "extension/test.sh" not in names and "extension/package.sh" not in names

@@ -1,24 +1,26 @@
 """The language server (`python -m modc.lsp`, i.e. `modc lsp`), driven as a real process over
 stdio by modc.lsp.client (JSON-RPC with Content-Length framing over pipes), plus in-process
 tests of the position conversions and the completion heuristics."""
+
 from __future__ import annotations
 
 import statistics
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from modc.compiler import check_text
 from modc.diagnostics import REGISTRY
 from modc.lsp import convert
+from modc.lsp.client import Client
 from modc.lsp.completion import complete
 from modc.lsp.document import Analysis
 from modc.lsp.formatting import formatting
 from modc.lsp.hover import hover
-from modc.lsp.language import KEYWORDS, STATEMENTS
+from modc.lsp.language import keyword_doc, statements
 from modc.lsp.symbols import definition, symbols
-from modc.lsp.client import Client
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT / "tests" / "diagnostics"
@@ -68,14 +70,22 @@ def server():
     c = start_server()
     yield c
     code = c.shutdown()
-    errors = [m for _, m in c.notifications if m.get("method") in ("window/logMessage", "window/showMessage")
-              and m["params"]["type"] == 1 and "modc:" in m["params"]["message"]
-              and not m["params"]["message"].startswith("modc: checking")]  # compiler bugs: see the corpus test
+    errors = [
+        m
+        for _, m in c.notifications
+        if m.get("method") in ("window/logMessage", "window/showMessage")
+        and m["params"]["type"] == 1
+        and "modc:" in m["params"]["message"]
+        and not m["params"]["message"].startswith("modc: checking")
+    ]  # compiler bugs: see the corpus test
     assert code == 0
     assert not errors, errors  # no handler of ours failed during the whole module
 
 
 _n = 0
+
+
+LAST_DIAGS: dict[int, list[dict]] = {}  # the first diagnostics open_doc saw, by client
 
 
 def open_doc(server: Client, text: str, name: str = "t.mod", directory: Path | None = None) -> str:
@@ -84,11 +94,12 @@ def open_doc(server: Client, text: str, name: str = "t.mod", directory: Path | N
     _n += 1
     uri = convert.path_to_uri(str((directory or Path("/tmp/modc-lsp-test")) / f"{_n}" / name))
     server.open(uri, text)
-    server._last_diags = server.diagnostics(uri, version=1)
+    LAST_DIAGS[id(server)] = server.diagnostics(uri, version=1)
     return uri
 
 
 # --- lifecycle and capabilities ----------------------------------------------------------------------
+
 
 def test_initialize_advertises_features():
     with Client([sys.executable, "-m", "modc.lsp"], cwd=str(ROOT)) as c:
@@ -108,25 +119,34 @@ def test_exit_without_shutdown_and_closed_stdin_end_the_process():
     c.close()
     c = Client([sys.executable, "-m", "modc.lsp"], cwd=str(ROOT))
     c.initialize()
-    c.proc.stdin.close()
+    c.stdin.close()
     c.proc.wait(10)
     c.close()
 
 
 # --- diagnostics ------------------------------------------------------------------------------------
 
+
 def test_diagnostics_on_open_and_cleared_by_a_fix(server):
     text = "robot a {\n    chain H1 - L4(port=40deg) - L1\n}\n"
     uri = open_doc(server, text)
-    [d] = server._last_diags
+    [d] = LAST_DIAGS[id(server)]
     assert d["code"] == "twist-not-realisable" and d["source"] == "modc" and d["severity"] == 1
     line, col = pos(text, "port=40deg")
-    assert d["range"] == {"start": {"line": line, "character": col}, "end": {"line": line, "character": col + len("port=40deg")}}
-    assert d["message"].startswith("L4 port 40deg cannot be set") and "\nhint: nearest realisable value: 45deg" in d["message"]
+    assert d["range"] == {
+        "start": {"line": line, "character": col},
+        "end": {"line": line, "character": col + len("port=40deg")},
+    }
+    assert (
+        d["message"].startswith("L4 port 40deg cannot be set")
+        and "\nhint: nearest realisable value: 45deg" in d["message"]
+    )
     assert d["data"]["hint"] == "nearest realisable value: 45deg"
     # an incremental edit: 40 -> 45
     line, col = pos(text, "40deg")
-    server.change(uri, 2, rng={"start": {"line": line, "character": col}, "end": {"line": line, "character": col + 2}}, new="45")
+    server.change(
+        uri, 2, rng={"start": {"line": line, "character": col}, "end": {"line": line, "character": col + 2}}, new="45"
+    )
     assert server.diagnostics(uri, version=2) == []
     # and breaking it again with a full-text change
     server.change(uri, 3, text="robot a {\n    chain H1 L4\n}\n")
@@ -136,7 +156,7 @@ def test_diagnostics_on_open_and_cleared_by_a_fix(server):
 
 def test_close_clears_diagnostics(server):
     uri = open_doc(server, "robot a { chain L1 }")
-    assert [d["code"] for d in server._last_diags] == ["first-variant"]
+    assert [d["code"] for d in LAST_DIAGS[id(server)]] == ["first-variant"]
     server.notify("textDocument/didClose", {"textDocument": {"uri": uri}})
     assert server.diagnostics(uri) == []
 
@@ -165,17 +185,22 @@ def test_diagnostics_are_the_cli_diagnostics(server):
         try:
             want = check_text(text, str(path)).diagnostics
         except Exception as e:  # a compiler bug: the editor says so instead of going quiet
-            assert len(got) == 1 and "internal error" in got[0]["message"] and type(e).__name__ in got[0]["message"], path.name
+            assert len(got) == 1 and "internal error" in got[0]["message"] and type(e).__name__ in got[0]["message"], (
+                path.name
+            )
             continue
         assert [d["code"] for d in got] == [d.code for d in want], path.name
-        for g, w in zip(got, want):
+        for g, w in zip(got, want, strict=True):
             sev = {"error": 1, "warning": 2, "note": 3}[w.severity.value]
             assert g["severity"] == sev and g["message"].split("\nhint: ")[0].endswith(w.message), path.name
             assert g["data"]["hint"] == w.hint
             if w.span.file == str(path) and text.isascii():
                 lines = text.split("\n")
                 line = w.span.line - 1
-                assert g["range"]["start"] == {"line": line, "character": min(w.span.col - 1, len(lines[line]) if line < len(lines) else 0)}, path.name
+                assert g["range"]["start"] == {
+                    "line": line,
+                    "character": min(w.span.col - 1, len(lines[line]) if line < len(lines) else 0),
+                }, path.name
             seen.add(w.code)
     assert len(seen) > 30  # the corpus covers most codes
 
@@ -183,20 +208,21 @@ def test_diagnostics_are_the_cli_diagnostics(server):
 def test_yaml_documents_get_diagnostics(server):
     good = (ROOT / "examples" / "quickstart.yaml").read_text()
     open_doc(server, good, "q.yaml")
-    assert server._last_diags == []
+    assert LAST_DIAGS[id(server)] == []
     bad = "robots:\n  - name: a\n    chain: [L1, {unit: L4, port: 40deg}]\n"
     open_doc(server, bad, "b.yml")
-    assert {d["code"] for d in server._last_diags} == {"first-variant", "twist-not-realisable"}
+    assert {d["code"] for d in LAST_DIAGS[id(server)]} == {"first-variant", "twist-not-realisable"}
 
 
 def test_no_torque_analysis_in_the_editor(server):
     # an arm that cannot hold itself: compile reports torque-over-peak, the editor (lint level) does not
     text = "robot weak {\n    chain H1 - L4(link=500mm) - L4(link=500mm) - L4(link=500mm)\n    payload 3 kg\n}\n"
     open_doc(server, text)
-    assert "torque-over-peak" not in {d["code"] for d in server._last_diags}
+    assert "torque-over-peak" not in {d["code"] for d in LAST_DIAGS[id(server)]}
 
 
 # --- hover ------------------------------------------------------------------------------------------
+
 
 def hover_text(server, uri, text, needle, nth=0, delta=1):
     h = server.at("textDocument/hover", uri, *pos(text, needle, nth, delta))
@@ -236,11 +262,12 @@ def test_hover_on_h4_anywhere(server):
 def test_every_keyword_has_a_hover():
     from modc.syntax import grammar_keywords
 
-    assert grammar_keywords() <= set(KEYWORDS)
-    assert set(STATEMENTS) <= grammar_keywords()
+    assert all(keyword_doc(k) for k in grammar_keywords())
+    assert set(statements()) <= grammar_keywords()
 
 
 # --- completion -------------------------------------------------------------------------------------
+
 
 def complete_at_end(server, text, name="t.mod"):
     uri = open_doc(server, text, name)
@@ -269,7 +296,10 @@ def test_completion_of_allowable_codes(server):
     text = "robot a {\n    chain L1\n    allow first-v"
     items = complete_at_end(server, text)
     edit = next(i for i in items if i["label"] == "first-variant")["textEdit"]
-    assert edit["range"]["start"] == {"line": 2, "character": 10} and edit["range"]["end"] == {"line": 2, "character": 17}
+    assert edit["range"]["start"] == {"line": 2, "character": 10} and edit["range"]["end"] == {
+        "line": 2,
+        "character": 17,
+    }
 
 
 def test_completion_of_parameters_and_measures(server):
@@ -286,13 +316,17 @@ def test_completion_of_parameters_and_measures(server):
 
 def test_completion_of_statements_and_clauses(server):
     got = labels(complete_at_end(server, "robot a {\n    chain H1 - L1\n    "))
-    assert got == list(STATEMENTS)
+    assert got == list(statements())
     assert "chain" in labels(complete_at_end(server, "robot a {\n    cha"))
     assert labels(complete_at_end(server, "")) == ["robot"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf ")) == ["size"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf size (1, 1, 1) m ")) == ["at"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    library ")) == ["mark2", "mark2-strict"]
-    assert labels(complete_at_end(server, "robot a { chain H1 - L4(port=45deg) - L1\n    limit ")) == ["joint_1", "joint_2", "joint_3"]
+    assert labels(complete_at_end(server, "robot a { chain H1 - L4(port=45deg) - L1\n    limit ")) == [
+        "joint_1",
+        "joint_2",
+        "joint_3",
+    ]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ")) == ["home"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose home (0,0,0) deg\n    pose ")) == []
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ready ")) == ["(0, 0, 0) deg"]
@@ -301,13 +335,16 @@ def test_completion_of_statements_and_clauses(server):
 
 def test_completion_in_yaml(server):
     assert "L4" in labels(complete_at_end(server, "robots:\n  - name: a\n    chain:\n      - H1\n      - ", "a.yaml"))
-    assert "first-variant" in labels(complete_at_end(server, "robots:\n  - name: a\n    chain: [L1]\n    allow: [", "a.yaml"))
+    assert "first-variant" in labels(
+        complete_at_end(server, "robots:\n  - name: a\n    chain: [L1]\n    allow: [", "a.yaml")
+    )
     items = complete_at_end(server, "robots:\n  - name: a\n    chain:\n      - H1\n      - L", "a.yaml")
     edit = next(i for i in items if i["label"] == "L4")["textEdit"]  # the typed "L" is replaced
     assert edit["range"] == {"start": {"line": 4, "character": 8}, "end": {"line": 4, "character": 9}}
 
 
 # --- symbols, definition, formatting ----------------------------------------------------------------
+
 
 def test_document_symbols(server):
     uri = open_doc(server, FARM)
@@ -317,14 +354,18 @@ def test_document_symbols(server):
     kids = {(c["name"], c["detail"]) for c in farm["children"]}
     assert {("chain", "H1-L4-L3"), ("ready", "pose"), ("floor", "box"), ("plant", "target")} <= kids
     chain = next(c for c in farm["children"] if c["name"] == "chain")
-    assert [(u["name"], u["detail"]) for u in chain["children"]] == [("H1", "joint_1"), ("L4", "joint_2"), ("L3", "joint_3")]
+    assert [(u["name"], u["detail"]) for u in chain["children"]] == [
+        ("H1", "joint_1"),
+        ("L4", "joint_2"),
+        ("L3", "joint_3"),
+    ]
     assert farm["selectionRange"]["start"] == {"line": 0, "character": 6}
 
 
 def test_document_symbols_of_a_half_typed_file(server):
     text = "robot a {\n    chain H1 - L4(piv\n    pose p (0, 0) deg\nrobot b {\n    target t at (0"
     uri = open_doc(server, text)
-    assert server._last_diags and server._last_diags[0]["severity"] == 1
+    assert LAST_DIAGS[id(server)] and LAST_DIAGS[id(server)][0]["severity"] == 1
     syms = server.result("textDocument/documentSymbol", {"textDocument": {"uri": uri}})
     assert [s["name"] for s in syms] == ["a", "b"]
     assert [c["name"] for c in syms[1]["children"]] == ["t"]
@@ -340,8 +381,10 @@ def test_definition(server):
     uri = open_doc(server, FARM)
 
     def where(needle, nth=0, delta=1):
-        return [(loc["uri"], loc["range"]["start"]["line"], loc["range"]["start"]["character"])
-                for loc in server.at("textDocument/definition", uri, *pos(FARM, needle, nth, delta))]
+        return [
+            (loc["uri"], loc["range"]["start"]["line"], loc["range"]["start"]["character"])
+            for loc in server.at("textDocument/definition", uri, *pos(FARM, needle, nth, delta))
+        ]
 
     # joint_2 in `limit` -> the second unit of the chain
     assert where("joint_2") == [(uri, *pos(FARM, "L4(pivot"))]
@@ -369,14 +412,15 @@ def test_definition_in_a_half_typed_file(server):
 def test_formatting(server):
     text = "robot a {\nchain H1 -   L1\n}\n"
     uri = open_doc(server, text)
-    edits = server.result("textDocument/formatting", {"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": True}})
+    edits = server.result(
+        "textDocument/formatting", {"textDocument": {"uri": uri}, "options": {"tabSize": 4, "insertSpaces": True}}
+    )
     try:
         from modc.syntax.format import format_text
     except ImportError:
         assert edits == []  # no formatter yet: no edits
         return
-    want = format_text(text, convert.uri_to_path(uri))
-    want = want[0] if isinstance(want, tuple) else want
+    want, _ = format_text(text, convert.uri_to_path(uri))
     assert want == "robot a {\n    chain H1 - L1\n}\n"
     if want == text:
         assert edits == []
@@ -389,7 +433,7 @@ def test_formatting(server):
 def test_formatting_calls_format_text(monkeypatch):
     import types as pytypes
 
-    fake = pytypes.ModuleType("modc.syntax.format")
+    fake: Any = pytypes.ModuleType("modc.syntax.format")
     fake.format_text = lambda text, path: (text.replace("-   ", "- "), [])
     monkeypatch.setitem(sys.modules, "modc.syntax.format", fake)
     an = Analysis("robot a {\n    chain H1 -   L1\n}", "/x/a.mod")
@@ -405,6 +449,7 @@ def test_formatting_calls_format_text(monkeypatch):
 
 # --- robustness -------------------------------------------------------------------------------------
 
+
 def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     uri = open_doc(server, FARM)
 
@@ -417,7 +462,14 @@ def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     assert r["error"]["code"] == -32601
     alive()
     # bad params -> an error response (invalid params), not a crash
-    for params in ({"textDocument": 5}, {"position": {"line": "x"}}, [], None, {"textDocument": {"uri": uri}, "position": {"line": -1, "character": 0}}):
+    bad: tuple[object, ...] = (
+        {"textDocument": 5},
+        {"position": {"line": "x"}},
+        [],
+        None,
+        {"textDocument": {"uri": uri}, "position": {"line": -1, "character": 0}},
+    )
+    for params in bad:
         r = server.request("textDocument/hover", params)
         assert "error" in r or r.get("result") is None
         alive()
@@ -426,9 +478,15 @@ def test_malformed_requests_get_errors_and_the_server_keeps_answering(server):
     alive()
     # positions out of range are clamped: no error
     for line, col in ((1000, 0), (0, 10_000), (10_000, 10_000)):
-        assert "result" in server.request("textDocument/hover", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
-        assert "result" in server.request("textDocument/completion", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
-        assert "result" in server.request("textDocument/definition", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
+        assert "result" in server.request(
+            "textDocument/hover", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}}
+        )
+        assert "result" in server.request(
+            "textDocument/completion", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}}
+        )
+        assert "result" in server.request(
+            "textDocument/definition", {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}}
+        )
     alive()
     # a document that was never opened: empty answers, and the file is not read
     other = "file:///dev/zero"
@@ -459,7 +517,7 @@ HALF_TYPED = [
     "robot a { chain H1 - L4(pivot=-90deg,",
     "robot a { chain H1 - L4 } }",
     "robot a { dh { row a=",
-    "robot a { library \"unterminated",
+    'robot a { library "unterminated',
     "robot a { pose",
     "robot a { allow",
     "}}}}((((",
@@ -486,7 +544,10 @@ def test_half_typed_files_never_break_a_feature(server):
             for method in ("textDocument/hover", "textDocument/completion", "textDocument/definition"):
                 r = server.request(method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": col}})
                 assert "result" in r, (method, text, r)
-        for method, extra in (("textDocument/documentSymbol", {}), ("textDocument/formatting", {"options": {"tabSize": 4, "insertSpaces": True}})):
+        for method, extra in (
+            ("textDocument/documentSymbol", {}),
+            ("textDocument/formatting", {"options": {"tabSize": 4, "insertSpaces": True}}),
+        ):
             r = server.request(method, {"textDocument": {"uri": uri}, **extra})
             assert "result" in r, (method, text, r)
     # one error per unparsable text, as the CLI
@@ -510,12 +571,15 @@ def test_diagnostics_latency_smoke(server):
     times = []
     for v in range(2, 22):
         t0 = server.change(uri, v, text=text + f"\n# edit {v}\n")
-        t1, _ = server.wait_notification("textDocument/publishDiagnostics", lambda p: p["uri"] == uri and p["version"] == v)
+        t1, _ = server.wait_notification(
+            "textDocument/publishDiagnostics", lambda p, v=v: p["uri"] == uri and p["version"] == v
+        )
         times.append(t1 - t0)
     assert statistics.median(times) < 0.25
 
 
 # --- in-process: conversions ------------------------------------------------------------------------
+
 
 def test_positions_count_utf16_code_units():
     text = "# 🤖 é\nrobot a { chain H1 - L4 }  # ℍ 🤖 x"
@@ -569,19 +633,36 @@ def test_lexer_and_outline_survive_anything():
             definition(an, off, "file:///x/a.mod")
 
 
-@pytest.mark.parametrize("path, text", [
-    ("/x/a.mod", "robot a {\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 10, 0) deg\n    target p at (0.2, 0, 0.3) m\n}\n"),
-    ("/x/a.yaml", "robots:\n  - name: a\n    chain: [H1, {unit: L4, port: 45deg}, L1]\n    poses: {home: \"(0, 10, 0) deg\"}\n"),
-])
+@pytest.mark.parametrize(
+    "path, text",
+    [
+        (
+            "/x/a.mod",
+            "robot a {\n    chain H1 - L4(port=45deg) - L1\n    pose home (0, 10, 0) deg\n"
+            "    target p at (0.2, 0, 0.3) m\n}\n",
+        ),
+        (
+            "/x/a.yaml",
+            'robots:\n  - name: a\n    chain: [H1, {unit: L4, port: 45deg}, L1]\n    poses: {home: "(0, 10, 0) deg"}\n',
+        ),
+    ],
+)
 def test_each_version_is_parsed_once(monkeypatch, path, text):
     """Diagnostics, symbols, hover, completion and definitions all use the check's own parse."""
     import modc.syntax
     import modc.syntax.yaml_form
 
     calls = []
+
+    def counting(real):
+        def parse(*args):
+            calls.append(args)
+            return real(*args)
+
+        return parse
+
     for module, name in ((modc.syntax, "parse"), (modc.syntax.yaml_form, "parse_yaml")):
-        real = getattr(module, name)
-        monkeypatch.setattr(module, name, lambda *a, real=real: calls.append(a) or real(*a))
+        monkeypatch.setattr(module, name, counting(getattr(module, name)))
     an = Analysis(text, path)
     an.diagnostics()
     assert an.parsed
@@ -591,3 +672,147 @@ def test_each_version_is_parsed_once(monkeypatch, path, text):
         hover(an, off)
         definition(an, off, "file://" + path)
     assert len(calls) == 1
+
+
+# --- the language described once: read from the grammar ---------------------------------------------
+
+
+def test_keyword_classes_are_read_from_the_grammar():
+    from modc.lsp import language
+
+    assert language.declaration_keywords() == {"robot"}
+    assert language.statements() == (
+        "chain",
+        "dh",
+        "library",
+        "base",
+        "tool",
+        "payload",
+        "pose",
+        "limit",
+        "box",
+        "sphere",
+        "cylinder",
+        "target",
+        "allow",
+    )
+    assert language.statements("dh") == ("row",)
+    assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links"}
+    assert language.name_takers() == {"robot", "pose", "limit", "box", "sphere", "cylinder", "target"}
+    assert language.syntax_of("cylinder") == "cylinder NAME radius QUANTITY length QUANTITY at (…) rpy (…)"
+
+
+def test_every_value_keyword_has_a_quantity_kind():
+    """A keyword followed by a quantity or vector in the grammar needs its kind (length, angle,
+    mass) in language.QUANTITY_KINDS, so that completion offers the right units of measure."""
+    from modc.lsp import language
+
+    assert language.value_keywords() <= set(language.QUANTITY_KINDS), sorted(
+        language.value_keywords() - set(language.QUANTITY_KINDS)
+    )
+
+
+GRAMMAR_PLUS = {
+    # a new statement: grammar only
+    "     | allow\n": "     | allow\n     | gripper\n",
+    'allow: "allow"': 'gripper: "gripper" NAME at\nallow: "allow"',
+    # a new top-level block with its own statement
+    "start: robot*": 'start: (robot | design)*\ndesign: "design" NAME "{" use* "}"\nuse: "use" NAME',
+}
+
+
+@pytest.fixture
+def grammar_plus(monkeypatch, tmp_path):
+    """The real grammar with a new statement (`gripper NAME at (…)`) and a new top-level block
+    (`design NAME { use NAME }`): nothing else changed."""
+    from lark import Lark
+
+    import modc.syntax.parser as parser
+    from modc.lsp import language
+    from modc.resources import data_dir
+
+    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
+    for old, new in GRAMMAR_PLUS.items():
+        assert old in text
+        text = text.replace(old, new)
+    lark = Lark(
+        text,
+        parser="lalr",
+        propagate_positions=True,
+        maybe_placeholders=True,
+        start=["start", "unit_text", "quantity_text", "vector_text"],
+    )
+    monkeypatch.setattr(parser, "_lark", lambda: lark)
+    language.reset()
+    yield
+    monkeypatch.undo()
+    language.reset()
+
+
+def _labels(items) -> list[str]:
+    return [i.label for i in items]
+
+
+def test_a_new_statement_needs_no_language_server_change(grammar_plus):
+    from modc.lsp import language
+
+    assert "gripper" in language.statements() and "gripper" in language.name_takers()
+    assert language.declaration_keywords() == {"robot", "design"} and language.statements("design") == ("use",)
+    got = _labels(complete(Analysis("robot a {\n    chain H1 - L1\n    ", "/x/a.mod"), 33))
+    assert got[-1] == "gripper" and got[:-1] == list(language.statements())[:-1]
+    text = "robot a {\n    chain H1 - L1\n    gripper g "
+    assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["at"]
+    text += "at (0, 0, 0.1) "
+    assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["m", "cm", "mm"]
+    assert set(_labels(complete(Analysis("", "/x/a.mod"), 0))) == {"robot", "design"}
+    text = "design d {\n    "
+    assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["use"]
+    # the half-typed outline declares the new statement's name
+    an = Analysis("robot a {\n    chain H1 - L1\n    gripper g at (0, 0", "/x/a.mod")
+    assert [(d.kind, d.name) for d in an.decls] == [("robot", "a"), ("gripper", "g")]
+    assert hover(an, an.text.index("gripper") + 1) is not None
+
+
+def test_capability_by_dotted_path():
+    from lsprotocol import types
+
+    from modc.lsp.server import capability
+
+    path = "text_document.completion.completion_item.snippet_support"
+    assert capability(types.ClientCapabilities(), path, False) is False
+    caps = types.ClientCapabilities(
+        text_document=types.TextDocumentClientCapabilities(
+            completion=types.CompletionClientCapabilities(
+                completion_item=types.ClientCompletionItemOptions(snippet_support=True)
+            )
+        )
+    )
+    assert capability(caps, path, False) is True
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "robot a { dh {\n    row a=0.3 m, alpha=0deg, d=0 m\nrow\nrow\nrow x",
+        "row\nrow\n",
+        "chain H1\nchain\n  robot\nrobot a {\n    @@@\n    chain H1 -",
+        "robot a {\n    chain H1 H2\n    pose p (0, 0\n    box\n",
+    ],
+)
+def test_tolerant_parse_always_moves_forward(text):
+    """Restarts that fail on their own first word move on: every prefix finishes."""
+    from modc.lsp import tolerant
+
+    for n in range(len(text) + 1):
+        tolerant.stand_at(text[:n])
+        tolerant.outline(text[:n])
+
+
+def test_parameters_are_the_lowerings():
+    """Parameter names and kinds come from the lowering (model/lower.py); every one has its words."""
+    from modc.lsp import language
+    from modc.model import lower
+
+    assert language.UNIT_PARAMS == tuple(lower.UNIT_PARAMS) and language.DH_PARAMS == tuple(lower.DH_PARAMS)
+    assert set(language.PARAM_TEXT) == set(lower.UNIT_PARAMS) | set(lower.DH_PARAMS)
+    assert all(kind in language.KIND_MEASURES for kind, _ in language.PARAMS.values())

@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 stamp=node_modules/.modc-package-lock.json
-if [ ! -x node_modules/.bin/vscode-tmgrammar-test ] || ! cmp -s package-lock.json "$stamp"; then
+if [ ! -x node_modules/.bin/vscode-tmgrammar-test ] || [ ! -x node_modules/.bin/vsce ] || ! cmp -s package-lock.json "$stamp"; then
     npm ci --no-audit --no-fund --loglevel=error
     cp package-lock.json "$stamp"
 fi

@@ -28,9 +28,6 @@ def _root(version: Annotated[bool, typer.Option("--version", callback=_version, 
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = list(sys.argv[1:] if argv is None else argv)
-    # `modc FILE -o OUT` is `modc compile FILE -o OUT`.
-    commands = {c.name or c.callback.__name__ for c in app.registered_commands}
-    if args and not args[0].startswith("-") and args[0] not in commands:
-        args.insert(0, "compile")
-    app(args=args, prog_name="modc")
+    from .app import run
+
+    run(list(sys.argv[1:] if argv is None else argv))

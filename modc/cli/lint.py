@@ -1,4 +1,5 @@
 """`modc lint` and `modc fmt`: checking and formatting .mod files, for CI and editors."""
+
 from __future__ import annotations
 
 from enum import Enum
@@ -33,6 +34,15 @@ def lint_cmd(
     format: Annotated[LintFormat, typer.Option("--format", "-f", help="output format")] = LintFormat.text,
     library: LibraryOpt = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
+    sarif_root: Annotated[
+        str,
+        typer.Option(
+            "--sarif-root",
+            metavar="DIR",
+            help="with --format sarif: the repository root that paths are "
+            "relative to (files outside it get absolute file: URIs)",
+        ),
+    ] = ".",
 ):
     """Check files without writing anything."""
     from ..compiler import InputError, check_file
@@ -57,7 +67,7 @@ def lint_cmd(
         if shown:
             print(render_github(shown))
     elif format is LintFormat.sarif:
-        print(render_sarif(shown, __version__))
+        print(render_sarif(shown, __version__, root=sarif_root, sources=sources))
     else:
         _print_diagnostics(diags, sources)
         if not quiet:
@@ -70,7 +80,9 @@ def lint_cmd(
 @app.command("fmt")
 def fmt_cmd(
     files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
-    check: Annotated[bool, typer.Option("--check", help="write nothing; list the files that would change and exit 1 if any")] = False,
+    check: Annotated[
+        bool, typer.Option("--check", help="write nothing; list the files that would change and exit 1 if any")
+    ] = False,
 ):
     """Rewrite .mod files in the canonical layout (comments kept, meaning unchanged)."""
     from ..compiler import YAML_SUFFIXES, InputError, read_source

@@ -68,7 +68,7 @@ MISSING_EQUALS = _register("missing-equals", E, "a unit parameter without '='",
     "expected '=' after parameter name, found {found}", "write parameters as (pivot=45deg, port=90deg)")
 EXPECTED_STATEMENT = _register("expected-statement", E, "something that is not a statement inside a robot block",
     "expected a statement, found {found}",
-    "statements are: chain, library, base, tool, payload, pose, limit, box, sphere, cylinder, target, allow")
+    "statements are: {statements}")
 EXPECTED_ROBOT = _register("expected-robot", E, "top-level content outside a `robot NAME { … }` block",
     "expected 'robot NAME {{', found {found}", "every statement lives inside a robot block: robot arm {{ chain H1 - L1 }}")
 EMPTY_FILE = _register("empty-file", W, "a file with no robot block",

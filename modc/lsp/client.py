@@ -7,6 +7,7 @@ Used by tests/test_lsp.py and benchmarks/bench_lsp.py; standard library only.
         c.open("file:///tmp/a.mod", "robot a { chain H1 - L1 }")
         c.diagnostics("file:///tmp/a.mod")
 """
+
 from __future__ import annotations
 
 import itertools
@@ -25,8 +26,12 @@ class ServerGone(Exception):
 class Client:
     def __init__(self, cmd: list[str] | None = None, cwd: str | None = None, env: dict | None = None):
         self.cmd = cmd or [sys.executable, "-m", "modc.lsp"]
-        self.proc = subprocess.Popen(self.cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     cwd=cwd, env=env)
+        self.proc = subprocess.Popen(
+            self.cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd, env=env
+        )
+        # PIPE on all three: the streams exist (Popen types them Optional)
+        assert self.proc.stdin is not None and self.proc.stdout is not None and self.proc.stderr is not None
+        self.stdin, self.stdout, self.stderr_pipe = self.proc.stdin, self.proc.stdout, self.proc.stderr
         self._ids = itertools.count(1)
         self._cond = threading.Condition()
         self.responses: dict = {}
@@ -40,7 +45,7 @@ class Client:
 
     # --- wire -------------------------------------------------------------------------------
     def _read(self) -> None:
-        out = self.proc.stdout
+        out = self.stdout
         try:
             while True:
                 length = None
@@ -72,13 +77,13 @@ class Client:
                 self._cond.notify_all()
 
     def _read_stderr(self) -> None:
-        for line in self.proc.stderr:
+        for line in self.stderr_pipe:
             self.stderr.append(line)
 
     def send_bytes(self, data: bytes) -> None:
         try:
-            self.proc.stdin.write(data)
-            self.proc.stdin.flush()
+            self.stdin.write(data)
+            self.stdin.flush()
         except (BrokenPipeError, ValueError, OSError) as e:
             raise ServerGone(str(e)) from None
 
@@ -144,20 +149,32 @@ class Client:
 
     # --- LSP conveniences -------------------------------------------------------------------
     def initialize(self, capabilities: dict | None = None) -> dict:
-        caps = capabilities if capabilities is not None else {
-            "textDocument": {"completion": {"completionItem": {"snippetSupport": True}},
-                             "hover": {"contentFormat": ["markdown", "plaintext"]},
-                             "documentSymbol": {"hierarchicalDocumentSymbolSupport": True}}}
+        caps = (
+            capabilities
+            if capabilities is not None
+            else {
+                "textDocument": {
+                    "completion": {"completionItem": {"snippetSupport": True}},
+                    "hover": {"contentFormat": ["markdown", "plaintext"]},
+                    "documentSymbol": {"hierarchicalDocumentSymbolSupport": True},
+                }
+            }
+        )
         result = self.result("initialize", {"processId": None, "rootUri": None, "capabilities": caps})
         self.notify("initialized", {})
         return result
 
     def open(self, uri: str, text: str, version: int = 1, language: str = "modc") -> float:
-        return self.notify("textDocument/didOpen", {"textDocument": {"uri": uri, "languageId": language, "version": version, "text": text}})
+        return self.notify(
+            "textDocument/didOpen",
+            {"textDocument": {"uri": uri, "languageId": language, "version": version, "text": text}},
+        )
 
     def change(self, uri: str, version: int, text: str | None = None, rng: dict | None = None, new: str = "") -> float:
         change = {"text": text} if rng is None else {"range": rng, "text": new}
-        return self.notify("textDocument/didChange", {"textDocument": {"uri": uri, "version": version}, "contentChanges": [change]})
+        return self.notify(
+            "textDocument/didChange", {"textDocument": {"uri": uri, "version": version}, "contentChanges": [change]}
+        )
 
     def diagnostics(self, uri: str, version: int | None = None, timeout: float = 10.0) -> list[dict]:
         def match(p):
@@ -166,7 +183,9 @@ class Client:
         return self.wait_notification("textDocument/publishDiagnostics", match, timeout)[1]["diagnostics"]
 
     def at(self, method: str, uri: str, line: int, character: int, **extra):
-        return self.result(method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": character}, **extra})
+        return self.result(
+            method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": character}, **extra}
+        )
 
     def shutdown(self, timeout: float = 10.0) -> int:
         """shutdown, exit; the server's exit code."""
@@ -180,7 +199,7 @@ class Client:
     def close(self) -> None:
         if self.proc.poll() is None:
             try:
-                self.proc.stdin.close()
+                self.stdin.close()
             except OSError:
                 pass
             try:
@@ -188,13 +207,13 @@ class Client:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
-        for f in (self.proc.stdin, self.proc.stdout, self.proc.stderr):
+        for f in (self.stdin, self.stdout, self.stderr_pipe):
             try:
                 f.close()
             except OSError:
                 pass
 
-    def __enter__(self) -> "Client":
+    def __enter__(self) -> Client:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -5,6 +5,7 @@ points), end exclusive (modc.diagnostics.Span). LSP counts 0-based lines and, by
 code units in a line (or UTF-8 bytes / code points when the client negotiated them). A lone
 '\\r' is not a line break here (it is not one for the .mod lexer either).
 """
+
 from __future__ import annotations
 
 import bisect
@@ -65,14 +66,16 @@ class LineIndex:
         if line < 0 or line >= len(self.starts):
             return ""
         end = self.starts[line + 1] - 1 if line + 1 < len(self.starts) else len(self.text)
-        return self.text[self.starts[line]:end]
+        return self.text[self.starts[line] : end]
 
     # --- offsets (characters) <-> LSP positions ---------------------------------------------
     def position(self, offset: int) -> types.Position:
         offset = max(0, min(offset, len(self.text)))
         line = bisect.bisect_right(self.starts, offset) - 1
         col = offset - self.starts[line]
-        return types.Position(line=line, character=_units(self.text[self.starts[line]:offset], self.encoding) if col else 0)
+        return types.Position(
+            line=line, character=_units(self.text[self.starts[line] : offset], self.encoding) if col else 0
+        )
 
     def offset(self, pos: types.Position) -> int:
         """Character offset of an LSP position, clamped into the text (a position past the end

@@ -6,22 +6,25 @@ Two views of a document are used side by side:
 
 - the checked one (modc.compiler.check_text: the AST's spans and the model), exact but only
   there when the file parses;
-- a token view (a small lexer over the raw text and an outline of `robot NAME { statement … }`
-  blocks), which needs no parse and so keeps completion, hover, symbols and definitions
-  working while a file is half typed.
+- the error-tolerant parse (tolerant.py: the same grammar, restarted after errors and closed
+  with placeholders), which keeps completion, symbols and definitions working while a file is
+  half typed; and a token view of the raw text (`lex`: words, numbers, codes, comments, whose
+  shapes are the grammar's own terminals) that tells hover what is under the cursor.
 
 Every position conversion goes through convert.LineIndex; the server (server.py) only
 converts LSP positions to offsets and back.
 """
+
 from __future__ import annotations
 
 import bisect
 import re
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 from pathlib import Path
 from typing import NamedTuple
 
+from lark import Token, Tree
 from lsprotocol import types
 
 from ..compiler import YAML_SUFFIXES, Checked, check_text
@@ -29,8 +32,7 @@ from ..model.library import Library
 from ..model.library import default as default_library
 from ..model.library import load as load_library
 from ..syntax import ast
-from . import convert
-from .language import DECLARING, NAME_TAKERS, STATEMENTS
+from . import convert, language, tolerant
 
 # --- tokens and outline ---------------------------------------------------------------------------
 
@@ -43,134 +45,124 @@ class Tok(NamedTuple):
     bol: bool = False  # first token on its line
 
 
-_TOKEN = re.compile(r"""
-   (?P<ws>\s+)
-  |(?P<comment>\#[^\n]*)
-  |(?P<string>"[^"\n]*"?)
-  |(?P<number>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)
-  |(?P<code>[a-z][a-z0-9]*(?:-[a-z0-9]+)+)
-  |(?P<word>[A-Za-z_][A-Za-z0-9_]*)
-  |(?P<punct>[{}(),=\-])
-  |(?P<other>.)
-""", re.X | re.S)
+@cache
+def _token_re() -> re.Pattern[str]:
+    """The token view's shapes, taken from the grammar's own terminals (so they cannot drift):
+    a comment, a string (also one still being typed), a number, a diagnostic code (with a '-';
+    plain lowercase words are words), a name, the grammar's punctuation."""
+    grammar = language.grammar()
+
+    def pattern(name: str) -> str:
+        return grammar.get_terminal(name).pattern.to_regexp()
+
+    punctuation = sorted(
+        t.pattern.value for t in grammar.terminals if t.pattern.type == "str" and not t.pattern.value[:1].isalpha()
+    )
+    return re.compile(
+        "|".join(
+            (
+                r"(?P<ws>\s+)",
+                f"(?P<comment>{pattern('COMMENT')})",
+                f'(?P<string>(?:{pattern("STRING")})|"[^"\n]*)',
+                f"(?P<number>{pattern('NUMBER')})",
+                f"(?P<code>(?=[a-z0-9]+-)(?:{pattern('CODE_NAME')}))",
+                f"(?P<word>{pattern('NAME')})",
+                "(?P<punct>" + "|".join(map(re.escape, punctuation)) + ")",
+                "(?P<other>.)",
+            )
+        ),
+        re.S,
+    )
 
 
 def lex(text: str) -> list[Tok]:
     out = []
     bol = True
-    for m in _TOKEN.finditer(text):
+    for m in _token_re().finditer(text):
         kind = m.lastgroup
         if kind == "ws":
             bol = bol or "\n" in m.group()
         else:
-            out.append(Tok(kind, m.group(), m.start(), m.end(), bol))
+            if kind == "code" and "-" not in m.group():  # `a-` before a non-code character
+                kind = "word"
+            out.append(Tok(kind or "other", m.group(), m.start(), m.end(), bol))
             bol = False
     return out
 
 
 @dataclass
-class Stmt:
-    keyword: Tok
-    toks: list[Tok] = field(default_factory=list)
-
-    @property
-    def end(self) -> int:
-        return self.toks[-1].end if self.toks else self.keyword.end
-
-    @property
-    def declared(self) -> Tok | None:
-        """The name a pose, target or obstacle statement declares."""
-        if self.keyword.text in DECLARING and self.toks and self.toks[0].kind == "word":
-            return self.toks[0]
-        return None
-
-
-@dataclass
 class Block:
-    """`robot NAME { … }` as tokens: what survives a half-typed file."""
+    """A block (`robot NAME { … }`) of the error-tolerant parse: what survives a half-typed file.
+    Statements are parse trees whose tokens carry offsets into the document."""
 
-    robot: Tok
-    name: Tok | None = None
-    start: int = 0
-    end: int = 0
-    closed: bool = False
-    depth: int = 0  # brace depth reached at the end of the tokens seen (0 = header not opened)
-    stmts: list[Stmt] = field(default_factory=list)
+    keyword: str
+    name: Token | None
+    start: int
+    end: int
+    stmts: list[Tree] = field(default_factory=list)
 
-    def find(self, keyword: str) -> list[Stmt]:
-        return [s for s in self.stmts if s.keyword.text == keyword]
+    def find(self, kind: str) -> list[Tree]:
+        return [s for s in self.stmts if s.data == kind]
 
 
-def outline(toks: list[Tok], text_len: int) -> list[Block]:
+def tokens_of(node: Tree | Token) -> list[Token]:
+    """The document's own tokens of a tree (placeholders left out), in order."""
+    if isinstance(node, Token):
+        return [node] if tolerant.real(node) else []
+    return [t for t in node.scan_values(lambda v: isinstance(v, Token)) if tolerant.real(t)]
+
+
+def offsets(tok: Token) -> tuple[int, int]:
+    """A document token's offsets (the tolerant parse gives every one of them positions)."""
+    return tok.start_pos or 0, tok.end_pos or 0
+
+
+def extent(node: Tree | Token) -> tuple[int, int] | None:
+    toks = tokens_of(node)
+    return (offsets(toks[0])[0], offsets(toks[-1])[1]) if toks else None
+
+
+def declared(stmt: Tree) -> Token | None:
+    """The name a statement declares (pose, target, obstacles: keywords that take a NAME)."""
+    if stmt.data in language.name_takers() - language.REFERS and stmt.children:
+        first = stmt.children[0]
+        if isinstance(first, Token) and first.type == "NAME" and tolerant.real(first):
+            return first
+    return None
+
+
+def outline(text: str) -> list[Block]:
+    """The blocks of the tolerant parse; statements after an error inside a block stay in it."""
     blocks: list[Block] = []
-    cur: Block | None = None
-    paren = 0
-    prev: Tok | None = None
-    for t in toks:
-        if t.kind == "comment":
+    for base, inside, tree in tolerant.outline(text):
+        for tok in tree.scan_values(lambda v: isinstance(v, Token)):
+            if tolerant.real(tok):
+                tok.start_pos, tok.end_pos = offsets(tok)[0] + base, offsets(tok)[1] + base
+        name = tree.children[0] if tree.children and isinstance(tree.children[0], Token) else None
+        stmts = [c for c in tree.children if isinstance(c, Tree)]
+        if inside is not None and blocks and (name is None or not tolerant.real(name)):
+            blocks[-1].stmts += stmts
             continue
-        takes_name = prev is not None and prev.text in NAME_TAKERS
-        if t.bol and t.kind == "word" and t.text in (*STATEMENTS, "robot") and not takes_name:
-            paren = 0  # a keyword first on its line starts afresh, whatever was left open before
-        if t.kind == "word" and t.text == "robot" and not takes_name and paren == 0 and (cur is None or cur.depth <= 1 or t.bol):
-            if cur is not None:  # a robot inside an unclosed robot: the old one ends here
-                cur.end = t.start
-            cur = Block(robot=t, start=t.start, end=text_len)
-            blocks.append(cur)
-            paren = 0
-        elif cur is None:
-            pass  # top-level junk
-        elif cur.depth == 0:
-            if t.text == "{":
-                cur.depth = 1
-            elif cur.name is None and t.kind in ("word", "code"):
-                cur.name = t
-        else:
-            if t.text == "(":
-                paren += 1
-            elif t.text == ")":
-                paren = max(0, paren - 1)
-            if t.text == "}" and cur.depth == 1:
-                cur.end, cur.closed, cur.depth = t.end, True, 0
-                cur = None
-                paren = 0
-                prev = t
-                continue
-            if t.text == "{":
-                cur.depth += 1
-            elif t.text == "}":
-                cur.depth -= 1
-            if t.kind == "word" and t.text in STATEMENTS and cur.depth == 1 and paren == 0 and not takes_name:
-                cur.stmts.append(Stmt(t))
-                paren = 0
-            elif cur.stmts:
-                cur.stmts[-1].toks.append(t)
-        prev = t
+        span = extent(tree)
+        start = offsets(name)[0] if name is not None and tolerant.real(name) else (span[0] if span else base)
+        start = max(0, text.rfind(language.keyword_of(tree.data) or tree.data, 0, start + 1))
+        blocks.append(
+            Block(tree.data, name if name is not None and tolerant.real(name) else None, start, len(text), stmts)
+        )
+    for a, b in zip(blocks, blocks[1:], strict=False):
+        a.end = b.start
     return blocks
-
-
-def unit_words(toks: list[Tok]) -> list[Tok]:
-    """Unit-name tokens of a chain statement's body (words outside parentheses)."""
-    out, paren = [], 0
-    for t in toks:
-        if t.text == "(":
-            paren += 1
-        elif t.text == ")":
-            paren = max(0, paren - 1)
-        elif paren == 0 and t.kind == "word":
-            out.append(t)
-    return out
 
 
 def block_joints(block: Block) -> list[tuple[str, tuple[int, int]]] | None:
     """(unit text, offsets) of the joints of a block's first chain (its units) or dh table (its
     rows); None when it has neither."""
-    for st in block.stmts:
-        if st.keyword.text == "chain":
-            return [(t.text, (t.start, t.end)) for t in unit_words(st.toks)]
-        if st.keyword.text == "dh":
-            rows = [t for t in st.toks if t.text == "row"]
-            return [(f"row {i}", (t.start, t.end)) for i, t in enumerate(rows, 1)]
+    for node in block.stmts:
+        if node.data == "chain":
+            return [(str(t), offsets(t)) for t in tokens_of(node) if t.type == "UNIT_NAME"]
+        if node.data == "dh":
+            rows = [r for r in node.children if isinstance(r, Tree) and r.data == "dh_row" and extent(r)]
+            return [(f"row {i}", extent(r) or (0, 0)) for i, r in enumerate(rows, 1)]
     return None
 
 
@@ -184,6 +176,7 @@ def joint_number(text: str) -> int | None:
 
 # The AST statements that declare a name, by the kind the token view gives them.
 DECL_KINDS = {ast.Pose: "pose", ast.Target: "target", ast.Box: "box", ast.Sphere: "sphere", ast.Cylinder: "cylinder"}
+DECLARING = (ast.Pose, ast.Target, ast.Box, ast.Sphere, ast.Cylinder)
 
 
 @dataclass
@@ -230,7 +223,7 @@ class Analysis:
 
     @cached_property
     def blocks(self) -> list[Block]:
-        return [] if self.is_yaml else outline(self.tokens, len(self.text))
+        return [] if self.is_yaml else outline(self.text)
 
     def offsets(self, span) -> tuple[int, int]:
         return self.index.span_offsets(span)
@@ -273,15 +266,15 @@ class Analysis:
         return None
 
     def blocks_named(self, robot: str | None) -> list[Block]:
-        return [b for b in self.blocks if b.name is not None and b.name.text == robot]
+        return [b for b in self.blocks if b.name is not None and b.name == robot]
 
     def robot_at(self, offset: int) -> str | None:
         for r in self.tree.robots:
             a, b = self.offsets(r.span)
             if a <= offset <= b:
                 return r.name.text
-        b = self.block_at(offset)
-        return b.name.text if b is not None and b.name is not None else None
+        block = self.block_at(offset)
+        return str(block.name) if block is not None and block.name is not None else None
 
     @cached_property
     def model_robots(self) -> tuple:
@@ -314,7 +307,8 @@ class Analysis:
         block = next(iter(self.blocks_named(robot)), None)
         if block is not None:
             for st in block.find("library"):
-                if st.toks and (lib := self.library_ref(st.toks[0].text)) is not None:
+                ref = tokens_of(st)
+                if ref and (lib := self.library_ref(str(ref[0]))) is not None:
                     return lib
         return default_library()
 
@@ -330,17 +324,24 @@ class Analysis:
             for r in self.tree.robots:
                 out.append(Decl("robot", r.name.text, None, self.offsets(r.name.span), self.offsets(r.span)))
                 for st in r.body:
-                    if kind := DECL_KINDS.get(type(st)):
-                        out.append(Decl(kind, st.name.text, r.name.text, self.offsets(st.name.span), self.offsets(st.span)))
+                    if isinstance(st, DECLARING):
+                        kind = DECL_KINDS[type(st)]
+                        out.append(
+                            Decl(kind, st.name.text, r.name.text, self.offsets(st.name.span), self.offsets(st.span))
+                        )
             return out
         for b in self.blocks:
             if b.name is None:
                 continue
-            out.append(Decl("robot", b.name.text, None, (b.name.start, b.name.end), (b.start, b.end)))
-            for st in b.stmts:
-                if (n := st.declared) is not None:
-                    out.append(Decl(st.keyword.text, n.text, b.name.text, (n.start, n.end), (st.keyword.start, st.end)))
+            out.append(Decl(b.keyword, str(b.name), None, offsets(b.name), (b.start, b.end)))
+            for node in b.stmts:
+                if (n := declared(node)) is not None and (rng := extent(node)) is not None:
+                    out.append(Decl(node.data, str(n), str(b.name), offsets(n), self.stmt_range(node, rng)))
         return out
+
+    def stmt_range(self, st: Tree, rng: tuple[int, int]) -> tuple[int, int]:
+        """A statement's offsets from its keyword (which the tree leaves out) to its last token."""
+        return max(0, self.text.rfind(language.keyword_of(st.data) or st.data, 0, rng[0] + 1)), rng[1]
 
     def units_of(self, robot: str) -> list[tuple[str, tuple[int, int]]]:
         """(unit text, offsets) of a robot's joints in order: chain units, or dh rows."""

@@ -1,4 +1,5 @@
 """Formatting: the document in `modc fmt`'s canonical form."""
+
 from __future__ import annotations
 
 from lsprotocol import types
@@ -17,9 +18,7 @@ def formatting(an: Analysis) -> list[types.TextEdit]:
         from ..syntax.format import format_text
     except ImportError:
         return []
-    new = format_text(an.text, an.path)
-    if isinstance(new, tuple):  # (text or None when it does not parse, diagnostics)
-        new = new[0]
-    if not isinstance(new, str) or new == an.text:
+    new, _diagnostics = format_text(an.text, an.path)  # text, or None when it does not parse
+    if new is None or new == an.text:
         return []
     return [types.TextEdit(range=an.index.whole(), new_text=new)]

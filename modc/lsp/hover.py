@@ -1,6 +1,7 @@
 """Hover: what the word under the cursor is (a keyword, a unit and its actuator, a parameter, a
 diagnostic code, a library, `joint_N`, a declared name), as Markdown. The unit and parameter
 texts are also completion's documentation."""
+
 from __future__ import annotations
 
 import math
@@ -10,7 +11,8 @@ from lsprotocol import types
 from ..diagnostics import REGISTRY
 from ..model.library import Library
 from .document import Analysis, Tok, joint_number
-from .language import KEYWORDS, MEASURES, NAME_TAKERS, PARAMS, UNIT_PARAMS
+from .language import MEASURES, PARAMS, REFERS, UNIT_PARAMS, keyword_doc, name_takers
+from .language import all_keywords as language_keywords
 
 
 def _g(x: float) -> str:
@@ -53,9 +55,15 @@ def param_markdown(name: str, lib: Library) -> str:
         extra = f" Realisable in {lib.name}: {_g(t.min_deg)}° … {_g(t.max_deg)}° in {_g(t.step_deg)}° steps."
     elif name == "port":
         t = lib.twists.port
-        extra = f" Realisable in {lib.name}: multiples of {_g(t.step_deg)}°" + ("." if t.wraps else f" in {_g(t.min_deg)}° … {_g(t.max_deg)}°.")
+        extra = f" Realisable in {lib.name}: multiples of {_g(t.step_deg)}°" + (
+            "." if t.wraps else f" in {_g(t.min_deg)}° … {_g(t.max_deg)}°."
+        )
     elif name == "link":
-        extra = f" Printable in {lib.name}: {_g(lib.link_length_min)} … {_g(lib.link_length_max)} m; default {_g(lib.units[max(lib.units)].x23)} m."
+        default = lib.units[max(lib.units)].x23
+        extra = (
+            f" Printable in {lib.name}: {_g(lib.link_length_min)} … {_g(lib.link_length_max)} m;"
+            f" default {_g(default)} m."
+        )
     return f"**{name}** ({kind}) — {text}{extra}"
 
 
@@ -74,7 +82,7 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
     robot = an.robot_at(tok.start)
     lib = an.library_for(robot)
     md = None
-    if prev is not None and prev.text in NAME_TAKERS - {"limit"} and tok.kind == "word":
+    if prev is not None and prev.text in name_takers() - REFERS and tok.kind == "word":
         md = _decl_markdown(an, text, robot, prev.text)
     elif text in PARAMS and nxt is not None and nxt.text in ("=", ":"):
         md = param_markdown(text, lib)
@@ -86,8 +94,8 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
         md = _joint_markdown(an, robot, n)
     elif tok.kind == "word" and lib.split(text) is not None:
         md = unit_markdown(lib, text, _unit_spec_at(an, robot, tok))
-    elif text in KEYWORDS:
-        md = KEYWORDS[text]
+    elif text in language_keywords():
+        md = keyword_doc(text)
     elif text in MEASURES and prev is not None and (prev.kind == "number" or prev.text == ")"):
         kind, word = MEASURES[text]
         md = f"**{text}**: {word} ({kind})"
@@ -97,7 +105,9 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
             md = _decl_markdown(an, text, decl.robot, decl.kind)
     if md is None:
         return None
-    return types.Hover(contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=md), range=an.index.range(tok.start, tok.end))
+    return types.Hover(
+        contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=md), range=an.index.range(tok.start, tok.end)
+    )
 
 
 def _decl_markdown(an: Analysis, name: str, robot: str | None, kind: str) -> str | None:
@@ -107,7 +117,7 @@ def _decl_markdown(an: Analysis, name: str, robot: str | None, kind: str) -> str
         return f"**robot {name}**{seq}"
     for d in an.decls:
         if d.name == name and d.kind == kind and d.robot == robot:
-            source = " ".join(an.text[d.range[0]:d.range[1]].split())
+            source = " ".join(an.text[d.range[0] : d.range[1]].split())
             return f"**{kind} {name}** (robot {robot})\n\n```\n{source}\n```"
     return f"**{kind} {name}**"
 
@@ -128,8 +138,10 @@ def _joint_markdown(an: Analysis, robot: str | None, n: int) -> str | None:
         return None
     u = r.units[n - 1]
     lo, hi = r.joint_range(n)
-    return (f"**joint_{n}**: the joint of unit {n} ({u.name}); range {_g(round(math.degrees(lo), 6))}° … "
-            f"{_g(round(math.degrees(hi), 6))}° with limits applied")
+    return (
+        f"**joint_{n}**: the joint of unit {n} ({u.name}); range {_g(round(math.degrees(lo), 6))}° … "
+        f"{_g(round(math.degrees(hi), 6))}° with limits applied"
+    )
 
 
 def _unit_spec_at(an: Analysis, robot: str | None, tok: Tok):

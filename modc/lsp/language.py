@@ -1,32 +1,82 @@
-"""The .mod language in words, for the language server: statement keywords and what they take,
-the hover text of every keyword, parameter and unit of measure, and the clause order that
-completion follows. Tests check these tables against the grammar."""
+"""The .mod language for the language server and the editor grammars.
+
+What the grammar says is read from it (grammar/modc.lark through Lark's rules): which keywords
+open a block, start a statement or a clause, which take a name, each keyword's syntax. What only
+the model knows is written here, in words: the hover text of keywords, parameters and units of
+measure, and which kind of quantity follows a keyword. Tests check that every keyword and every
+value-taking keyword of the grammar has its entry.
+"""
+
 from __future__ import annotations
 
-from ..model import quantities
+from ..model import lower, quantities
 
-STATEMENTS = ("chain", "dh", "library", "base", "tool", "payload", "pose", "limit", "box", "sphere",
-              "cylinder", "target", "allow")
-# Keywords after which a NAME follows (so `pose chain (…)` names a pose 'chain').
-NAME_TAKERS = frozenset({"robot", "pose", "limit", "box", "sphere", "cylinder", "target"})
+# The grammar's facts (keyword classes, name takers, syntax) are read in modc.syntax.keywords.
+from ..syntax.keywords import (  # noqa: F401  (re-exported for the language server's modules)
+    all_keywords,
+    clause_keywords,
+    declaration_keywords,
+    grammar,
+    keyword_of,
+    literal_of,
+    name_takers,
+    statement_keywords,
+    statements,
+    syntax_of,
+    terminal_of,
+    value_keywords,
+)
+
+
+def reset() -> None:
+    """Forget what was read from the grammar (tests that swap the grammar call this)."""
+    from ..syntax import keywords
+    from . import tolerant
+
+    keywords.reset()
+    tolerant._restart.cache_clear()
+    tolerant._block_for.cache_clear()
+
+
+# --- what the model knows ----------------------------------------------------------------------
+
+# The kind of quantity after a value keyword (value_keywords(); a test keeps them in step).
+QUANTITY_KINDS = {
+    "at": "a length",
+    "size": "a length",
+    "radius": "a length",
+    "length": "a length",
+    "rpy": "an angle",
+    "pose": "an angle",
+    "limit": "an angle",
+    "payload": "a mass",
+}
+# Name-taking statements whose name refers to something (a joint) rather than declaring one.
+REFERS = frozenset({"limit"})
 
 KEYWORDS = {
     "robot": "`robot NAME { … }` — one arm; a file holds one or more robot blocks.",
-    "chain": "`chain H1 - H4(pivot=-90deg) - L4` — the modular units, base first (required unless a `dh` table is given).",
-    "dh": "`dh [fit-links] { row a=…, alpha=…, d=… … }` — a standard DH table that modc turns into a chain of units (paper section 4.2).",
+    "chain": "`chain H1 - H4(pivot=-90deg) - L4` — the modular units, base first (required unless a `dh` table is "
+    "given).",
+    "dh": "`dh [fit-links] { row a=…, alpha=…, d=… … }` — a standard DH table that modc turns into a chain of "
+    "units (paper section 4.2).",
     "row": "`row a=0.3 m, alpha=-90deg, d=0 m[, theta=0deg]` — one row of a `dh` table (standard DH), base first.",
     "fit-links": "`dh fit-links { … }` — print link modules whose length realises each row's `a` exactly.",
-    "library": "`library mark2` | `library mark2-strict` | `library \"path.yaml\"` — the module library this robot is built from (default mark2).",
+    "library": '`library mark2` | `library mark2-strict` | `library "path.yaml"` — '
+    "the module library this robot is built from (default mark2).",
     "base": "`base at (x, y, z) m rpy (r, p, y) deg` — where base_link sits in the cell (for simulation and planning).",
     "tool": "`tool at (x, y, z) m rpy (r, p, y) deg` — tool0 relative to the last unit's last frame.",
     "payload": "`payload 0.2 kg at (x, y, z) m` — a payload's mass and its centre of mass in tool0.",
     "pose": "`pose NAME (q1, …, qn) deg` — a named joint pose, one angle per joint; `home` is the robot's home pose.",
     "limit": "`limit joint_N (lower, upper) deg` — narrow joint N's range (within the library's).",
-    "box": "`box NAME size (x, y, z) m at (x, y, z) m [rpy (…) deg]` — a box obstacle in base_link (size = full edge lengths).",
+    "box": "`box NAME size (x, y, z) m at (x, y, z) m [rpy (…) deg]` — a box obstacle in base_link (size = full "
+    "edge lengths).",
     "sphere": "`sphere NAME radius R m at (x, y, z) m` — a sphere obstacle in base_link.",
-    "cylinder": "`cylinder NAME radius R m length L m at (x, y, z) m [rpy (…) deg]` — a cylinder obstacle in base_link, axis along z before rpy.",
+    "cylinder": "`cylinder NAME radius R m length L m at (x, y, z) m [rpy (…) deg]` — a cylinder obstacle in "
+    "base_link, axis along z before rpy.",
     "target": "`target NAME at (x, y, z) m` — a position for tool0, in base_link.",
-    "allow": "`allow first-variant, …` — silence one of the paper's assembly rules for this robot on purpose (e.g. for a wrist).",
+    "allow": "`allow first-variant, …` — silence one of the paper's assembly rules for this robot on purpose (e.g. "
+    "for a wrist).",
     "at": "`at (x, y, z) m` — a position (in base_link for obstacles and targets, in tool0 for a payload).",
     "rpy": "`rpy (roll, pitch, yaw) deg` — an orientation as fixed-axis roll, pitch, yaw (as in URDF).",
     "size": "`size (x, y, z) m` — a box's full edge lengths.",
@@ -34,19 +84,25 @@ KEYWORDS = {
     "length": "`length L m` — a cylinder's length along its axis.",
 }
 
-PARAMS = {
-    "pivot": ("an angle", "turns the joint axis in the adaptive twist unit: a rotation about y before the joint "
-              "(intersecting axes, the paper's type III twist)."),
-    "port": ("an angle", "turns the next module where it meets the end of the link: a rotation about x (skew axes, "
-             "the paper's type II twist). Only units with a link module (types 3 and 4)."),
-    "link": ("a length", "the printed link module's length (x23). Only units with a link module (types 3 and 4)."),
-    "a": ("a length", "DH `a`: length of the common normal, along x_i (standard DH: Rz(θ) Tz(d) Tx(a) Rx(α))."),
-    "alpha": ("an angle", "DH `alpha`: twist about x_i between consecutive joint axes."),
-    "d": ("a length", "DH `d`: offset along z_(i-1)."),
-    "theta": ("an angle", "DH `theta`: joint angle offset about z_(i-1) (default 0)."),
+# What each parameter does, in words; their names and kinds are the lowering's (model/lower.py).
+PARAM_TEXT = {
+    "pivot": (
+        "turns the joint axis in the adaptive twist unit: a rotation about y before the joint "
+        "(intersecting axes, the paper's type III twist)."
+    ),
+    "port": (
+        "turns the next module where it meets the end of the link: a rotation about x (skew axes, "
+        "the paper's type II twist). Only units with a link module (types 3 and 4)."
+    ),
+    "link": ("the printed link module's length (x23). Only units with a link module (types 3 and 4)."),
+    "a": ("DH `a`: length of the common normal, along x_i (standard DH: Rz(θ) Tz(d) Tx(a) Rx(α))."),
+    "alpha": ("DH `alpha`: twist about x_i between consecutive joint axes."),
+    "d": ("DH `d`: offset along z_(i-1)."),
+    "theta": ("DH `theta`: joint angle offset about z_(i-1) (default 0)."),
 }
-UNIT_PARAMS = ("pivot", "port", "link")
-DH_PARAMS = ("a", "alpha", "d", "theta")
+UNIT_PARAMS = tuple(lower.UNIT_PARAMS)
+DH_PARAMS = tuple(lower.DH_PARAMS)
+PARAMS = {name: (kind, PARAM_TEXT.get(name, "")) for name, kind in {**lower.UNIT_PARAMS, **lower.DH_PARAMS}.items()}
 MEASURES = {
     **{u: ("an angle", n) for u, n in (("deg", "degrees"), ("rad", "radians"))},
     **{u: ("a length", n) for u, n in (("m", "metres"), ("cm", "centimetres"), ("mm", "millimetres"))},
@@ -55,16 +111,7 @@ MEASURES = {
 assert set(MEASURES) == set(quantities.ALL)
 KIND_MEASURES = {kind: list(table) for kind, table in quantities.KINDS.items()}
 
-# Clauses after a statement keyword, in grammar order: (keyword, required). "" is a bare value.
-CLAUSES = {
-    "box": (("size", True), ("at", True), ("rpy", False)),
-    "sphere": (("radius", True), ("at", True)),
-    "cylinder": (("radius", True), ("length", True), ("at", True), ("rpy", False)),
-    "base": (("at", False), ("rpy", False)),
-    "tool": (("at", False), ("rpy", False)),
-    "payload": (("", True), ("at", False)),
-    "target": (("at", True),),
-}
-OBSTACLES = ("box", "sphere", "cylinder")
-# Statements whose first word is a name that hover, symbols and go-to-definition know.
-DECLARING = ("pose", "target", *OBSTACLES)
+
+def keyword_doc(keyword: str) -> str:
+    """Hover text of a keyword: its prose when written, else its syntax from the grammar."""
+    return KEYWORDS.get(keyword) or f"`{syntax_of(keyword)}`"

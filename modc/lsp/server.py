@@ -10,6 +10,7 @@ with an empty result; a request whose params do not fit the LSP types gets an In
 error; a crash of the compiler itself shows as one diagnostic at the top of the file. Only
 open documents are served (a request about another URI never reads a file).
 """
+
 from __future__ import annotations
 
 import asyncio
@@ -49,7 +50,9 @@ class ModcProtocol(LanguageServerProtocol):
             return super().structure_message(data)
         except JsonRpcException as e:
             if isinstance(data.get("id"), (int, str)) and isinstance(data.get("method"), str):
-                self._send_response(data["id"], error=types.ResponseError(code=e.code, message=f"{data['method']}: {e.message}"))
+                self._send_response(
+                    data["id"], error=types.ResponseError(code=e.code, message=f"{data['method']}: {e.message}")
+                )
             log.warning("dropped a malformed %s message", data.get("method", "?"))
             return _DROPPED
 
@@ -64,8 +67,12 @@ class ModcProtocol(LanguageServerProtocol):
 
 class ModcServer(LanguageServer):
     def __init__(self) -> None:
-        super().__init__("modc", __version__, protocol_cls=ModcProtocol,
-                         text_document_sync_kind=types.TextDocumentSyncKind.Incremental)
+        super().__init__(
+            "modc",
+            __version__,
+            protocol_cls=ModcProtocol,
+            text_document_sync_kind=types.TextDocumentSyncKind.Incremental,
+        )
         self.analyses: dict[str, tuple[int | None, str, Analysis]] = {}
         self.pending: set[str] = set()
         self.shut_down = False
@@ -98,7 +105,9 @@ class ModcServer(LanguageServer):
             self.report(f"modc: checking {uri} failed")
             diags = [convert.internal_error(e)]
         version = self.analyses.get(uri, (None,))[0]
-        self.text_document_publish_diagnostics(types.PublishDiagnosticsParams(uri=uri, diagnostics=diags, version=version))
+        self.text_document_publish_diagnostics(
+            types.PublishDiagnosticsParams(uri=uri, diagnostics=diags, version=version)
+        )
 
     def schedule(self, uri: str) -> None:
         """Publish on the next turn of the event loop, once per burst of changes."""
@@ -191,16 +200,24 @@ def hover(ls: ModcServer, params: types.HoverParams):
     return hover_at(an, offset) if an is not None else None
 
 
+def capability(capabilities: object, dotted: str, default: object = None) -> object:
+    """One client capability by its dotted path; default where the client leaves any part out."""
+    node = capabilities
+    for name in dotted.split("."):
+        node = getattr(node, name, None)
+        if node is None:
+            return default
+    return node
+
+
 @server.feature(types.TEXT_DOCUMENT_COMPLETION, types.CompletionOptions(trigger_characters=["(", ",", "-", "="]))
 @guarded([])
 def completion(ls: ModcServer, params: types.CompletionParams):
     an, offset = _at(ls, params)
     if an is None:
         return []
-    snippets = bool(ls.client_capabilities.text_document and ls.client_capabilities.text_document.completion
-                    and ls.client_capabilities.text_document.completion.completion_item
-                    and ls.client_capabilities.text_document.completion.completion_item.snippet_support)
-    return complete(an, offset, snippets)
+    snippets = capability(ls.client_capabilities, "text_document.completion.completion_item.snippet_support", False)
+    return complete(an, offset, bool(snippets))
 
 
 @server.feature(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL)

@@ -1,4 +1,5 @@
 """Document symbols (the outline of robots and what they declare) and go-to-definition."""
+
 from __future__ import annotations
 
 import re
@@ -9,20 +10,34 @@ from lsprotocol import types
 from ..model.library import resolve as resolve_library
 from ..syntax import ast
 from . import convert
-from .document import DECL_KINDS, Analysis, Tok, joint_number, unit_words
+from .document import DECL_KINDS, DECLARING, Analysis, Tok, declared, extent, joint_number, offsets, tokens_of
 
 SYMBOL_KIND = {
-    "robot": types.SymbolKind.Class, "chain": types.SymbolKind.Array, "unit": types.SymbolKind.Module,
-    "dh": types.SymbolKind.Array, "row": types.SymbolKind.Field, "pose": types.SymbolKind.Constant,
-    "target": types.SymbolKind.Variable, "box": types.SymbolKind.Struct, "sphere": types.SymbolKind.Struct,
+    "robot": types.SymbolKind.Class,
+    "chain": types.SymbolKind.Array,
+    "unit": types.SymbolKind.Module,
+    "dh": types.SymbolKind.Array,
+    "row": types.SymbolKind.Field,
+    "pose": types.SymbolKind.Constant,
+    "target": types.SymbolKind.Variable,
+    "box": types.SymbolKind.Struct,
+    "sphere": types.SymbolKind.Struct,
     "cylinder": types.SymbolKind.Struct,
 }
 
 
-def _sym(an: Analysis, name: str, kind: str, rng: tuple[int, int], sel: tuple[int, int], detail: str = "", children=None) -> types.DocumentSymbol:
+def _sym(
+    an: Analysis, name: str, kind: str, rng: tuple[int, int], sel: tuple[int, int], detail: str = "", children=None
+) -> types.DocumentSymbol:
     a, b = min(rng[0], sel[0]), max(rng[1], sel[1])
-    return types.DocumentSymbol(name=name or "?", kind=SYMBOL_KIND[kind], range=an.index.range(a, b),
-                                selection_range=an.index.range(*sel), detail=detail or None, children=children)
+    return types.DocumentSymbol(
+        name=name or "?",
+        kind=SYMBOL_KIND[kind],
+        range=an.index.range(a, b),
+        selection_range=an.index.range(*sel),
+        detail=detail or None,
+        children=children,
+    )
 
 
 def symbols(an: Analysis) -> list[types.DocumentSymbol]:
@@ -35,14 +50,23 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
             for st in r.body:
                 rng = an.offsets(st.span)
                 if isinstance(st, ast.Chain):
-                    units = [_sym(an, u.name.text, "unit", an.offsets(u.span), an.offsets(u.name.span), f"joint_{i}")
-                             for i, u in enumerate(st.units, 1)]
-                    children.append(_sym(an, "chain", "chain", rng, (rng[0], rng[0]), "-".join(u.name.text for u in st.units), units))
+                    units = [
+                        _sym(an, u.name.text, "unit", an.offsets(u.span), an.offsets(u.name.span), f"joint_{i}")
+                        for i, u in enumerate(st.units, 1)
+                    ]
+                    children.append(
+                        _sym(
+                            an, "chain", "chain", rng, (rng[0], rng[0]), "-".join(u.name.text for u in st.units), units
+                        )
+                    )
                 elif isinstance(st, ast.DH):
-                    rows = [_sym(an, f"row {i}", "row", an.offsets(row.span), an.offsets(row.span), f"joint_{i}")
-                            for i, row in enumerate(st.rows, 1)]
+                    rows = [
+                        _sym(an, f"row {i}", "row", an.offsets(row.span), an.offsets(row.span), f"joint_{i}")
+                        for i, row in enumerate(st.rows, 1)
+                    ]
                     children.append(_sym(an, "dh", "dh", rng, (rng[0], rng[0]), f"{len(st.rows)} rows", rows))
-                elif (kind := DECL_KINDS.get(type(st))) is not None:
+                elif isinstance(st, DECLARING):
+                    kind = DECL_KINDS[type(st)]
                     children.append(_sym(an, st.name.text, kind, rng, an.offsets(st.name.span), kind))
             out.append(_sym(an, r.name.text, "robot", an.offsets(r.span), an.offsets(r.name.span), "robot", children))
         return out
@@ -50,17 +74,33 @@ def symbols(an: Analysis) -> list[types.DocumentSymbol]:
         if b.name is None:
             continue
         children = []
-        for st in b.stmts:
-            kw = st.keyword.text
-            rng = (st.keyword.start, st.end)
-            if kw == "chain":
-                units = [_sym(an, t.text, "unit", (t.start, t.end), (t.start, t.end), f"joint_{i}") for i, t in enumerate(unit_words(st.toks), 1)]
-                children.append(_sym(an, "chain", "chain", rng, (st.keyword.start, st.keyword.end), "", units))
-            elif kw == "dh":
-                children.append(_sym(an, "dh", "dh", rng, (st.keyword.start, st.keyword.end)))
-            elif (n := st.declared) is not None:
-                children.append(_sym(an, n.text, kw, rng, (n.start, n.end), kw))
-        out.append(_sym(an, b.name.text, "robot", (b.start, b.end), (b.name.start, b.name.end), "robot", children))
+        for node in b.stmts:
+            if (span := extent(node)) is None:
+                continue
+            rng = an.stmt_range(node, span)
+            keyword = (rng[0], rng[0] + len(node.data))
+            if node.data == "chain":
+                units = [
+                    _sym(an, str(t), "unit", offsets(t), offsets(t), f"joint_{i}")
+                    for i, t in enumerate((t for t in tokens_of(node) if t.type == "UNIT_NAME"), 1)
+                ]
+                children.append(_sym(an, "chain", "chain", rng, keyword, "", units))
+            elif node.data == "dh":
+                children.append(_sym(an, "dh", "dh", rng, keyword))
+            elif (n := declared(node)) is not None and node.data in SYMBOL_KIND:
+                children.append(_sym(an, str(n), node.data, rng, offsets(n), node.data))
+        name = offsets(b.name)
+        out.append(
+            _sym(
+                an,
+                str(b.name),
+                b.keyword if b.keyword in SYMBOL_KIND else "robot",
+                (b.start, b.end),
+                name,
+                b.keyword,
+                children,
+            )
+        )
     return out
 
 
@@ -74,7 +114,11 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
         return []
     prev, _ = an.neighbours(tok)
     robot = an.robot_at(tok.start)
-    if prev is not None and prev.text == "library" or (an.is_yaml and prev is not None and prev.text == ":" and _yaml_key_before(an, tok) == "library"):
+    if (
+        prev is not None
+        and prev.text == "library"
+        or (an.is_yaml and prev is not None and prev.text == ":" and _yaml_key_before(an, tok) == "library")
+    ):
         path = resolve_library(tok.text.strip('"'), Path(an.path).parent)
         if path is None:
             return []
@@ -95,5 +139,5 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
 
 
 def _yaml_key_before(an: Analysis, tok: Tok) -> str | None:
-    m = re.match(r"\s*(?:-\s+)?([A-Za-z_]+)\s*:", an.text[an.line_start(tok.start):tok.start])
+    m = re.match(r"\s*(?:-\s+)?([A-Za-z_]+)\s*:", an.text[an.line_start(tok.start) : tok.start])
     return m.group(1) if m else None

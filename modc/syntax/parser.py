@@ -103,7 +103,10 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
     if label == "missing-equals":
         return codes.MISSING_EQUALS.at(span, found=found)
     if label == "expected-statement":
-        return codes.EXPECTED_STATEMENT.at(span, found=found)
+        from .keywords import block_statement_terminals
+
+        allowed = [w for t, w in block_statement_terminals().items() if t in set(e.accepts or e.expected)]
+        return codes.EXPECTED_STATEMENT.at(span, found=found, statements=", ".join(allowed))
     if label == "expected-robot":
         return codes.EXPECTED_ROBOT.at(span, found=found)
     expected = e.accepts or e.expected
@@ -111,7 +114,6 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
     return codes.SYNTAX_ERROR.at(span, found=found, expected=_expected(expected), hint=hint)
 
 
-STATEMENT_KEYWORDS = {"CHAIN", "DH", "LIBRARY", "BASE", "TOOL", "PAYLOAD", "POSE", "LIMIT", "BOX", "SPHERE", "CYLINDER", "TARGET", "ALLOW"}
 WORDS = {"NAME", "CODE_NAME", "UNIT_NAME", "MEASURE", "LIBRARY_REF"}
 
 
@@ -123,7 +125,9 @@ def _rule_label(e) -> str | None:
     # token types are the lexer's fallback guess here, so look at the text itself
     if "MINUS" in accepts and re.fullmatch(r"[A-Za-z]+[0-9]+", str(e.token)):
         return "missing-dash"
-    if e.token.type in WORDS and accepts & STATEMENT_KEYWORDS:
+    from .keywords import block_statement_terminals
+
+    if e.token.type in WORDS and accepts & set(block_statement_terminals()):
         return "expected-statement"
     return None
 

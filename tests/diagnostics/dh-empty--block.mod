@@ -1,4 +1,4 @@
 robot planar {
-    dh {   # expect: error[dh-empty]
+    dh {   # expect: error[dh-empty] the DH table has no rows
     }
 }

@@ -3,6 +3,6 @@
 robot planar {
     dh {
         row a=0.3 m, alpha=0deg, d=0 m
-        row a=0.22 m, d=0 m   # expect: error[dh-row-incomplete]
+        row a=0.22 m, d=0 m   # expect: error[dh-row-incomplete] DH row 2 lacks alpha
     }
 }

@@ -1,5 +1,5 @@
 robot cellarm {
     chain H1 - H4(pivot=-90deg) - L3(port=45deg)
     box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.25) m
-    target shelf at (-0.24, -0.23, 0.585) m   # expect: error[duplicate-name]
+    target shelf at (-0.24, -0.23, 0.585) m   # expect: error[duplicate-name] 'shelf' is already defined in robot 'cellarm'
 }

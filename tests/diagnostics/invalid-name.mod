@@ -1,5 +1,7 @@
 # A name longer than 64 characters: it would become a file name (mod3_<name>.urdf.xacro) and a ROS package name.
 robot farm {
     chain H1 - L4(port=45deg) - L1
-    pose home_position_of_the_farm_arm_when_it_is_parked_next_to_the_potting_bench (0, 0, 0) deg   # expect: error[invalid-name]
+    pose home_position_of_the_farm_arm_when_it_is_parked_next_to_the_potting_bench (0, 0, 0) deg
 }
+# the message is long: its expectation sits here, not on line 4
+# expect-line 4: error[invalid-name] pose name 'home_position_of_the_farm_arm_when_it_is…' is not allowed: it has 73 characters (at most 64)

@@ -1,4 +1,4 @@
 # Library text (descriptions, actuator models) holds no control characters: libraries/bad-description.yaml has a line break.
-robot farm { library "libraries/bad-description.yaml"   # expect-in libraries/bad-description.yaml:15: error[library-invalid]
+robot farm { library "libraries/bad-description.yaml"   # expect-in libraries/bad-description.yaml:15: error[library-invalid] module library 'libraries/bad-description.yaml' is invalid: description: control character '\n' (character 17) is not allowed in text
     chain H1 - L4(port=45deg) - L1
 }

@@ -1,4 +1,4 @@
 robot farm {
-    library "nope.yaml"   # expect: error[library-not-found]
+    library "nope.yaml"   # expect: error[library-not-found] module library 'nope.yaml' not found
     chain H1 - L4(port=45deg) - L1
 }
