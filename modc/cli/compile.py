@@ -29,6 +29,11 @@ def compile_cmd(
     seed: Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")] = 0,
     smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
     torque: Annotated[Optional[TorqueLevel], typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")] = None,
+    ros: Annotated[Optional[int], typer.Option("--ros", help="ROS package for ROS 1 (noetic) or 2 (jazzy); default $ROS_DISTRO, $ROS_VERSION, else 2")] = None,
+    ros_distro: Annotated[Optional[str], typer.Option(help="target distro: noetic, humble or jazzy (overrides --ros and $ROS_DISTRO)")] = None,
+    ik_solver: Annotated[Optional[str], typer.Option(help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's; see README)")] = None,
+    ros_package: Annotated[Optional[str], typer.Option(help="ROS package name (default: <robot>_moveit_config)")] = None,
+    command_interface: Annotated[Optional[str], typer.Option(help="ros2_control command interface: position (default) or effort")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
 ):
@@ -65,7 +70,8 @@ def compile_cmd(
         if not ok:
             _err(f"modc: smoke test failed; nothing written to {out}")
             raise typer.Exit(EXIT_ERRORS)
-    files = build(checked, selected, collision_samples=collision_samples, seed=seed)
+    ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
+    files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     with usage_errors("compile", writing=out):
         write_tree(files, out, force=force)
     if verbose:
@@ -74,3 +80,22 @@ def compile_cmd(
     if not quiet:
         robots = ", ".join(f"{r.file_stem} ({r.sequence})" for r in checked.design.robots)
         _err(f"modc: {len(files)} files written to {out}: {robots}")
+
+
+def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface) -> dict:
+    """Build fields of the ROS backend. The environment ($ROS_DISTRO, $ROS_VERSION) is read here
+    and only here, below the command-line options (README "Use in ROS 2 / ROS 1")."""
+    import os
+
+    from ..backends import Build
+    from ..backends.ros_target import RosOptionError, distro_for, resolve
+
+    try:
+        options = {"ros_distro": distro_for(ros, ros_distro, dict(os.environ)), "ik_solver": ik_solver,
+                   "ros_package": ros_package, "command_interface": command_interface}
+        if selected is None or "ros" in selected:
+            resolve(Build(checked.design, **options))
+    except RosOptionError as e:
+        _err(f"modc: {e}")
+        raise typer.Exit(EXIT_USAGE)
+    return options
