@@ -18,7 +18,8 @@ kinematics, joint_limits, cartesian_limits, fake_controllers, simple_moveit_cont
 ros_controllers (effort JointTrajectoryController with the library's PID), ompl_planning and
 sensors_3d; launch/ holds demo.launch, move_group.launch and the files they include.
 
-Both: urdf/<stem>_ros.urdf (the URDF with package:// mesh URIs, for RViz and MoveIt),
+Both: urdf/<stem>_ros.urdf (the URDF with package:// mesh URIs and base_link's mass on a fixed
+child base_link_inertia, which KDL wants; for RViz and MoveIt),
 config/<stem>.scene (the file's obstacles, when it has any), package.xml and CMakeLists.txt
 for the one build system of the target. config/<stem>.srdf comes from the SRDF backend.
 
@@ -37,11 +38,12 @@ from dataclasses import dataclass
 
 from .. import __version__
 from ..kinematics import rpy_matrix
+from ..physical.assembly import kdl_root
 from . import Build, register
 from .format import num
 from .ros_target import IK_PLUGINS, Target, resolve
 from .templates import render
-from .urdf import urdf_text
+from . import urdf as urdf_backend
 
 # --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
 
@@ -337,8 +339,11 @@ def robot_outputs(build: Build, robot, target: Target) -> dict[str, str]:
     """The files every robot of the file gets."""
     ctx = context(build, robot, target)
     f = ctx["files"]
-    # the URDF backend's renderer over the same physical description, with ROS mesh URIs
-    out = {f["description"]: urdf_text(build, robot, mesh_prefix=f"package://{target.package}/meshes/")}
+    # the URDF backend's renderer over the same physical description, with ROS mesh URIs and an
+    # inertia-free root for KDL (base_link's mass on base_link_inertia)
+    desc = kdl_root(build.description(robot))
+    mesh_prefix = f"package://{target.package}/meshes/"
+    out = {f["description"]: render("urdf.xml.j2", urdf_backend.context(desc, robot, build.source_name, mesh_prefix))}
     if target.ros == 2:
         out[f["urdf_xacro"]] = render("ros/ros2/robot.urdf.xacro.j2", ctx)
         out[f["ros2_control"]] = render("ros/ros2/ros2_control.xacro.j2", ctx)
