@@ -18,8 +18,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-
 from conftest import EXAMPLES, checked_ok
+
 from modc.backends import Build, load_all
 from modc.backends import ros_target as rt
 from modc.compiler import build, check_file
@@ -75,8 +75,8 @@ def packages(tmp_path_factory):
 
 
 def ros_files(files: dict) -> set[str]:
-    return {rel for rel in files if not rel.startswith(("urdf/", "meshes/", "report")) and not rel.endswith((".srdf", ".scene"))
-            and not rel.endswith((".urdf.xacro", ".ros2_control.xacro"))}
+    per_robot = (".srdf", ".scene", ".urdf.xacro", ".ros2_control.xacro")
+    return {rel for rel in files if not rel.startswith(("urdf/", "meshes/", "report")) and not rel.endswith(per_robot)}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -84,7 +84,7 @@ def ros_files(files: dict) -> set[str]:
 
 
 def test_layout_is_the_setup_assistants(packages):
-    for (stem, distro), (c, files, d) in packages.items():
+    for (stem, distro), (c, files, _) in packages.items():
         robot = c.design.robots[0]
         s = robot.file_stem
         if distro == "jazzy":
@@ -111,7 +111,7 @@ def test_package_is_named_after_the_robot_not_the_file(tmp_path):
     assert rt.package_name("Farm_Arm") == "farm_arm_moveit_config"
     assert rt.package_name("9lives") == "modc_9lives_moveit_config"
     assert rt.valid_package_name(rt.package_name("a__b-"))
-    c, files = compile_files(src, ros_package="my_cell")
+    c, files = compile_files(src, ros_package="my_cell")  # noqa: RUF059
     assert "<name>my_cell</name>" in files["package.xml"]
     for bad in ("My-Cell", "cell__x", "1cell", "cell_"):
         with pytest.raises(rt.RosOptionError):
@@ -192,7 +192,7 @@ def test_cli_reads_the_environment_below_its_options(tmp_path, monkeypatch):
 
 def test_package_xml_parses_with_catkin_pkg(packages):
     catkin = pytest.importorskip("catkin_pkg.package", reason="catkin_pkg parses package.xml")
-    for (stem, distro), (c, files, d) in packages.items():
+    for (_, distro), (_, files, d) in packages.items():
         p = catkin.parse_package(str(d / "package.xml"))
         p.validate()
         build_type = "ament_cmake" if distro == "jazzy" else "catkin"
@@ -235,7 +235,7 @@ def test_cmakelists_installs_the_package_with_ament_or_catkin(packages, tmp_path
 
 def test_ros_description_is_the_urdf_with_package_meshes_and_no_root_inertia(packages):
     urdf_parser = pytest.importorskip("urdf_parser_py.urdf", reason="urdf_parser_py reads the ROS description")
-    for (stem, distro), (c, files, d) in packages.items():
+    for c, files, d in packages.values():
         for robot in c.design.robots:
             pkg = rt.package_name(c.design.robots[0].name)
             ros_urdf = urdf_parser.URDF.from_xml_string(files[f"urdf/{robot.file_stem}_ros.urdf"].encode())
@@ -252,14 +252,14 @@ def test_ros_description_is_the_urdf_with_package_meshes_and_no_root_inertia(pac
 
 def test_urdf_xacro_expands_to_the_robot_with_ros2_control(packages):
     xacro = pytest.importorskip("xacro")
-    for (stem, distro), (c, files, d) in packages.items():
+    for (_, distro), (c, files, d) in packages.items():
         if distro != "jazzy":
             continue
         robot = c.design.robots[0]
         doc = xacro.process_file(str(d / f"config/{robot.file_stem}.urdf.xacro"))
         root = ET.fromstring(doc.toxml())
         ros_urdf = ET.fromstring(files[f"urdf/{robot.file_stem}_ros.urdf"])
-        assert {l.get("name") for l in root.findall("link")} == {l.get("name") for l in ros_urdf.findall("link")}
+        assert {e.get("name") for e in root.findall("link")} == {e.get("name") for e in ros_urdf.findall("link")}
         (control,) = root.findall("ros2_control")
         assert control.find("hardware/plugin").text == "mock_components/GenericSystem"
         home = yaml.safe_load(files["config/initial_positions.yaml"])["initial_positions"]
@@ -284,7 +284,7 @@ def close(value, expected: float, what: str) -> None:
 
 
 def test_controllers_carry_the_library_gains(packages):
-    for (stem, distro), (c, files, d) in packages.items():
+    for (stem, distro), (c, files, _) in packages.items():
         robot = c.design.robots[0]
         ctl = robot.library.control
         names = [f"joint_{k}" for k in range(1, robot.dof + 1)]
@@ -311,7 +311,7 @@ def test_controllers_carry_the_library_gains(packages):
 
 
 def test_joint_limits_match_the_library(packages):
-    for (stem, distro), (c, files, d) in packages.items():
+    for c, files, _ in packages.values():
         robot = c.design.robots[0]
         lim = yaml.safe_load(files["config/joint_limits.yaml"])["joint_limits"]
         for k, unit in enumerate(robot.units, start=1):
@@ -326,7 +326,7 @@ def test_joint_limits_match_the_library(packages):
 
 
 def test_kinematics_group_is_the_srdf_group(packages):
-    for (stem, distro), (c, files, d) in packages.items():
+    for c, files, _ in packages.values():
         robot = c.design.robots[0]
         srdf = ET.fromstring(files[f"config/{robot.file_stem}.srdf"])
         chain_groups = [g.get("name") for g in srdf.findall("group") if g.find("chain") is not None]
@@ -336,7 +336,7 @@ def test_kinematics_group_is_the_srdf_group(packages):
 
 
 def test_xml_and_yaml_files_parse(packages):
-    for (stem, distro), (c, files, d) in packages.items():
+    for _, files, _ in packages.values():
         for rel, text in files.items():
             if isinstance(text, bytes):
                 continue

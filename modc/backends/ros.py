@@ -40,10 +40,10 @@ from .. import __version__
 from ..kinematics import rpy_matrix
 from ..physical.assembly import kdl_root
 from . import Build, register
+from . import urdf as urdf_backend
 from .format import num
 from .ros_target import IK_PLUGINS, Target, resolve
 from .templates import render
-from . import urdf as urdf_backend
 
 # --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
 

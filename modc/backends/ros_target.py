@@ -128,5 +128,6 @@ def resolve(build) -> Target:
     robots = build.design.robots
     package = build.ros_package or package_name(robots[0].name if robots else "modc")
     if not valid_package_name(package):
-        raise RosOptionError(f"'{package}' is not a valid ROS package name (lowercase letters, digits, single underscores)")
+        raise RosOptionError(f"'{package}' is not a valid ROS package name "
+                             "(lowercase letters, digits and single underscores, starting with a letter)")
     return Target(distro, solver, iface, package)

@@ -1,7 +1,7 @@
 """`modc FILE -o OUT`: check, build every backend, write OUT atomically."""
 from __future__ import annotations
 
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -17,23 +17,36 @@ from .app import (
     usage_errors,
 )
 
+OnlyOpt = Annotated[str | None, typer.Option(help="comma-separated backends to run (default: all; `modc backends`)")]
+SamplesOpt = Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")]
+SeedOpt = Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")]
+TorqueOpt = Annotated[TorqueLevel | None,
+                      typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")]
+# ROS package options (README "Use in ROS 2 / ROS 1"; precedence in modc.backends.ros_target.distro_for)
+RosOpt = Annotated[int | None, typer.Option(
+    "--ros", help="ROS package for ROS 1 (noetic) or ROS 2 (jazzy); default: $ROS_DISTRO, $ROS_VERSION, else 2")]
+DistroOpt = Annotated[str | None, typer.Option(help="target distro: noetic, humble or jazzy (overrides --ros)")]
+IkOpt = Annotated[str | None, typer.Option(help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's)")]
+PackageOpt = Annotated[str | None, typer.Option(help="ROS package name (default: <robot>_moveit_config)")]
+InterfaceOpt = Annotated[str | None, typer.Option(help="ros2_control command interface: position (default) or effort")]
+
 
 @app.command("compile")
 def compile_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
     out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
     library: LibraryOpt = None,
-    only: Annotated[Optional[str], typer.Option(help="comma-separated backends to run (default: all); see `modc backends`")] = None,
+    only: OnlyOpt = None,
     force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
-    collision_samples: Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")] = 10_000,
-    seed: Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")] = 0,
+    collision_samples: SamplesOpt = 10_000,
+    seed: SeedOpt = 0,
     smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
-    torque: Annotated[Optional[TorqueLevel], typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")] = None,
-    ros: Annotated[Optional[int], typer.Option("--ros", help="ROS package for ROS 1 (noetic) or 2 (jazzy); default $ROS_DISTRO, $ROS_VERSION, else 2")] = None,
-    ros_distro: Annotated[Optional[str], typer.Option(help="target distro: noetic, humble or jazzy (overrides --ros and $ROS_DISTRO)")] = None,
-    ik_solver: Annotated[Optional[str], typer.Option(help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's; see README)")] = None,
-    ros_package: Annotated[Optional[str], typer.Option(help="ROS package name (default: <robot>_moveit_config)")] = None,
-    command_interface: Annotated[Optional[str], typer.Option(help="ros2_control command interface: position (default) or effort")] = None,
+    torque: TorqueOpt = None,
+    ros: RosOpt = None,
+    ros_distro: DistroOpt = None,
+    ik_solver: IkOpt = None,
+    ros_package: PackageOpt = None,
+    command_interface: InterfaceOpt = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
 ):
@@ -42,10 +55,11 @@ def compile_cmd(
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
     try:
-        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=(torque or TorqueLevel.error).value)
+        severity = (torque or TorqueLevel.error).value
+        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=severity)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not checked.ok:
         from ..diagnostics.render import summary
@@ -97,5 +111,5 @@ def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, com
             resolve(Build(checked.design, **options))
     except RosOptionError as e:
         _err(f"modc: {e}")
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     return options
