@@ -360,3 +360,22 @@ robot Wrist2 { chain L1 - L4(pivot=-90deg, port=90deg) - L1
         assert {f"urdf/{stem}_ros.urdf", f"config/{stem}.urdf.xacro", f"config/{stem}.ros2_control.xacro"} <= set(files)
     assert '"mod3_left_arm"' in files["launch/demo.launch.py"]  # MoveIt's configuration: the first robot
     assert f"config/{c.design.robots[1].file_stem}.scene" in files
+
+
+def test_awkward_file_names_stay_inert(tmp_path):
+    """The file name reaches comments and package.xml's description only: valid XML, and nothing
+    roslaunch substitutes (fake_controllers.yaml is loaded with subst_value)."""
+    src = tmp_path / "a&b <c> $(env HOME) ${x}.mod"  # "--" in comments: the URDF backend's (sec-names)
+    src.write_text("robot r { chain H1 - L4(port=45deg) - L1 }\n")
+    for distro in ("jazzy", "noetic"):
+        _, files = compile_files(src, ros_distro=distro, collision_samples=0)
+        for rel, text in files.items():
+            if rel.endswith((".xml", ".xacro", ".launch", ".urdf", ".srdf")):
+                ET.fromstring(text)
+            if rel.endswith((".yaml", ".rviz")) or rel == ".setup_assistant":
+                yaml.safe_load(text)
+            if rel.endswith(".py"):
+                compile(text, rel, "exec")
+        if distro == "noetic":
+            assert "$(env" not in files["config/fake_controllers.yaml"]
+        assert ET.fromstring(files["package.xml"]).find("description").text.count("a&b <c>") == 1
