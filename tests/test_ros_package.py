@@ -75,7 +75,7 @@ def packages(tmp_path_factory):
 
 
 def ros_files(files: dict) -> set[str]:
-    per_robot = (".srdf", ".scene", ".urdf.xacro", ".ros2_control.xacro")
+    per_robot = (".srdf", ".scene", ".urdf.xacro", ".ros2_control.xacro", ".srdf.xacro")
     return {rel for rel in files if not rel.startswith(("urdf/", "meshes/", "report")) and not rel.endswith(per_robot)}
 
 
