@@ -1,13 +1,14 @@
 """The ROS 1 package (--ros 1, noetic) in Debian's real ROS 1 tools.
 
 Debian packages ROS 1 (apt: ros-core python3-roslaunch ros-robot-state-publisher catkin
-catkin-lint); every test skips, saying why, where the machine lacks them. The tools run with the
+catkin-lint colcon python3-colcon-ros); every test skips, saying why, where the machine lacks them. The tools run with the
 system Python (/usr/bin), whatever the test's interpreter.
 
 - roslaunch --nodes / --dump-params resolve MoveIt 1's demo.launch, move_group.launch (the
   arm's controllers or the fake ones) and the controller bring-up: every include, $(find),
   rosparam file and argument of the package;
-- catkin_make install builds and installs it, catkin_lint finds nothing to report;
+- catkin_make install and colcon build (colcon-ros) build and install it, catkin_lint finds
+  nothing to report; colcon sees the ROS 2 package as ament_cmake;
 - robot_state_publisher (KDL) loads the ROS description without the root-inertia warning that
   the plain URDF, whose base_link carries the base's mass, gives.
 """
@@ -171,3 +172,28 @@ def test_robot_state_publisher_has_no_root_inertia_warning(workspace):
 def test_no_ros2_file_in_a_ros1_package(workspace):
     for _, _, d in workspace[1].values():
         assert not list(d.rglob("*.launch.py")) and not (d / "config/ros2_controllers.yaml").exists()
+
+
+def test_colcon_builds_the_ros1_package_and_sees_the_ros2_one_as_ament_cmake(workspace, tmp_path):
+    """colcon (Debian, with colcon-ros) builds the catkin package; for ROS 2 it identifies the
+    package's build type (building it needs ament_cmake, which is not installable here)."""
+    colcon = tool("colcon")
+    _, pkgs, env = workspace
+    _, pkg, d = pkgs["farm"]
+    src = tmp_path / "ws" / "src"
+    shutil.copytree(d, src / pkg)
+    r = run([colcon, "list"], env, cwd=src.parent)
+    if "ros.catkin" not in r.stdout:
+        pytest.skip(f"colcon has no ROS package support (apt: python3-colcon-ros): {r.stdout} {r.stderr}")
+    assert r.stdout.split() == [pkg, f"src/{pkg}", "(ros.catkin)"]
+    r = run([colcon, "build", "--merge-install"], env, cwd=src.parent)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert (src.parent / "install/share" / pkg / "launch/demo.launch").is_file()
+    ros2 = tmp_path / "ws2" / "src" / pkg
+    files = build(check_file(EXAMPLES[0]), collision_samples=0)  # jazzy
+    for rel, content in files.items():
+        p = ros2 / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_bytes(content) if isinstance(content, bytes) else p.write_text(content, encoding="utf-8")
+    r = run([colcon, "list"], env, cwd=ros2.parent.parent)
+    assert r.stdout.split()[-1] == "(ros.ament_cmake)"
