@@ -1,8 +1,8 @@
 """The ROS 1 package (--ros 1, noetic) in Debian's real ROS 1 tools.
 
 Debian packages ROS 1 (apt: ros-core python3-roslaunch ros-robot-state-publisher catkin
-catkin-lint colcon python3-colcon-ros); every test skips, saying why, where the machine lacks them. The tools run with the
-system Python (/usr/bin), whatever the test's interpreter.
+catkin-lint colcon python3-colcon-ros); every test skips, saying why, where the machine lacks
+them. The tools run with the system Python (/usr/bin), whatever the test's interpreter.
 
 - roslaunch --nodes / --dump-params resolve MoveIt 1's demo.launch, move_group.launch (the
   arm's controllers or the fake ones) and the controller bring-up: every include, $(find),
