@@ -33,13 +33,13 @@ from __future__ import annotations
 
 import math
 import re
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from .. import __version__
 from ..kinematics import rpy_matrix
 from ..physical.assembly import kdl_root
 from . import Build, register
+from . import srdf as srdf_backend
 from . import urdf as urdf_backend
 from .format import num
 from .ros_target import IK_PLUGINS, Target, resolve
@@ -51,8 +51,8 @@ PACKAGE_VERSION = "0.1.0"
 PACKAGE_LICENSE = "BSD-3-Clause"  # what MoveIt Setup Assistant writes; the generated package is the user's
 MAINTAINER = ("modc user", "user@example.com")  # placeholder: edit package.xml before releasing
 
-DEFAULT_GROUP = "arm"  # planning group name when no SRDF names one (the SRDF backend's name)
-DEFAULT_WORLD_FRAME = "world"  # parent of the SRDF's virtual joint when no SRDF says otherwise
+# The SRDF backend's planning group and virtual joint (world -> base_link, templates/srdf.xml.j2)
+VIRTUAL_JOINT_PARENT = "world"
 ARM_CONTROLLER = "arm_controller"
 JOINT_STATE_CONTROLLER = "joint_state_controller"  # ROS 1
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"  # ROS 2
@@ -83,36 +83,6 @@ ROS2_LAUNCHES = ("demo", "move_group", "moveit_rviz", "rsp", "spawn_controllers"
 
 
 # --- names ---------------------------------------------------------------------------------------
-
-def _srdf(build: Build, robot) -> ET.Element | None:
-    """The SRDF backend's output for this robot, if it ran before this backend."""
-    text = build.files.get(f"config/{robot.file_stem}.srdf")
-    if isinstance(text, bytes):
-        text = text.decode("utf-8")
-    if not text:
-        return None
-    try:
-        return ET.fromstring(text)
-    except ET.ParseError:
-        return None
-
-
-def planning_group(build: Build, robot) -> str:
-    """The SRDF's arm group (the first group with a chain), else DEFAULT_GROUP."""
-    srdf = _srdf(build, robot)
-    groups = [] if srdf is None else [g for g in srdf.findall("group") if g.get("name")]
-    chains = [g for g in groups if g.find("chain") is not None]
-    return (chains or groups)[0].get("name") if groups else DEFAULT_GROUP
-
-
-def virtual_joint(build: Build, robot) -> tuple[str, str]:
-    """(parent frame, child link) of the SRDF's virtual joint (MoveIt's planning frame), else world -> base_link."""
-    srdf = _srdf(build, robot)
-    vj = None if srdf is None else srdf.find("virtual_joint")
-    if vj is not None and vj.get("parent_frame") and vj.get("child_link"):
-        return vj.get("parent_frame"), vj.get("child_link")
-    return DEFAULT_WORLD_FRAME, "base_link"
-
 
 def comment_safe(text: str) -> str:
     """Text that can stand inside an XML comment or after a YAML # on one line (no "--", no trailing "-")."""
@@ -233,14 +203,13 @@ def robot_files(stem: str) -> dict[str, str]:
 def context(build: Build, robot, target: Target) -> dict:
     """Every value the templates place, for the package's (first) robot."""
     js = joints(robot)
-    parent, child = virtual_joint(build, robot)
     plugin, ik_package = IK_PLUGINS[target.ik_solver]
     return {
         "version": __version__, "source": comment_safe(build.source_name), "package": target.package,
         "distro": target.distro.name, "ros": target.ros,
         "robot": robot.name, "stem": robot.file_stem, "sequence": robot.sequence, "dof": robot.dof,
-        "library": robot.library.name, "group": planning_group(build, robot),
-        "virtual_parent": parent, "virtual_child": child,
+        "library": robot.library.name, "group": srdf_backend.GROUP,
+        "virtual_parent": VIRTUAL_JOINT_PARENT, "virtual_child": srdf_backend.BASE_LINK,
         "controller": ARM_CONTROLLER, "joint_state_controller": JOINT_STATE_CONTROLLER,
         "joint_state_broadcaster": JOINT_STATE_BROADCASTER,
         "joints": [_joint_ctx(j, target.command_interface) for j in js],

@@ -26,6 +26,7 @@ from .templates import render
 def body_of(robot: Robot) -> dict[str, str]:
     """Macro-form link with geometry -> the URDF link whose geometry contains it (xacro.LINKS)."""
     lib = robot.library
+    assert lib is not None, "a checked robot has its library"
     out: dict[str, str] = {}
     for n, unit in enumerate(robot.units, start=1):
         carrier = "base_link" if n == 1 else f"link_{n - 1}"  # the input side rides on the previous link
