@@ -379,3 +379,28 @@ def test_awkward_file_names_stay_inert(tmp_path):
         if distro == "noetic":
             assert "$(env" not in files["config/fake_controllers.yaml"]
         assert ET.fromstring(files["package.xml"]).find("description").text.count("a&b <c>") == 1
+
+
+def test_library_output_ignores_the_environment(monkeypatch):
+    """Only the CLI reads $ROS_DISTRO / $ROS_VERSION: build() (and so the golden files) does not."""
+    before = compile_files(EXAMPLES[0], collision_samples=0)[1]
+    monkeypatch.setenv("ROS_DISTRO", "noetic")
+    monkeypatch.setenv("ROS_VERSION", "1")
+    after = compile_files(EXAMPLES[0], collision_samples=0)[1]
+    assert after == before and "<buildtool_depend>ament_cmake</buildtool_depend>" in after["package.xml"]
+
+
+def test_effort_command_interface():
+    c, files = compile_files(EXAMPLES[0], command_interface="effort", collision_samples=0)
+    robot = c.design.robots[0]
+    arm = yaml.safe_load(files["config/ros2_controllers.yaml"])["arm_controller"]["ros__parameters"]
+    assert arm["command_interfaces"] == ["effort"]
+    control = ET.fromstring(files[f"config/{robot.file_stem}.ros2_control.xacro"])
+    for k, unit in enumerate(robot.units, start=1):
+        (joint,) = [j for j in control.iter("joint") if j.get("name") == f"joint_{k}"]
+        ci = joint.find("command_interface")
+        peak = robot.library.variants[unit.variant].actuator.torque_peak
+        assert ci.get("name") == "effort"
+        assert [float(p.text) for p in ci.findall("param")] == pytest.approx([-peak, peak])
+    setup = yaml.safe_load(files[".setup_assistant"])["moveit_setup_assistant_config"]
+    assert setup["control_xacro"]["command"] == ["effort"]
