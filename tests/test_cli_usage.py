@@ -92,7 +92,7 @@ def test_lsp_works_from_the_light_install(light):
 @pytest.mark.parametrize(
     "command",
     [
-        [str(FARM), "-o", "OUT"],  # compile (meshes: trimesh)
+        [str(FARM), "-o", "OUT"],  # compile (torque check and collision matrix: pinocchio)
         ["sim", str(FARM)],
         ["plan", str(FARM), "--to", "plant"],
         ["check", str(FARM)],
@@ -114,7 +114,7 @@ def test_pyproject_light_and_full():
     core = {d.split(">")[0].split("<")[0].split("=")[0].strip() for d in project["dependencies"]}
     assert core == {"lark", "pydantic", "jinja2", "numpy", "pyyaml", "typer", "rich", "pygls"}
     full = {d.split(">")[0].split("<")[0].strip() for d in project["optional-dependencies"]["full"]}
-    assert {"pin", "pybullet", "ompl", "trimesh", "pillow"} <= full
+    assert {"pin", "pybullet", "ompl", "pillow", "mujoco", "viser", "cma", "dask", "distributed"} <= full
     for doc in ("README.md", ".ci/run"):  # the documented setup still installs everything
         assert ".[full" in (ROOT / doc).read_text(encoding="utf-8"), doc
 

@@ -45,9 +45,9 @@ def test_home_is_inside_the_limits(limited):
 def test_backends_emit_that_home(limited, tmp_path):
     c, files = limited
     r = c.design.robots[0]
-    init = yaml.safe_load(files[f"config/{r.file_stem}_initial_positions.yaml"])["initial_positions"]
+    init = yaml.safe_load(files["config/initial_positions.yaml"])["initial_positions"]
     assert [init[f"joint_{i}"] for i in (1, 2, 3)] == pytest.approx(EXPECTED, abs=1e-11)
-    assert "MoveIt's default values" in files[f"config/{r.file_stem}_initial_positions.yaml"]
+    assert "MoveIt's default values" in files["config/initial_positions.yaml"]
     srdf = files[f"config/{r.file_stem}.srdf"]
     state = ET.fromstring(srdf).find("group_state[@name='home']")
     assert [float(j.get("value")) for j in state.findall("joint")] == pytest.approx(EXPECTED, abs=1e-11)

@@ -97,3 +97,20 @@ def test_fingerprint_follows_every_input_of_the_description():
     prints.append(describe(checked_ok(base.replace("-90deg", "-75deg") % "").design.robots[0]).fingerprint())
     assert len(set(prints)) == len(prints)
     assert describe(checked_ok(base % "").design.robots[0]).fingerprint() == prints[0]
+
+
+def test_kdl_root_moves_the_base_mass_to_a_fixed_child():
+    """KDL's root link has no inertia: base_link's mass moves to base_link_inertia, total unchanged."""
+    from modc.physical.assembly import BASE_INERTIA_LINK, kdl_root
+
+    r = checked_ok("robot r { chain H1 - L4(port=45deg) - L1 }").design.robots[0]
+    plain = describe(r)
+    desc = kdl_root(plain)
+    (j,) = [j for j in desc.joints if j.child == BASE_INERTIA_LINK]
+    assert j.kind == "fixed" and j.parent == "base_link" and np.array_equal(j.T_parent_child, np.eye(4))
+    links = {link.name: link for link in desc.links}
+    assert links["base_link"].inertial is None and links["base_link"].visuals == plain.links[0].visuals
+    assert links[BASE_INERTIA_LINK].inertial is plain.links[0].inertial and not links[BASE_INERTIA_LINK].visuals
+    assert desc.total_mass == pytest.approx(library_mass(r), rel=1e-12) == plain.total_mass
+    assert plain.links[0].inertial is not None  # the plain URDF keeps it (PyBullet gives inertia-less links 1 kg)
+    assert kdl_root(desc) is desc

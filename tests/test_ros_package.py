@@ -1,13 +1,11 @@
-"""The ROS package backend (modc/backends/ros.py): OUT/ is a ROS package a ROS user can build and launch.
+"""The ROS backend (modc/backends/ros.py): OUT/ is the MoveIt configuration package the MoveIt
+Setup Assistant would write, for ROS 2 (jazzy, humble) or ROS 1 (noetic).
 
-Every example is checked and the backend's emit is called directly (with the URDF backend's
-output, which the ROS description wraps). What is asserted is what a ROS user relies on:
-every YAML parses and carries the library's numbers (PID gains [2, 0, 0.05], rated speed,
-peak torque, position range, home pose) under the names MoveIt and ros_control expect;
-package.xml is a valid format 3 manifest (catkin_pkg) that builds with ament_cmake under ROS 2
-and catkin under ROS 1; CMakeLists.txt installs urdf, meshes, config and launch; the launch
-files run (against stand-ins for the ROS launch API) and load only files that exist; the ROS
-description processes with xacro into the same robot as the plain URDF, with package:// meshes.
+What a ROS user relies on is asserted with the real consumers installable here: catkin_pkg
+parses package.xml, the PyPI xacro expands config/<robot>.urdf.xacro, urdf_parser_py reads the
+ROS description; every YAML carries the library's numbers under the names MoveIt and
+ros_control expect. MoveIt's own tools are in tests/test_ros_moveit.py (the builder's lookups)
+and tests/test_ros1_runtime.py (roslaunch, catkin, catkin_lint).
 """
 from __future__ import annotations
 
@@ -15,763 +13,394 @@ import math
 import re
 import shutil
 import subprocess
-import sys
-import types
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 import yaml
-
 from conftest import EXAMPLES, checked_ok
-from modc.backends import BACKENDS, Build, load_all
 
-load_all()  # the driver's registration order first
-_WIRED = "ros" in BACKENDS
-from modc.backends import ros  # noqa: E402
-from modc.backends import urdf as urdf_backend  # noqa: E402
-
-if not _WIRED:  # imported here but not (yet) listed in load_all(): keep other tests' compiles as they were
-    BACKENDS.pop("ros", None)
-from modc.compiler import check_file
+from modc.backends import Build, load_all
+from modc.backends import ros_target as rt
+from modc.compiler import build, check_file
 
 # catkin_pkg's condition parser uses pyparsing's pre-3.0 names
 pytestmark = pytest.mark.filterwarnings("ignore:.*deprecated.*:DeprecationWarning")
 
+load_all()
 
-
-def catkin():
-    """catkin_pkg (test extra): the ROS tools' own package.xml parser."""
-    return pytest.importorskip("catkin_pkg.package", reason="catkin_pkg parses package.xml")
-
-TWO_ROBOTS = """
-robot left_arm {
-    chain H1 - L4(port=45deg) - L1
-    pose home (10, -20, 30) deg
-    limit joint_2 (-90, 45) deg
+ROS2_LAYOUT = {
+    ".setup_assistant", "package.xml", "CMakeLists.txt", "config/kinematics.yaml", "config/joint_limits.yaml",
+    "config/pilz_cartesian_limits.yaml", "config/initial_positions.yaml", "config/moveit_controllers.yaml",
+    "config/ros2_controllers.yaml", "config/moveit.rviz",
+    *(f"launch/{n}.launch.py" for n in ("demo", "move_group", "moveit_rviz", "rsp", "spawn_controllers",
+                                         "static_virtual_joint_tfs", "warehouse_db", "setup_assistant")),
 }
-robot Wrist2 {
-    chain L1 - L4(pivot=-90deg, port=90deg) - L1
-    allow first-variant
-    sphere ball radius 0.05 m at (0.3, 0, 0.2) m
+ROS1_LAYOUT = {
+    ".setup_assistant", "package.xml", "CMakeLists.txt", "config/kinematics.yaml", "config/joint_limits.yaml",
+    "config/cartesian_limits.yaml", "config/fake_controllers.yaml", "config/simple_moveit_controllers.yaml",
+    "config/ros_controllers.yaml", "config/ompl_planning.yaml", "config/sensors_3d.yaml", "launch/moveit.rviz",
+    "launch/demo.launch", "launch/move_group.launch", "launch/planning_context.launch",
+    "launch/planning_pipeline.launch.xml", "launch/ompl_planning_pipeline.launch.xml",
+    "launch/trajectory_execution.launch.xml", "launch/fake_moveit_controller_manager.launch.xml",
+    "launch/simple_moveit_controller_manager.launch.xml", "launch/sensor_manager.launch.xml",
+    "launch/moveit_rviz.launch", "launch/ros_controllers.launch", "launch/setup_assistant.launch",
+    "launch/warehouse.launch", "launch/warehouse_settings.launch.xml", "launch/default_warehouse_db.launch",
 }
-"""
 
 
-def make_build(checked) -> Build:
-    b = Build(checked.design, diagnostics=list(checked.diagnostics))
-    b.files.update(urdf_backend.emit(b))  # the plain URDF, as the compile driver would have it
-    return b
-
-
-def emit(checked, **options) -> tuple[Build, dict[str, str]]:
-    b = make_build(checked)
-    for k, v in options.items():
-        setattr(b, k, v)
-    return b, ros.emit(b)
+def compile_files(source: Path | str, **options) -> tuple[Build, dict]:
+    c = check_file(source) if isinstance(source, Path) else checked_ok(source)
+    assert c.ok
+    return c, build(c, **options)
 
 
 def write(files: dict, out: Path) -> Path:
     for rel, content in files.items():
         p = out / rel
         p.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
-            p.write_bytes(content)
-        else:
-            p.write_text(content, encoding="utf-8")
+        p.write_bytes(content) if isinstance(content, bytes) else p.write_text(content, encoding="utf-8")
     return out
 
 
 @pytest.fixture(scope="module")
-def examples(tmp_path_factory):
-    """example stem -> (Build, ros files, package directory with the URDF and the ros files)."""
+def packages(tmp_path_factory):
+    """(example stem, distro) -> (checked, files, package directory), for every example and distro."""
     out = {}
     for ex in EXAMPLES:
-        c = check_file(ex)
-        assert c.ok, ex
-        b, files = emit(c)
-        d = write({**b.files, **files}, tmp_path_factory.mktemp(ex.stem) / "pkg")
-        out[ex.stem] = (b, files, d)
+        for distro in ("jazzy", "noetic"):
+            c, files = compile_files(ex, ros_distro=distro)
+            out[ex.stem, distro] = (c, files, write(files, tmp_path_factory.mktemp(f"{ex.stem}_{distro}")))
     return out
 
 
-def load(files: dict, rel: str):
-    assert rel in files, f"{rel} missing; emitted: {sorted(files)}"
-    return yaml.safe_load(files[rel])
-
-
-def close(text_value, expected: float, what: str) -> None:
-    assert isinstance(text_value, float), f"{what}: {text_value!r} is not a float (ROS 2 parameters are typed)"
-    assert math.isclose(text_value, expected, rel_tol=1e-10, abs_tol=1e-12), f"{what}: {text_value} != {expected}"
+def ros_files(files: dict) -> set[str]:
+    per_robot = (".srdf", ".scene", ".urdf.xacro", ".ros2_control.xacro", ".srdf.xacro")
+    return {rel for rel in files if not rel.startswith(("urdf/", "meshes/", "mjcf/", "report")) and not rel.endswith(per_robot)}
 
 
 # ------------------------------------------------------------------------------------------------
-# Files and names
+# layout and names
 
 
-def test_every_example_gets_the_package_files(examples):
-    for stem, (b, files, _) in examples.items():
-        assert {"package.xml", "CMakeLists.txt"} <= set(files)
-        for robot in b.design.robots:
-            f = ros.robot_files(robot.file_stem)
-            expected = {f[k] for k in ("ros_controllers", "ros2_controllers", "moveit_controllers",
-                                       "simple_moveit_controllers", "kinematics", "joint_limits",
-                                       "initial_positions", "description", "ros2_control", "demo_launch",
-                                       "display_launch_ros2", "display_launch_ros1")}
-            assert expected <= set(files), (stem, sorted(expected - set(files)))
-            assert all(p.startswith(f"config/{robot.file_stem}") for p in expected if p.endswith(".yaml"))
-            assert (f["scene"] in files) == bool(robot.obstacles)
+def test_layout_is_the_setup_assistants(packages):
+    for (stem, distro), (c, files, _) in packages.items():
+        robot = c.design.robots[0]
+        s = robot.file_stem
+        if distro == "jazzy":
+            assert ros_files(files) == ROS2_LAYOUT, stem
+            assert {f"config/{s}.urdf.xacro", f"config/{s}.ros2_control.xacro"} <= set(files)
+        else:
+            assert ros_files(files) == ROS1_LAYOUT | {f"launch/{s}_moveit_controller_manager.launch.xml",
+                                                      f"launch/{s}_moveit_sensor_manager.launch.xml"}, stem
+        # SPEC section 5's normative paths stay where they were
+        assert {f"urdf/{s}.urdf", f"config/{s}.srdf", f"urdf/{s}_ros.urdf", f"urdf/{s}.urdf.xacro"} <= set(files)
+        assert (f"config/{s}.scene" in files) == bool(robot.obstacles)
+        # exactly one file for MoveIt's trajectory execution among *_controllers.yaml (ROS 2)
+        controllers = sorted(rel for rel in files if re.fullmatch(r"config/.*_controllers\.yaml", rel))
+        assert controllers == (["config/moveit_controllers.yaml", "config/ros2_controllers.yaml"] if distro == "jazzy"
+                               else ["config/fake_controllers.yaml", "config/ros_controllers.yaml",
+                                     "config/simple_moveit_controllers.yaml"])
+
+
+def test_package_is_named_after_the_robot_not_the_file(tmp_path):
+    src = tmp_path / "cell_v2.mod"
+    src.write_text("robot Farm_Arm { chain H1 - L4(port=45deg) - L1 }\n")
+    c, files = compile_files(src)
+    assert "<name>farm_arm_moveit_config</name>" in files["package.xml"]
+    assert rt.package_name("Farm_Arm") == "farm_arm_moveit_config"
+    assert rt.package_name("9lives") == "modc_9lives_moveit_config"
+    assert rt.valid_package_name(rt.package_name("a__b-"))
+    c, files = compile_files(src, ros_package="my_cell")  # noqa: RUF059
+    assert "<name>my_cell</name>" in files["package.xml"]
+    for bad in ("My-Cell", "cell__x", "1cell", "cell_"):
+        with pytest.raises(rt.RosOptionError):
+            build(c, ros_package=bad)
 
 
 def test_output_is_deterministic():
-    c = check_file(EXAMPLES[0])
-    assert emit(c)[1] == emit(c)[1]
-
-
-def test_package_names_are_valid_ros_names():
-    assert ros.package_name("farm.mod") == "farm_modc"
-    assert ros.package_name("examples/table3_raven.mod") == "table3_raven_modc"
-    assert ros.package_name("quickstart.yaml") == "quickstart_modc"
-    assert ros.package_name("My-Arm v2.mod") == "my_arm_v2_modc"
-    assert ros.package_name("3D arm.mod") == "modc_3d_arm"
-    assert ros.package_name("__.mod") == "modc"
-    for name in ["farm.mod", "My-Arm v2.mod", "3D arm.mod", "__.mod", "x__y.mod", "<string>", "é.mod"]:
-        pkg = ros.package_name(name)
-        assert ros.valid_package_name(pkg), (name, pkg)
-        assert re.fullmatch(r"[a-z][a-z0-9_]*", pkg) and "__" not in pkg
-    assert not ros.valid_package_name("Farm") and not ros.valid_package_name("1farm")
-    assert not ros.valid_package_name("farm__modc") and not ros.valid_package_name("farm_")
-
-
-def test_package_name_override_is_validated():
-    c = check_file(EXAMPLES[0])
-    _, files = emit(c, ros_package="my_cell")
-    assert "<name>my_cell</name>" in files["package.xml"]
-    with pytest.raises(ValueError, match="not a valid ROS package name"):
-        emit(c, ros_package="My-Cell")
+    a = compile_files(EXAMPLES[0])[1]
+    b = compile_files(EXAMPLES[0])[1]
+    assert a == b
 
 
 # ------------------------------------------------------------------------------------------------
-# package.xml and CMakeLists.txt
+# target distro, IK plugin, options
 
 
-def test_package_xml_parses_with_catkin_pkg(examples):
-    catkin_pkg = catkin()
-    for stem, (b, files, d) in examples.items():
-        pkg = catkin_pkg.parse_package(str(d / "package.xml"))
-        pkg.validate()  # raises InvalidPackage on errors
-        assert pkg.package_format == 3
-        assert pkg.name == ros.package_name(b.source_name) == f"{stem}_modc"
-        assert ros.valid_package_name(pkg.name)
-        assert pkg.maintainers and pkg.licenses
-        for version, build_type, buildtool in [("2", "ament_cmake", "ament_cmake"), ("1", "catkin", "catkin")]:
-            p = catkin_pkg.parse_package(str(d / "package.xml"))
-            p.evaluate_conditions({"ROS_VERSION": version})
-            assert p.get_build_type() == build_type
-            tools = [x.name for x in p.buildtool_depends if x.evaluated_condition]
-            assert tools == [buildtool]
-            deps = {x.name for x in p.exec_depends if x.evaluated_condition}
-            assert {"robot_state_publisher", "xacro", "joint_trajectory_controller", "trac_ik_kinematics_plugin",
-                    "moveit_simple_controller_manager", "controller_manager"} <= deps
-            if version == "2":
-                assert {"rviz2", "joint_state_broadcaster", "launch_ros", "moveit_configs_utils",
-                        "moveit_ros_move_group"} <= deps and "rviz" not in deps
-            else:
-                assert {"rviz", "effort_controllers", "joint_state_controller"} <= deps and "rviz2" not in deps
+def test_distro_precedence():
+    assert rt.distro_for() == "jazzy"
+    assert rt.distro_for(env={"ROS_DISTRO": "humble", "ROS_VERSION": "2"}) == "humble"
+    assert rt.distro_for(env={"ROS_VERSION": "1"}) == "noetic"
+    assert rt.distro_for(2, env={"ROS_DISTRO": "noetic"}) == "jazzy"  # --ros beats the environment
+    assert rt.distro_for(1) == "noetic"
+    assert rt.distro_for(None, "Humble", env={"ROS_DISTRO": "noetic"}) == "humble"  # --ros-distro beats all
+    for args in [(1, "jazzy"), (3, None), (None, "iron")]:
+        with pytest.raises(rt.RosOptionError):
+            rt.distro_for(*args)
+    with pytest.raises(rt.RosOptionError, match="--ros-distro"):
+        rt.distro_for(env={"ROS_DISTRO": "galactic"})
 
 
-def _fake_cmake_packages(root: Path) -> Path:
-    """Minimal ament_cmake and catkin CMake configs: enough for this data-only package."""
-    (root / "ament_cmake").mkdir(parents=True)
-    (root / "ament_cmake" / "ament_cmakeConfig.cmake").write_text(
-        "macro(ament_package)\n  set(AMENT_PACKAGE_CALLED TRUE)\nendmacro()\n")
-    (root / "catkin").mkdir(parents=True)
-    (root / "catkin" / "catkinConfig.cmake").write_text(
-        "macro(catkin_package)\n"
-        "  set(CATKIN_PACKAGE_SHARE_DESTINATION share/${PROJECT_NAME})\n"
-        "endmacro()\n")
-    return root
+@pytest.mark.parametrize("distro, solver, package", [
+    ("jazzy", "trac_ik", "trac_ik_kinematics_plugin"), ("humble", "kdl", "moveit_kinematics"),
+    ("noetic", "kdl", "moveit_kinematics")])
+def test_ik_plugin_is_released_in_the_distro(distro, solver, package):
+    c, files = compile_files(EXAMPLES[0], ros_distro=distro)
+    kin = yaml.safe_load(files["config/kinematics.yaml"])
+    (group,) = kin.values()
+    assert group["kinematics_solver"] == rt.IK_PLUGINS[solver][0]
+    assert f"<exec_depend>{package}</exec_depend>" in files["package.xml"]
+    # moveit_kinematics is always there (the Setup Assistant's dependency, KDL's package)
+    others = {rt.IK_PLUGINS[s][1] for s in rt.IK_PLUGINS if s != solver} - {package, "moveit_kinematics"}
+    assert not any(f">{p}<" in files["package.xml"] for p in others)
+
+
+def test_ik_solver_option():
+    c, files = compile_files(EXAMPLES[0], ros_distro="humble", ik_solver="pick_ik")
+    assert yaml.safe_load(files["config/kinematics.yaml"])["arm"]["kinematics_solver"] == "pick_ik/PickIkPlugin"
+    with pytest.raises(rt.RosOptionError, match="not released for ROS humble"):
+        build(c, ros_distro="humble", ik_solver="trac_ik")
+    with pytest.raises(rt.RosOptionError):
+        build(c, ik_solver="ikfast")
+    with pytest.raises(rt.RosOptionError):
+        build(c, command_interface="velocity")
+
+
+def test_cli_reads_the_environment_below_its_options(tmp_path, monkeypatch):
+    from typer.testing import CliRunner
+
+    from modc.cli.app import app
+
+    src = str(EXAMPLES[0])
+    runner = CliRunner()
+    monkeypatch.setenv("ROS_DISTRO", "noetic")
+    r = runner.invoke(app, ["compile", src, "-o", str(tmp_path / "a"), "-q", "--collision-samples", "0"])
+    assert r.exit_code == 0, r.output
+    assert "<buildtool_depend>catkin</buildtool_depend>" in (tmp_path / "a/package.xml").read_text()
+    r = runner.invoke(app, ["compile", src, "-o", str(tmp_path / "b"), "-q", "--collision-samples", "0", "--ros", "2"])
+    assert r.exit_code == 0, r.output
+    assert "ament_cmake" in (tmp_path / "b/package.xml").read_text()
+    r = runner.invoke(app, ["compile", src, "-o", str(tmp_path / "c"), "-q", "--ros-distro", "humble",
+                            "--ik-solver", "trac_ik"])
+    assert r.exit_code == 2 and "not released" in r.output and not (tmp_path / "c").exists()
+
+
+# ------------------------------------------------------------------------------------------------
+# package.xml and CMakeLists.txt agree, for the one ROS version of the target
+
+
+def test_package_xml_parses_with_catkin_pkg(packages):
+    catkin = pytest.importorskip("catkin_pkg.package", reason="catkin_pkg parses package.xml")
+    for (_, distro), (_, files, d) in packages.items():
+        p = catkin.parse_package(str(d / "package.xml"))
+        p.validate()
+        build_type = "ament_cmake" if distro == "jazzy" else "catkin"
+        assert [dep.name for dep in p.buildtool_depends] == [build_type]
+        assert p.get_build_type() == build_type
+        assert not any(dep.condition for dep in p.exec_depends), "no $ROS_VERSION conditions: one target"
+        names = {dep.name for dep in p.exec_depends}
+        assert {"moveit_ros_move_group", "robot_state_publisher", "xacro"} <= names
+        assert ("rviz2" in names) == (distro == "jazzy") and ("rviz" in names) == (distro == "noetic")
+        cmake = files["CMakeLists.txt"]
+        assert f"project({p.name})" in cmake and f"find_package({build_type} REQUIRED)" in cmake
+        assert "ROS_VERSION" not in cmake and ("ament" in cmake) == (distro == "jazzy")
 
 
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="needs cmake")
-@pytest.mark.parametrize("ros_version", ["2", "1"])
-def test_cmakelists_installs_the_package(compiled_examples, tmp_path, ros_version):
-    """CMakeLists.txt configures under ROS 2 (ament_cmake) and ROS 1 (catkin) and installs the
-    package's urdf, meshes, config and launch directories into share/<package>."""
-    src = tmp_path / "src"
-    shutil.copytree(compiled_examples["farm"], src)  # URDF, meshes, report, ... of the real compile
-    c = check_file(next(e for e in EXAMPLES if e.stem == "farm"))
-    _, files = emit(c)
-    write(files, src)
-    fake = _fake_cmake_packages(tmp_path / "cmake")
-    env = {"PATH": "/usr/bin:/bin", "ROS_VERSION": ros_version}
-    build, prefix = tmp_path / "build", tmp_path / "install"
-    r = subprocess.run(["cmake", "-S", str(src), "-B", str(build), f"-DCMAKE_PREFIX_PATH={fake}/ament_cmake;{fake}/catkin",
-                        f"-DCMAKE_INSTALL_PREFIX={prefix}"], capture_output=True, text=True, env=env, timeout=300)
-    assert r.returncode == 0, r.stdout + r.stderr
-    r = subprocess.run(["cmake", "--install", str(build)], capture_output=True, text=True, env=env, timeout=300)
-    assert r.returncode == 0, r.stdout + r.stderr
-    share = prefix / "share" / "farm_modc"
-    for rel in ["urdf/mod3_farm.urdf", "urdf/mod3_farm_ros.urdf.xacro", "urdf/mod3_farm.ros2_control.xacro",
-                "config/mod3_farm_ros2_controllers.yaml", "config/mod3_farm_kinematics.yaml",
-                "launch/mod3_farm_demo.launch.py", "launch/mod3_farm_display.launch"]:
-        assert (share / rel).is_file(), rel
-    meshes = sorted(p.name for p in (share / "meshes").iterdir())
-    assert meshes and all(m.endswith(".stl") for m in meshes)
+def test_cmakelists_installs_the_package_with_ament_or_catkin(packages, tmp_path):
+    """Configure and install with a stand-in for ament_cmake / catkin's find_package (the real
+    catkin build is in test_ros1_runtime.py; ament_cmake is not installable here)."""
+    for distro in ("jazzy", "noetic"):
+        c, files, d = packages["farm", distro]
+        stub = tmp_path / distro / "stub"
+        stub.mkdir(parents=True)
+        (stub / "ament_cmakeConfig.cmake").write_text("macro(ament_package)\nendmacro()\n")
+        (stub / "catkinConfig.cmake").write_text(
+            "set(CATKIN_PACKAGE_SHARE_DESTINATION share/${PROJECT_NAME})\nmacro(catkin_package)\nendmacro()\n")
+        build_dir, prefix = tmp_path / distro / "build", tmp_path / distro / "install"
+        env = {"PATH": "/usr/bin:/bin"}
+        subprocess.run(["cmake", "-S", str(d), "-B", str(build_dir), f"-DCMAKE_PREFIX_PATH={stub}",
+                        f"-DCMAKE_INSTALL_PREFIX={prefix}"], check=True, capture_output=True, env=env)
+        subprocess.run(["cmake", "--install", str(build_dir)], check=True, capture_output=True, env=env)
+        share = prefix / "share" / rt.package_name(c.design.robots[0].name)
+        for rel in files:
+            if rel not in ("package.xml", "CMakeLists.txt", "report.json"):
+                assert (share / rel).is_file(), f"{distro}: {rel} not installed"
 
 
 # ------------------------------------------------------------------------------------------------
-# Controllers: the library's gains, joints and limits
+# the robot description for ROS
 
 
-def test_ros1_controllers_use_the_library_gains(examples):
-    for stem, (b, files, _) in examples.items():
-        for robot in b.design.robots:
-            y = load(files, ros.robot_files(robot.file_stem)["ros_controllers"])
-            names = [f"joint_{i}" for i in range(1, robot.dof + 1)]
-            assert y["joint_state_controller"]["type"] == "joint_state_controller/JointStateController"
-            arm = y["arm_controller"]
-            assert arm["type"] == "effort_controllers/JointTrajectoryController"
-            assert arm["joints"] == names
-            ctl = robot.library.control
-            assert (ctl.p, ctl.i, ctl.d) == (2.0, 0.0, 0.05)  # paper section 4.4
-            assert set(arm["gains"]) == set(names)
-            for n in names:
-                g = arm["gains"][n]
-                close(g["p"], ctl.p, f"{stem} {n} p")
-                close(g["i"], ctl.i, f"{stem} {n} i")
-                close(g["d"], ctl.d, f"{stem} {n} d")
-                assert arm["constraints"][n]["goal"] > 0
-            assert arm["constraints"]["goal_time"] > 0
+def test_ros_description_is_the_urdf_with_package_meshes_and_no_root_inertia(packages):
+    urdf_parser = pytest.importorskip("urdf_parser_py.urdf", reason="urdf_parser_py reads the ROS description")
+    for c, files, d in packages.values():
+        for robot in c.design.robots:
+            pkg = rt.package_name(c.design.robots[0].name)
+            ros_urdf = urdf_parser.URDF.from_xml_string(files[f"urdf/{robot.file_stem}_ros.urdf"].encode())
+            plain = urdf_parser.URDF.from_xml_string(files[f"urdf/{robot.file_stem}.urdf"].encode())
+            assert ros_urdf.get_root() == "base_link" and ros_urdf.link_map["base_link"].inertial is None
+            inertia = ros_urdf.link_map["base_link_inertia"].inertial
+            assert inertia.mass == pytest.approx(plain.link_map["base_link"].inertial.mass, rel=1e-12)
+            assert {j.name for j in ros_urdf.joints} == {j.name for j in plain.joints} | {"base_link_inertia_joint"}
+            meshes = [g.geometry.filename for link in ros_urdf.links for g in link.visuals + link.collisions]
+            assert meshes and all(m.startswith(f"package://{pkg}/meshes/") for m in meshes)
+            for m in meshes:
+                assert (d / m.removeprefix(f"package://{pkg}/")).is_file()
 
 
-def test_ros2_controllers(examples):
-    for stem, (b, files, _) in examples.items():
-        for robot in b.design.robots:
-            y = load(files, ros.robot_files(robot.file_stem)["ros2_controllers"])
-            names = [f"joint_{i}" for i in range(1, robot.dof + 1)]
-            cm = y["controller_manager"]["ros__parameters"]
-            assert isinstance(cm["update_rate"], int) and cm["update_rate"] > 0
+def test_urdf_xacro_expands_to_the_robot_with_ros2_control(packages):
+    xacro = pytest.importorskip("xacro")
+    for (_, distro), (c, files, d) in packages.items():
+        if distro != "jazzy":
+            continue
+        robot = c.design.robots[0]
+        doc = xacro.process_file(str(d / f"config/{robot.file_stem}.urdf.xacro"))
+        root = ET.fromstring(doc.toxml())
+        ros_urdf = ET.fromstring(files[f"urdf/{robot.file_stem}_ros.urdf"])
+        assert {e.get("name") for e in root.findall("link")} == {e.get("name") for e in ros_urdf.findall("link")}
+        (control,) = root.findall("ros2_control")
+        assert control.find("hardware/plugin").text == "mock_components/GenericSystem"
+        home = yaml.safe_load(files["config/initial_positions.yaml"])["initial_positions"]
+        assert home == {f"joint_{k}": q for k, q in enumerate(robot.home(), start=1)}
+        for j in control.findall("joint"):
+            assert j.find("command_interface").get("name") == "position"
+            (initial,) = [p for p in j.iter("param") if p.get("name") == "initial_value"]
+            assert float(initial.text) == pytest.approx(home[j.get("name")])
+        # a real driver instead of the mock hardware
+        doc = xacro.process_file(str(d / f"config/{robot.file_stem}.urdf.xacro"),
+                                 mappings={"ros2_control_plugin": "kinova/KortexSystem"})
+        assert "<plugin>kinova/KortexSystem</plugin>" in doc.toxml()
+
+
+# ------------------------------------------------------------------------------------------------
+# the numbers in the YAML files
+
+
+def close(value, expected: float, what: str) -> None:
+    assert isinstance(value, float), f"{what}: {value!r} is not a float (ROS 2 parameters are typed)"
+    assert math.isclose(value, expected, rel_tol=1e-10, abs_tol=1e-12), f"{what}: {value} != {expected}"
+
+
+def test_controllers_carry_the_library_gains(packages):
+    for (stem, distro), (c, files, _) in packages.items():
+        robot = c.design.robots[0]
+        ctl = robot.library.control
+        names = [f"joint_{k}" for k in range(1, robot.dof + 1)]
+        if distro == "jazzy":
+            cfg = yaml.safe_load(files["config/ros2_controllers.yaml"])
+            cm = cfg["controller_manager"]["ros__parameters"]
             assert cm["arm_controller"]["type"] == "joint_trajectory_controller/JointTrajectoryController"
             assert cm["joint_state_broadcaster"]["type"] == "joint_state_broadcaster/JointStateBroadcaster"
-            arm = y["arm_controller"]["ros__parameters"]
-            assert arm["joints"] == names
-            assert arm["command_interfaces"] == ["position"]  # mock hardware mirrors position commands
-            assert arm["state_interfaces"] == ["position", "velocity"]
-            ctl = robot.library.control
-            for n in names:
-                close(arm["gains"][n]["p"], ctl.p, f"{stem} {n} p")
-                close(arm["gains"][n]["i"], ctl.i, f"{stem} {n} i")
-                close(arm["gains"][n]["d"], ctl.d, f"{stem} {n} d")
-                assert isinstance(arm["constraints"][n]["goal"], float)
-                assert isinstance(arm["constraints"][n]["trajectory"], float)
-            assert isinstance(arm["constraints"]["goal_time"], float)
-            assert isinstance(arm["constraints"]["stopped_velocity_tolerance"], float)
-
-
-def test_effort_command_interface_option():
-    """build.ros2_command_interface = "effort": the ROS 2 JTC commands effort (and closes the PID
-    with the gains), and the ros2_control joints bound the command by the peak torque."""
-    c = check_file(next(e for e in EXAMPLES if e.stem == "farm"))
-    b, files = emit(c, ros2_command_interface="effort")
-    arm = load(files, "config/mod3_farm_ros2_controllers.yaml")["arm_controller"]["ros__parameters"]
-    assert arm["command_interfaces"] == ["effort"]
-    x = ET.fromstring(files["urdf/mod3_farm.ros2_control.xacro"])
-    robot = b.design.robots[0]
-    for k, joint in enumerate(x.iter("joint"), start=1):
-        cmd = joint.find("command_interface")
-        assert cmd.get("name") == "effort"
-        peak = robot.library.variants[robot.units[k - 1].variant].actuator.torque_peak
-        params = {p.get("name"): float(p.text) for p in cmd.findall("param")}
-        assert params == {"min": -peak, "max": peak}
-    with pytest.raises(ValueError):
-        emit(c, ros2_command_interface="velocity")
-
-
-def test_moveit_controllers(examples):
-    for stem, (b, files, _) in examples.items():
-        for robot in b.design.robots:
-            names = [f"joint_{i}" for i in range(1, robot.dof + 1)]
-            y = load(files, ros.robot_files(robot.file_stem)["moveit_controllers"])
-            assert y["moveit_controller_manager"] == "moveit_simple_controller_manager/MoveItSimpleControllerManager"
-            m = y["moveit_simple_controller_manager"]
-            assert m["controller_names"] == ["arm_controller"]
-            arm = m["arm_controller"]
-            assert arm == {"type": "FollowJointTrajectory", "action_ns": "follow_joint_trajectory",
-                           "default": True, "joints": names}
-            y1 = load(files, ros.robot_files(robot.file_stem)["simple_moveit_controllers"])
-            assert y1["controller_list"] == [{"name": "arm_controller", "action_ns": "follow_joint_trajectory",
-                                             "type": "FollowJointTrajectory", "default": True, "joints": names}]
-
-
-def test_joint_limits_match_the_library(examples):
-    for stem, (b, files, _) in examples.items():
-        for robot in b.design.robots:
-            y = load(files, ros.robot_files(robot.file_stem)["joint_limits"])
-            assert 0 < y["default_velocity_scaling_factor"] <= 1
-            assert 0 < y["default_acceleration_scaling_factor"] <= 1
-            limits = y["joint_limits"]
-            assert list(limits) == [f"joint_{i}" for i in range(1, robot.dof + 1)]
-            urdf = ET.fromstring(b.files[f"urdf/{robot.file_stem}.urdf"])
-            for k, unit in enumerate(robot.units, start=1):
-                lim = limits[f"joint_{k}"]
-                act = robot.library.variants[unit.variant].actuator
-                lo, hi = robot.joint_range(k)
-                assert lim["has_position_limits"] and lim["has_velocity_limits"]
-                assert lim["has_acceleration_limits"] and lim["has_effort_limits"]
-                close(lim["min_position"], lo, f"{stem} joint_{k} min")
-                close(lim["max_position"], hi, f"{stem} joint_{k} max")
-                close(lim["max_velocity"], act.rpm * 2 * math.pi / 60, f"{stem} joint_{k} velocity")
-                close(lim["max_effort"], act.torque_peak, f"{stem} joint_{k} effort")
-                close(lim["max_acceleration"], act.velocity / ros.ACCEL_RAMP_TIME, f"{stem} joint_{k} acceleration")
-                # the same limits as the URDF's <limit>
-                u = urdf.find(f"joint[@name='joint_{k}']/limit")
-                for key, attr in [("min_position", "lower"), ("max_position", "upper"),
-                                  ("max_velocity", "velocity"), ("max_effort", "effort")]:
-                    assert math.isclose(lim[key], float(u.get(attr)), rel_tol=1e-11), (stem, k, key)
-
-
-def test_heavy_and_light_velocities():
-    """Paper Table 1: KA-75+ 12.2 RPM, KA-58 20.3 RPM."""
-    c = check_file(next(e for e in EXAMPLES if e.stem == "farm"))
-    _, files = emit(c)
-    limits = load(files, "config/mod3_farm_joint_limits.yaml")["joint_limits"]
-    assert math.isclose(limits["joint_1"]["max_velocity"], 12.2 * math.pi / 30, rel_tol=1e-11)  # H1
-    assert math.isclose(limits["joint_2"]["max_velocity"], 20.3 * math.pi / 30, rel_tol=1e-11)  # L4
-    assert limits["joint_1"]["max_effort"] == 30.5 and limits["joint_3"]["max_effort"] == 6.8
-
-
-def test_kinematics_uses_trac_ik(examples):
-    for stem, (b, files, _) in examples.items():
-        for robot in b.design.robots:
-            y = load(files, ros.robot_files(robot.file_stem)["kinematics"])
-            assert list(y) == ["arm"]  # no SRDF backend ran: the default group name
-            g = y["arm"]
-            assert g["kinematics_solver"] == "trac_ik_kinematics_plugin/TRAC_IKKinematicsPlugin"
-            assert g["kinematics_solver_timeout"] > 0 and g["kinematics_solver_search_resolution"] > 0
-            assert g["position_only_ik"] is (robot.dof < 6)
-            # the documented fallback is right there
-            assert "# kinematics_solver: kdl_kinematics_plugin/KDLKinematicsPlugin" in files[
-                ros.robot_files(robot.file_stem)["kinematics"]]
-
-
-def test_kdl_option():
-    c = check_file(next(e for e in EXAMPLES if e.stem == "farm"))
-    b, files = emit(c, ik_solver="kdl")
-    assert load(files, "config/mod3_farm_kinematics.yaml")["arm"]["kinematics_solver"] == \
-        "kdl_kinematics_plugin/KDLKinematicsPlugin"
-    pkg = catkin().parse_package_string(files["package.xml"])
-    names = {d.name for d in pkg.exec_depends}
-    assert "moveit_kinematics" in names and "trac_ik_kinematics_plugin" not in names
-    with pytest.raises(ValueError):
-        emit(c, ik_solver="ikfast")
-
-
-def test_planning_group_and_world_frame_follow_the_srdf():
-    """If the SRDF backend ran first, kinematics.yaml keys the SRDF's arm group and the demo
-    publishes the virtual joint's parent frame."""
-    c = check_file(next(e for e in EXAMPLES if e.stem == "farm"))
-    b = make_build(c)
-    b.files["config/mod3_farm.srdf"] = (
-        '<?xml version="1.0"?><robot name="mod3_farm"><group name="gripper"><link name="tool0"/></group>'
-        '<group name="manipulator"><chain base_link="base_link" tip_link="tool0"/></group>'
-        '<virtual_joint name="v" type="fixed" parent_frame="cell" child_link="base_link"/></robot>')
-    files = ros.emit(b)
-    assert list(load(files, "config/mod3_farm_kinematics.yaml")) == ["manipulator"]
-    assert '"--frame-id", "cell", "--child-frame-id", "base_link"' in files["launch/mod3_farm_demo.launch.py"]
-    plain = ros.emit(make_build(c))
-    assert list(load(plain, "config/mod3_farm_kinematics.yaml")) == ["arm"]
-    assert '"--frame-id", "world", "--child-frame-id", "base_link"' in plain["launch/mod3_farm_demo.launch.py"]
-
-
-def test_kinematics_group_matches_the_real_srdf_backend():
-    srdf = pytest.importorskip("modc.backends.srdf", reason="the SRDF backend is not there yet")
-    for ex in EXAMPLES:
-        c = check_file(ex)
-        b = make_build(c)
-        b.files.update(srdf.emit(b))
-        files = ros.emit(b)
-        for robot in b.design.robots:
-            doc = ET.fromstring(b.files[f"config/{robot.file_stem}.srdf"])
-            groups = {g.get("name") for g in doc.findall("group")}
-            group = list(load(files, ros.robot_files(robot.file_stem)["kinematics"]))[0]
-            assert group in groups, (ex.stem, group, groups)
-
-
-def test_initial_positions_are_the_home_pose():
-    c = checked_ok(TWO_ROBOTS, "cell.mod")
-    b, files = emit(c)
-    left = b.design.robots[0]
-    y = load(files, "config/mod3_left_arm_initial_positions.yaml")
-    assert list(y["initial_positions"]) == ["joint_1", "joint_2", "joint_3"]
-    for k, q in enumerate(left.home(), start=1):
-        close(y["initial_positions"][f"joint_{k}"], q, f"joint_{k}")
-    assert math.isclose(y["initial_positions"]["joint_3"], math.radians(30))
-    lim = load(files, "config/mod3_left_arm_joint_limits.yaml")["joint_limits"]["joint_2"]
-    assert math.isclose(lim["min_position"], math.radians(-90)) and math.isclose(lim["max_position"], math.radians(45))
-
-
-def test_one_package_for_a_file_with_two_robots(tmp_path):
-    c = checked_ok(TWO_ROBOTS, "cell.mod")
-    b, files = emit(c)
-    assert [r.file_stem for r in b.design.robots] == ["mod3_left_arm", "mod3_Wrist2"]
-    pkg = catkin().parse_package_string(files["package.xml"])
-    assert pkg.name == "cell_modc"
-    assert "left_arm = H1-L4-L1" in pkg.description and "Wrist2 = L1-L4-L1" in pkg.description
-    for stem in ["mod3_left_arm", "mod3_Wrist2"]:
-        for rel in ros.robot_files(stem).values():
-            if rel.startswith(("urdf/mod3_left_arm.urdf", "urdf/mod3_Wrist2.urdf", "config/mod3_left_arm.s",
-                               "config/mod3_Wrist2.srdf", "config/mod3_left_arm.scene")):
-                continue  # other backends' files, and left_arm has no obstacles
-            assert rel in files, rel
-    assert "config/mod3_Wrist2.scene" in files
-
-
-# ------------------------------------------------------------------------------------------------
-# Planning scene
-
-
-def test_scene_holds_the_obstacles(examples):
-    b, files, _ = examples["farm"]
-    robot = b.design.robots[0]
-    text = files["config/mod3_farm.scene"]
-    lines = text.splitlines()
-    assert lines[0] == "mod3_farm_environment" and lines[-1] == "."
-    objects = {}
-    i = 1
-    while lines[i] != ".":  # MoveIt's scene format: object pose, shapes (shape, size, pose, colour), subframes
-        assert lines[i].startswith("* ")
-        name = lines[i][2:]
-        assert lines[i + 1] == "0 0 0" and lines[i + 2] == "0 0 0 1" and lines[i + 3] == "1"
-        shape, size = lines[i + 4], [float(x) for x in lines[i + 5].split()]
-        xyz = [float(x) for x in lines[i + 6].split()]
-        quat = [float(x) for x in lines[i + 7].split()]
-        assert len(lines[i + 8].split()) == 4 and lines[i + 9] == "0"
-        objects[name] = (shape, size, xyz, quat)
-        i += 10
-    assert list(objects) == [o.name for o in robot.obstacles]
-    for o in robot.obstacles:
-        shape, size, xyz, quat = objects[o.name]
-        assert shape == o.shape and size == pytest.approx(list(o.size)) and xyz == pytest.approx(list(o.origin.xyz))
-        assert quat == pytest.approx([0, 0, 0, 1])
-
-
-def test_quaternion_of_rpy():
-    from modc.kinematics import rpy_matrix
-
-    for rpy in [(0, 0, 0), (0.3, -0.2, 1.1), (math.pi, 0, 0), (0, math.pi / 2, 0), (2.5, -1.2, -3.0)]:
-        x, y, z, w = ros.quaternion(rpy)
-        assert math.isclose(x * x + y * y + z * z + w * w, 1.0, rel_tol=1e-12)
-        R = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-             [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-        assert sum(R, []) == pytest.approx(rpy_matrix(rpy).ravel().tolist(), abs=1e-12)
-
-
-# ------------------------------------------------------------------------------------------------
-# Descriptions: ROS xacro and ros2_control
-
-
-def _canonical(elem: ET.Element, mesh_prefix: str) -> list:
-    out = []
-    for e in elem.iter():
-        attrs = dict(e.attrib)
-        if e.tag == "mesh":
-            assert attrs["filename"].startswith(mesh_prefix), attrs["filename"]
-            attrs["filename"] = attrs["filename"][len(mesh_prefix):]
-        out.append((e.tag, sorted(attrs.items()), (e.text or "").strip()))
-    return out
-
-
-def test_ros_description_is_the_urdf_with_package_meshes(examples):
-    xacro = pytest.importorskip("xacro")
-    for stem, (b, files, d) in examples.items():
-        for robot in b.design.robots:
-            f = ros.robot_files(robot.file_stem)
-            plain = ET.fromstring(b.files[f["urdf"]])
-            for ros2_control in ("true", "false"):
-                doc = xacro.process_file(str(d / f["description"]), mappings={"ros2_control": ros2_control})
-                got = ET.fromstring(doc.toxml())
-                assert got.get("name") == robot.file_stem
-                for tag in ("material", "link", "joint"):
-                    want = [_canonical(e, "../meshes/") for e in plain.findall(tag)]
-                    have = [_canonical(e, f"package://{stem}_modc/meshes/") for e in got.findall(tag)]
-                    assert have == want, (stem, tag)
-                assert [t.find("joint").get("name") for t in got.findall("transmission")] == \
-                    [f"joint_{i}" for i in range(1, robot.dof + 1)]
-                blocks = got.findall("ros2_control")
-                assert len(blocks) == (1 if ros2_control == "true" else 0)
-            # the ros2_control block: mock hardware, joints, interfaces, initial values = home
-            rc = blocks_of(xacro, d / f["description"])
-            assert rc.find("hardware/plugin").text == "mock_components/GenericSystem"
-            joints = rc.findall("joint")
-            assert [j.get("name") for j in joints] == [f"joint_{i}" for i in range(1, robot.dof + 1)]
-            for k, j in enumerate(joints, start=1):
-                cmd = j.find("command_interface")
-                assert cmd.get("name") == "position"
-                lo, hi = robot.joint_range(k)
-                params = {p.get("name"): float(p.text) for p in cmd.findall("param")}
-                assert params["min"] == pytest.approx(lo, rel=1e-11) and params["max"] == pytest.approx(hi, rel=1e-11)
-                assert [s.get("name") for s in j.findall("state_interface")] == ["position", "velocity"]
-                init = j.find("state_interface[@name='position']/param[@name='initial_value']")
-                assert float(init.text) == pytest.approx(robot.home()[k - 1], abs=1e-12)
-
-
-def blocks_of(xacro, path: Path, **mappings) -> ET.Element:
-    doc = xacro.process_file(str(path), mappings={"ros2_control": "true", **mappings})
-    (rc,) = ET.fromstring(doc.toxml()).findall("ros2_control")
-    return rc
-
-
-def test_ros2_control_plugin_and_initial_positions_are_arguments(tmp_path):
-    xacro = pytest.importorskip("xacro")
-    c = checked_ok(TWO_ROBOTS, "cell.mod")
-    _, files = emit(c)
-    d = write(files, tmp_path / "pkg")
-    # the file's own home pose reaches the mock hardware's initial values
-    rc = blocks_of(xacro, d / "urdf/mod3_left_arm_ros.urdf.xacro")
-    init = [float(j.find("state_interface/param").text) for j in rc.findall("joint")]
-    assert init == pytest.approx([math.radians(10), math.radians(-20), math.radians(30)])
-    # a real hardware interface and another start pose, given on the xacro command line
-    other = tmp_path / "start.yaml"
-    other.write_text("initial_positions: {joint_1: 0.5, joint_2: -0.25, joint_3: 1.0}\n")
-    rc = blocks_of(xacro, d / "urdf/mod3_left_arm_ros.urdf.xacro", ros2_control_plugin="kinova/KortexSystem",
-                   initial_positions_file=str(other))
-    assert rc.find("hardware/plugin").text == "kinova/KortexSystem"
-    assert [float(j.find("state_interface/param").text) for j in rc.findall("joint")] == [0.5, -0.25, 1.0]
-
-
-# ------------------------------------------------------------------------------------------------
-# Launch files
-
-
-class _Action:
-    def __init__(self, *args, **kwargs):
-        self.args, self.kwargs = args, kwargs
-
-
-class _LaunchConfiguration:
-    def __init__(self, name):
-        self.name = name
-
-    def perform(self, context):
-        return context[self.name]
-
-
-class _Builder:
-    """Stand-in for moveit_configs_utils.MoveItConfigsBuilder: records the files it is given."""
-
-    instances: list = []
-
-    def __init__(self, robot_name, robot_description="robot_description", package_name=None):
-        self.robot_name, self.package_name, self.paths = robot_name, package_name, {}
-        _Builder.instances.append(self)
-
-    def _record(self, key, file_path=None, **kwargs):
-        self.paths[key] = file_path
-        return self
-
-    def robot_description(self, file_path=None, mappings=None):
-        self.mappings = mappings
-        return self._record("robot_description", file_path)
-
-    def robot_description_semantic(self, file_path=None, mappings=None):
-        return self._record("robot_description_semantic", file_path)
-
-    def robot_description_kinematics(self, file_path=None):
-        return self._record("robot_description_kinematics", file_path)
-
-    def joint_limits(self, file_path=None):
-        return self._record("joint_limits", file_path)
-
-    def trajectory_execution(self, file_path=None, moveit_manage_controllers=True):
-        return self._record("trajectory_execution", file_path)
-
-    def planning_pipelines(self, default_planning_pipeline=None, pipelines=None, load_all=True):
-        self.pipelines = pipelines
-        return self
-
-    def to_moveit_configs(self):
-        cfg = types.SimpleNamespace(**{k: {k: v} for k, v in self.paths.items()})
-        cfg.planning_pipelines = {"planning_pipelines": self.pipelines}
-        cfg.to_dict = lambda: {k: v for k, v in self.paths.items()}
-        return cfg
-
-
-@pytest.fixture
-def ros2_launch_api(monkeypatch):
-    """Minimal stand-ins for launch, launch_ros, ament_index_python and moveit_configs_utils."""
-    shares: dict[str, str] = {}
-
-    def module(name, **attrs):
-        m = types.ModuleType(name)
-        m.__dict__.update(attrs)
-        monkeypatch.setitem(sys.modules, name, m)
-        return m
-
-    def get_package_share_directory(name):
-        if name not in shares:
-            raise LookupError(name)
-        return shares[name]
-
-    module("launch", LaunchDescription=lambda actions: list(actions))
-    module("launch.actions", DeclareLaunchArgument=_Action, OpaqueFunction=_Action, TimerAction=_Action)
-    module("launch.substitutions", LaunchConfiguration=_LaunchConfiguration)
-    module("launch_ros")
-    module("launch_ros.actions", Node=_Action)
-    module("ament_index_python")
-    module("ament_index_python.packages", get_package_share_directory=get_package_share_directory)
-    module("moveit_configs_utils", MoveItConfigsBuilder=_Builder)
-    _Builder.instances = []
-    return shares
-
-
-def run_launch(path: Path, **args):
-    """Exec a generated launch file, evaluate its OpaqueFunction with the given launch arguments."""
-    ns: dict = {"__file__": str(path), "__name__": "launch_under_test"}
-    exec(compile(path.read_text(), str(path), "exec"), ns)
-    description = ns["generate_launch_description"]()
-    declared = {a.args[0] if a.args else a.kwargs["name"]: a.kwargs.get("default_value")
-                for a in description if "default_value" in a.kwargs}
-    context = {**declared, **args}
-    actions = []
-    for a in description:
-        if "function" in a.kwargs:
-            actions += a.kwargs["function"](context)
-    return declared, flatten(actions)
-
-
-def flatten(actions):
-    out = []
-    for a in actions:
-        out.append(a)
-        out += flatten(a.kwargs.get("actions", []))
-    return out
-
-
-def nodes(actions, executable):
-    return [a for a in actions if a.kwargs.get("executable") == executable]
-
-
-def test_launch_files_compile(examples):
-    for stem, (b, files, d) in examples.items():
-        for rel in files:
-            if rel.endswith(".py"):
-                compile(files[rel], rel, "exec")
-
-
-def test_demo_launch_starts_control_moveit_and_rviz(examples, ros2_launch_api):
-    pytest.importorskip("xacro")
-    for stem, (b, files, d) in examples.items():
-        ros2_launch_api[f"{stem}_modc"] = str(d)
-        for robot in b.design.robots:
-            f = ros.robot_files(robot.file_stem)
-            declared, actions = run_launch(d / f["demo_launch"])
-            assert declared == {"moveit": "true", "rviz": "true", "hardware_plugin": "mock_components/GenericSystem"}
-            (rsp,) = nodes(actions, "robot_state_publisher")
-            description = rsp.kwargs["parameters"][0]["robot_description"]
-            doc = ET.fromstring(description)
-            assert doc.find("ros2_control/hardware/plugin").text == "mock_components/GenericSystem"
-            meshes = [m.get("filename") for m in doc.iter("mesh")]
-            assert meshes and all(m.startswith(f"package://{stem}_modc/meshes/") for m in meshes)
-            (control,) = nodes(actions, "ros2_control_node")
-            params = control.kwargs["parameters"]
-            assert params[0]["robot_description"] == description
-            assert Path(params[1]) == d / f["ros2_controllers"] and Path(params[1]).is_file()
-            spawned = [n.kwargs["arguments"][0] for n in nodes(actions, "spawner")]
-            assert spawned == ["joint_state_broadcaster", "arm_controller"]
-            # move_group reads the package's own MoveIt files (the SRDF comes from the SRDF backend)
-            builder = _Builder.instances[-1]
-            assert builder.package_name == f"{stem}_modc" and builder.pipelines == ["ompl"]
-            assert builder.paths == {
-                "robot_description": f["description"], "robot_description_semantic": f["srdf"],
-                "robot_description_kinematics": f["kinematics"], "joint_limits": f["joint_limits"],
-                "trajectory_execution": f["moveit_controllers"]}
-            for key, rel in builder.paths.items():
-                assert key == "robot_description_semantic" or (d / rel).is_file(), rel
-            assert f["srdf"] == f"config/{robot.file_stem}.srdf"  # SPEC section 5
-            assert len(nodes(actions, "move_group")) == 1
-            (tf,) = nodes(actions, "static_transform_publisher")  # the SRDF's virtual joint world -> base_link
-            assert tf.kwargs["arguments"] == ["--frame-id", "world", "--child-frame-id", "base_link"]
-            scene = nodes(actions, "moveit_publish_scene_from_text")
-            assert len(scene) == (1 if robot.obstacles else 0)
-            if scene:
-                assert scene[0].kwargs["arguments"][0] == "--scene"
-                assert Path(scene[0].kwargs["arguments"][1]).is_file()
-            (rviz,) = nodes(actions, "rviz2")
-            assert Path(rviz.kwargs["arguments"][1]).name == "ros2_moveit.rviz"
-            assert Path(rviz.kwargs["arguments"][1]).is_file()
-            # without MoveIt and RViz: control only
-            _, actions = run_launch(d / f["demo_launch"], moveit="false", rviz="false",
-                                    hardware_plugin="kinova/KortexSystem")
-            assert not nodes(actions, "move_group") and not nodes(actions, "rviz2")
-            assert not nodes(actions, "static_transform_publisher")
-            (rsp,) = nodes(actions, "robot_state_publisher")
-            assert "<plugin>kinova/KortexSystem</plugin>" in rsp.kwargs["parameters"][0]["robot_description"]
-
-
-def test_ros2_display_launch(examples, ros2_launch_api):
-    pytest.importorskip("xacro")
-    b, files, d = examples["farm"]
-    ros2_launch_api["farm_modc"] = str(d)
-    declared, actions = run_launch(d / "launch/mod3_farm_display.launch.py")
-    assert declared == {"gui": "true", "rviz": "true"}
-    (rsp,) = nodes(actions, "robot_state_publisher")
-    doc = ET.fromstring(rsp.kwargs["parameters"][0]["robot_description"])
-    assert doc.find("ros2_control") is None and doc.find("link[@name='tool0']") is not None
-    (jsp,) = nodes(actions, "joint_state_publisher_gui")
-    assert jsp.kwargs["parameters"] == [{"zeros": {"joint_1": 0.0, "joint_2": 0.0, "joint_3": 0.0}}]
-    (rviz,) = nodes(actions, "rviz2")
-    assert Path(rviz.kwargs["arguments"][1]).is_file()
-    _, actions = run_launch(d / "launch/mod3_farm_display.launch.py", gui="false", rviz="false")
-    assert nodes(actions, "joint_state_publisher") and not nodes(actions, "rviz2")
-
-
-def test_ros1_display_launch(examples):
-    for stem, (b, files, d) in examples.items():
-        for robot in b.design.robots:
-            f = ros.robot_files(robot.file_stem)
-            doc = ET.fromstring(files[f["display_launch_ros1"]])
-            assert doc.tag == "launch"
-            assert {a.get("name"): a.get("default") for a in doc.findall("arg")} == {"gui": "true", "rviz": "true"}
-            param = doc.find("param[@name='robot_description']").get("command")
-            m = re.fullmatch(r"\$\(find xacro\)/xacro '\$\(find (\w+)\)/(\S+)' ros2_control:=false", param)
-            assert m and m.group(1) == f"{stem}_modc" and (d / m.group(2)).is_file()
-            pkgs = {n.get("pkg") for n in doc.findall("node")}
-            assert {"robot_state_publisher", "joint_state_publisher", "joint_state_publisher_gui", "rviz"} <= pkgs
-            rviz = doc.find("node[@pkg='rviz']").get("args")
-            m = re.fullmatch(r"-d \$\(find (\w+)\)/(\S+)", rviz)
-            assert m and (d / m.group(2)).is_file()
-            for node in doc.findall("node"):
-                zeros = node.find("rosparam[@param='zeros']")
-                if zeros is not None:
-                    assert yaml.safe_load(zeros.text) == {f"joint_{k}": q for k, q in enumerate(robot.home(), start=1)}
-
-
-def test_xml_and_rviz_files_parse(examples):
-    for stem, (b, files, d) in examples.items():
+            arm = cfg["arm_controller"]["ros__parameters"]
+            moveit = yaml.safe_load(files["config/moveit_controllers.yaml"])
+            assert moveit["moveit_simple_controller_manager"]["controller_names"] == ["arm_controller"]
+            assert moveit["moveit_simple_controller_manager"]["arm_controller"]["joints"] == names
+        else:
+            arm = yaml.safe_load(files["config/ros_controllers.yaml"])["arm_controller"]
+            assert arm["type"] == "effort_controllers/JointTrajectoryController"
+            (simple,) = yaml.safe_load(files["config/simple_moveit_controllers.yaml"])["controller_list"]
+            assert simple["name"] == "arm_controller" and simple["joints"] == names
+            (fake,) = yaml.safe_load(files["config/fake_controllers.yaml"])["controller_list"]
+            assert fake["joints"] == names
+        assert arm["joints"] == names
+        for n in names:
+            for k in ("p", "i", "d"):
+                close(arm["gains"][n][k], getattr(ctl, k), f"{stem} {n} {k}")
+
+
+def test_joint_limits_match_the_library(packages):
+    for c, files, _ in packages.values():
+        robot = c.design.robots[0]
+        lim = yaml.safe_load(files["config/joint_limits.yaml"])["joint_limits"]
+        for k, unit in enumerate(robot.units, start=1):
+            act = robot.library.variants[unit.variant].actuator
+            lo, hi = robot.joint_range(k)
+            j = lim[f"joint_{k}"]
+            close(j["min_position"], lo, "min")
+            close(j["max_position"], hi, "max")
+            close(j["max_velocity"], act.velocity, "velocity")
+            close(j["max_effort"], act.torque_peak, "effort")
+            close(j["max_acceleration"], act.velocity / 0.5, "acceleration")
+
+
+def test_kinematics_group_is_the_srdf_group(packages):
+    for c, files, _ in packages.values():
+        robot = c.design.robots[0]
+        srdf = ET.fromstring(files[f"config/{robot.file_stem}.srdf"])
+        chain_groups = [g.get("name") for g in srdf.findall("group") if g.find("chain") is not None]
+        kin = yaml.safe_load(files["config/kinematics.yaml"])
+        assert list(kin) == chain_groups[:1]
+        assert kin[chain_groups[0]]["position_only_ik"] is (robot.dof < 6)
+
+
+def test_xml_and_yaml_files_parse(packages):
+    for _, files, _ in packages.values():
         for rel, text in files.items():
-            if rel.endswith((".xml", ".xacro", ".launch")):
+            if isinstance(text, bytes):
+                continue
+            if rel.endswith((".xml", ".xacro", ".launch", ".urdf", ".srdf")):
                 ET.fromstring(text)
-            if rel.endswith(".rviz"):
-                cfg = yaml.safe_load(text)
-                assert cfg["Visualization Manager"]["Global Options"]["Fixed Frame"] == "base_link"
+            if rel.endswith((".yaml", ".rviz")) or rel == ".setup_assistant":
+                yaml.safe_load(text)
+            if rel.endswith(".py"):
+                compile(text, rel, "exec")
 
 
-def test_real_number_literals():
-    assert ros.real(2) == "2.0" and ros.real(0) == "0.0" and ros.real(0.05) == "0.05"
-    assert ros.real(-3) == "-3.0" and ros.real(1e-5) == "1.0e-05" and ros.real(1.5e20) == "1.5e+20"
-    for x in [2, 0, 0.05, 1e-5, 1.5e20, -7.25, 123456789012345]:
-        v = yaml.safe_load(ros.real(x))
-        assert isinstance(v, float) and math.isclose(v, x, rel_tol=1e-11)
+def test_a_file_with_two_robots_is_one_package():
+    c, files = compile_files("""
+robot left_arm { chain H1 - L4(port=45deg) - L1 }
+robot Wrist2 { chain L1 - L4(pivot=-90deg, port=90deg) - L1
+    allow first-variant
+    sphere ball radius 0.05 m at (0.3, 0, 0.2) m }
+""")
+    assert "<name>left_arm_moveit_config</name>" in files["package.xml"]
+    for stem in (r.file_stem for r in c.design.robots):
+        assert {f"urdf/{stem}_ros.urdf", f"config/{stem}.urdf.xacro", f"config/{stem}.ros2_control.xacro"} <= set(files)
+    assert '"mod3_left_arm"' in files["launch/demo.launch.py"]  # MoveIt's configuration: the first robot
+    assert f"config/{c.design.robots[1].file_stem}.scene" in files
 
 
-def test_awkward_file_names_give_valid_xml():
-    c = checked_ok("robot r { chain H1 - L1 }\n", "my--arm & <co>-.mod")
-    _, files = emit(c)
-    for rel, text in files.items():
-        if rel.endswith((".xml", ".xacro", ".launch")):
-            ET.fromstring(text)
-    pkg = catkin().parse_package_string(files["package.xml"])
-    assert pkg.name == "my_arm_co_modc"
-    assert "my--arm & <co>-.mod" in ET.fromstring(files["package.xml"]).find("description").text
+def test_awkward_file_names_stay_inert(tmp_path):
+    """The file name reaches comments and package.xml's description only: valid XML, and nothing
+    roslaunch substitutes (fake_controllers.yaml is loaded with subst_value)."""
+    src = tmp_path / "a&b <c> $(env HOME) ${x}.mod"  # "--" in comments: the URDF backend's (sec-names)
+    src.write_text("robot r { chain H1 - L4(port=45deg) - L1 }\n")
+    for distro in ("jazzy", "noetic"):
+        _, files = compile_files(src, ros_distro=distro, collision_samples=0)
+        for rel, text in files.items():
+            if rel.endswith((".xml", ".xacro", ".launch", ".urdf", ".srdf")):
+                ET.fromstring(text)
+            if rel.endswith((".yaml", ".rviz")) or rel == ".setup_assistant":
+                yaml.safe_load(text)
+            if rel.endswith(".py"):
+                compile(text, rel, "exec")
+        if distro == "noetic":
+            assert "$(env" not in files["config/fake_controllers.yaml"]
+        assert ET.fromstring(files["package.xml"]).find("description").text.count("a&b <c>") == 1
+
+
+def test_library_output_ignores_the_environment(monkeypatch):
+    """Only the CLI reads $ROS_DISTRO / $ROS_VERSION: build() (and so the golden files) does not."""
+    before = compile_files(EXAMPLES[0], collision_samples=0)[1]
+    monkeypatch.setenv("ROS_DISTRO", "noetic")
+    monkeypatch.setenv("ROS_VERSION", "1")
+    after = compile_files(EXAMPLES[0], collision_samples=0)[1]
+    assert after == before and "<buildtool_depend>ament_cmake</buildtool_depend>" in after["package.xml"]
+
+
+def test_effort_command_interface():
+    c, files = compile_files(EXAMPLES[0], command_interface="effort", collision_samples=0)
+    robot = c.design.robots[0]
+    arm = yaml.safe_load(files["config/ros2_controllers.yaml"])["arm_controller"]["ros__parameters"]
+    assert arm["command_interfaces"] == ["effort"]
+    control = ET.fromstring(files[f"config/{robot.file_stem}.ros2_control.xacro"])
+    for k, unit in enumerate(robot.units, start=1):
+        (joint,) = [j for j in control.iter("joint") if j.get("name") == f"joint_{k}"]
+        ci = joint.find("command_interface")
+        peak = robot.library.variants[unit.variant].actuator.torque_peak
+        assert ci.get("name") == "effort"
+        assert [float(p.text) for p in ci.findall("param")] == pytest.approx([-peak, peak])
+    setup = yaml.safe_load(files[".setup_assistant"])["moveit_setup_assistant_config"]
+    assert setup["control_xacro"]["command"] == ["effort"]

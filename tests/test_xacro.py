@@ -342,7 +342,8 @@ def test_xacro_cli(farm, tmp_path):
 def test_files_and_library_layout():
     c = checked_ok(CHAINS["two_libraries"], "two.mod")
     files = xacro_backend.emit(Build(c.design))
-    assert sorted(files) == ["urdf/mod2_planar.urdf.xacro", "urdf/mod2_planar_macro.xacro", "urdf/mod3_strict.urdf.xacro",
+    assert sorted(files) == ["config/mod2_planar_macro.srdf.xacro", "config/mod3_strict_macro.srdf.xacro",
+                             "urdf/mod2_planar.urdf.xacro", "urdf/mod2_planar_macro.xacro", "urdf/mod3_strict.urdf.xacro",
                              "urdf/mod3_strict_macro.xacro", "urdf/modc_modules.xacro"]
     lib = files["urdf/modc_modules.xacro"]
     for ident in ("mark2", "mark2_strict"):

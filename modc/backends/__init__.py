@@ -33,12 +33,12 @@ def register(name: str, summary: str, heavy: bool = False):
 
 def load_all() -> dict[str, Backend]:
     # Registration happens on import, in run order: later backends may read earlier outputs
-    # (ros reads the SRDF's group names); report runs last so that it lists every output.
+    # (ros installs mjcf/ when the mjcf backend ran); report runs last so that it lists every output.
     from . import meshes, urdf  # noqa: F401
     from . import srdf  # noqa: F401
+    from . import mjcf  # noqa: F401
     from . import ros  # noqa: F401
     from . import xacro  # noqa: F401
-    from . import mjcf  # noqa: F401
     from . import report  # noqa: F401
 
     return BACKENDS

@@ -16,6 +16,12 @@ class Build:
     files: dict[str, str | bytes] = field(default_factory=dict)  # what earlier backends produced
     collision_samples: int | None = None  # SRDF collision matrix: samples (None: 10,000 as MoveIt)
     seed: int | None = None  # and its seed (None: 0)
+    # ROS package (modc.backends.ros_target): None = the default (jazzy, the distro's IK
+    # solver, position commands, <robot>_moveit_config). The CLI fills these from its options.
+    ros_distro: str | None = None
+    ik_solver: str | None = None
+    command_interface: str | None = None
+    ros_package: str | None = None
     _descriptions: dict[str, Description] = field(default_factory=dict)
 
     @property

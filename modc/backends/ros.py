@@ -1,63 +1,57 @@
-"""ROS backend: OUT/ becomes one buildable ROS package per input file (SPEC section 5).
+"""ROS backend: OUT/ is a MoveIt configuration package, file for file as the MoveIt Setup
+Assistant of the target distro writes it (SPEC section 5), for ROS 2 or for ROS 1.
 
-What a ROS user gets for every robot (stem = mod<n>_<name>):
+ROS 2 (humble, jazzy; templates/ros/ros2), the layout MoveItConfigsBuilder reads by default:
 
-    config/<stem>_ros_controllers.yaml          ROS 1 ros_control: effort JointTrajectoryController + JointStateController
-    config/<stem>_ros2_controllers.yaml         ROS 2 ros2_control: controller_manager, JointTrajectoryController, JointStateBroadcaster
-    config/<stem>_moveit_controllers.yaml       MoveIt 2: moveit_simple_controller_manager -> arm_controller
-    config/<stem>_simple_moveit_controllers.yaml  MoveIt 1: controller_list -> arm_controller
-    config/<stem>_kinematics.yaml               IK solver of the planning group (TRAC-IK; KDL as the documented fallback)
-    config/<stem>_joint_limits.yaml             MoveIt joint limits (position, velocity, acceleration, effort)
-    config/<stem>_initial_positions.yaml        home pose, read by the ros2_control xacro
-    config/<stem>.scene                         MoveIt planning scene of the file's obstacles (only if there are any)
-    urdf/<stem>_ros.urdf.xacro                  the robot for ROS: package:// mesh URIs, transmissions, ros2_control
-    urdf/<stem>.ros2_control.xacro              ros2_control macro (mock_components/GenericSystem by default)
-    launch/<stem>_demo.launch.py                ROS 2: robot_state_publisher, ros2_control_node, spawners, move_group, RViz
-    launch/<stem>_display.launch.py             ROS 2: robot_state_publisher + joint_state_publisher_gui + RViz
-    launch/<stem>_display.launch                ROS 1: the same with roslaunch
+    .setup_assistant                     urdf: urdf/<stem>_ros.urdf, srdf: config/<stem>.srdf
+    config/<stem>.urdf.xacro             the robot + ros2_control (what robot_description loads)
+    config/<stem>.ros2_control.xacro     ros2_control macro, mock_components/GenericSystem by default
+    config/kinematics.yaml joint_limits.yaml pilz_cartesian_limits.yaml initial_positions.yaml
+    config/moveit_controllers.yaml       MoveIt's controller list (the builder picks "moveit_")
+    config/ros2_controllers.yaml         controller_manager: arm_controller, joint_state_broadcaster
+    config/moveit.rviz
+    launch/{demo,move_group,moveit_rviz,rsp,spawn_controllers,static_virtual_joint_tfs,
+            warehouse_db,setup_assistant}.launch.py      each one call of moveit_configs_utils.launches
 
-and once per package: package.xml (format 3), CMakeLists.txt and RViz configurations. The
-package builds with ament_cmake under ROS 2 and with catkin under ROS 1 (REP 149 conditions on
-$ROS_VERSION), so one generated tree serves both.
+ROS 1 (noetic; templates/ros/ros1), MoveIt 1's Setup Assistant layout: config/ holds
+kinematics, joint_limits, cartesian_limits, fake_controllers, simple_moveit_controllers,
+ros_controllers (effort JointTrajectoryController with the library's PID), ompl_planning and
+sensors_3d; launch/ holds demo.launch, move_group.launch and the files they include.
 
-Options, read from the Build when present (the CLI may set them), else the defaults:
-    build.ros_package             package name (default: the input file's stem + "_modc", see package_name)
-    build.ik_solver               "trac_ik" (default, the paper's) or "kdl"
-    build.ros2_command_interface  "position" (default: mock hardware, Kinova position mode) or "effort"
-An invalid option raises ValueError (validate at the CLI first: valid_package_name, IK_SOLVERS,
-COMMAND_INTERFACES).
+Both: urdf/<stem>_ros.urdf (the URDF with package:// mesh URIs and base_link's mass on a fixed
+child base_link_inertia, which KDL wants; for RViz and MoveIt),
+config/<stem>.scene (the file's obstacles, when it has any), package.xml and CMakeLists.txt
+for the one build system of the target. config/<stem>.srdf comes from the SRDF backend.
 
-If the SRDF backend ran first, its arm group (kinematics.yaml) and virtual joint frame (the demo's
-static transform) are used; otherwise its conventions, "arm" and "world".
+A MoveIt configuration describes one robot: a file with several robots gets the package-wide
+MoveIt files of its first robot (robot_files and the scene for every robot).
 
-Python prepares every value as a string (numbers through modc.backends.format); the templates in
-templates/ros/ only lay them out. Output is deterministic.
+Python prepares every value as a plain string (numbers through modc.backends.format); the
+templates only lay them out. Output is deterministic and does not depend on the environment.
 """
 from __future__ import annotations
 
 import math
-import re
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from pathlib import Path
-
-from markupsafe import Markup
 
 from .. import __version__
 from ..kinematics import rpy_matrix
+from ..physical.assembly import kdl_root
 from . import Build, register
+from . import srdf as srdf_backend
+from . import urdf as urdf_backend
 from .format import num
-from .templates import comment, render, scene_token, text_line
-from .urdf import urdf_text
+from .ros_target import IK_PLUGINS, Target, resolve
+from .templates import comment, render, scene_token
 
-# --- documented choices (README: "ROS package") -------------------------------------------------
+# --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
 
 PACKAGE_VERSION = "0.1.0"
 PACKAGE_LICENSE = "BSD-3-Clause"  # what MoveIt Setup Assistant writes; the generated package is the user's
 MAINTAINER = ("modc user", "user@example.com")  # placeholder: edit package.xml before releasing
 
-DEFAULT_GROUP = "arm"  # planning group name when no SRDF names one (the SRDF backend's name)
-DEFAULT_WORLD_FRAME = "world"  # parent of the SRDF's virtual joint when no SRDF says otherwise
+# The SRDF backend's planning group and virtual joint (world -> base_link, templates/srdf.xml.j2)
+VIRTUAL_JOINT_PARENT = "world"
 ARM_CONTROLLER = "arm_controller"
 JOINT_STATE_CONTROLLER = "joint_state_controller"  # ROS 1
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"  # ROS 2
@@ -77,89 +71,17 @@ ACCEL_RAMP_TIME = 0.5  # s
 # MoveIt's own defaults (Setup Assistant): plans run at 10 % of the limits until the user scales up.
 VELOCITY_SCALING = 0.1
 ACCELERATION_SCALING = 0.1
-
-IK_SOLVERS = {
-    "trac_ik": ("trac_ik_kinematics_plugin/TRAC_IKKinematicsPlugin", "trac_ik_kinematics_plugin"),
-    "kdl": ("kdl_kinematics_plugin/KDLKinematicsPlugin", "moveit_kinematics"),
-}
-DEFAULT_IK_SOLVER = "trac_ik"  # the paper's choice (section 4.4, TRAC-IK)
 IK_TIMEOUT = 0.005  # s, per attempt (Setup Assistant's default)
 IK_RESOLUTION = 0.005  # rad
-# ros2_control command interface: "position" drives mock_components/GenericSystem (which only
-# mirrors position commands) and matches the Kinova actuators, which close their own PID loop
-# on position; "effort" makes the ROS 2 JointTrajectoryController close the PID with the gains.
-COMMAND_INTERFACES = ("position", "effort")
-DEFAULT_COMMAND_INTERFACE = "position"
 MOCK_PLUGIN = "mock_components/GenericSystem"
-
 SCENE_COLOR = "0.6 0.6 0.6 0.8"  # RGBA of obstacles in MoveIt's planning scene
 
-PACKAGE_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+# The Setup Assistant's ROS 2 launch files, each one call of moveit_configs_utils.launches
+ROS2_LAUNCHES = ("demo", "move_group", "moveit_rviz", "rsp", "spawn_controllers", "static_virtual_joint_tfs",
+                 "warehouse_db", "setup_assistant")
 
 
 # --- names ---------------------------------------------------------------------------------------
-
-def valid_package_name(name: str) -> bool:
-    """REP 144: lowercase letters, digits and single underscores, starting with a letter."""
-    return bool(PACKAGE_NAME.match(name)) and "__" not in name and not name.endswith("_")
-
-
-def package_name(source_name: str) -> str:
-    """farm.mod -> farm_modc: the input file's stem, sanitised to a REP 144 name, plus _modc."""
-    stem = re.sub(r"[^a-z0-9]+", "_", Path(source_name).stem.lower()).strip("_")
-    if not stem:
-        return "modc"
-    return f"{stem}_modc" if stem[0].isalpha() else f"modc_{stem}"
-
-
-def ik_solver(build: Build) -> str:
-    name = getattr(build, "ik_solver", None) or DEFAULT_IK_SOLVER
-    if name not in IK_SOLVERS:
-        raise ValueError(f"unknown IK solver '{name}' (choose from {', '.join(sorted(IK_SOLVERS))})")
-    return name
-
-
-def command_interface(build: Build) -> str:
-    name = getattr(build, "ros2_command_interface", None) or DEFAULT_COMMAND_INTERFACE
-    if name not in COMMAND_INTERFACES:
-        raise ValueError(f"unknown ros2_control command interface '{name}' (choose from {', '.join(COMMAND_INTERFACES)})")
-    return name
-
-
-def ros_package(build: Build) -> str:
-    name = getattr(build, "ros_package", None) or package_name(build.source_name)
-    if not valid_package_name(name):
-        raise ValueError(f"'{name}' is not a valid ROS package name (lowercase letters, digits, single underscores)")
-    return name
-
-
-def _srdf(build: Build, robot) -> ET.Element | None:
-    """The SRDF backend's output for this robot, if it ran before this backend."""
-    text = build.files.get(f"config/{robot.file_stem}.srdf")
-    if isinstance(text, bytes):
-        text = text.decode("utf-8")
-    if not text:
-        return None
-    try:
-        return ET.fromstring(text)
-    except ET.ParseError:
-        return None
-
-
-def planning_group(build: Build, robot) -> str:
-    """The SRDF's arm group (the first group with a chain), else DEFAULT_GROUP."""
-    srdf = _srdf(build, robot)
-    groups = [] if srdf is None else [g for g in srdf.findall("group") if g.get("name")]
-    chains = [g for g in groups if g.find("chain") is not None]
-    return (chains or groups)[0].get("name") if groups else DEFAULT_GROUP
-
-
-def world_frame(build: Build, robot) -> str:
-    """The parent frame of the SRDF's virtual joint (MoveIt's planning frame), else "world"."""
-    srdf = _srdf(build, robot)
-    vj = None if srdf is None else srdf.find("virtual_joint")
-    return vj.get("parent_frame") if vj is not None and vj.get("parent_frame") else DEFAULT_WORLD_FRAME
-
 
 # --- numbers -------------------------------------------------------------------------------------
 
@@ -257,22 +179,31 @@ def _scene(robot) -> dict | None:
     return {"name": f"{robot.file_stem}_environment", "objects": objects, "color": SCENE_COLOR}
 
 
-def robot_context(build: Build, robot, package: str) -> dict:
-    solver = ik_solver(build)
-    (alternative,) = (n for n in sorted(IK_SOLVERS) if n != solver)
-    iface = command_interface(build)
-    js = joints(robot)
-    stem = robot.file_stem
+def robot_files(stem: str) -> dict[str, str]:
+    """Per-robot paths, relative to the package root (templates and tests use these)."""
     return {
-        "version": __version__, "source": comment(build.source_name),
-        "source_comment": comment(build.source_name), "package": package,
-        "robot": robot.name, "stem": stem, "sequence": robot.sequence, "dof": robot.dof,
-        "library": comment(robot.library.name), "group": planning_group(build, robot),
-        "world_frame": world_frame(build, robot),
+        "srdf": f"config/{stem}.srdf",  # written by the SRDF backend
+        "urdf": f"urdf/{stem}.urdf",  # written by the URDF backend (relative mesh paths)
+        "description": f"urdf/{stem}_ros.urdf",  # the same robot with package:// mesh URIs
+        "urdf_xacro": f"config/{stem}.urdf.xacro",  # ROS 2: description + ros2_control
+        "ros2_control": f"config/{stem}.ros2_control.xacro",
+        "scene": f"config/{stem}.scene",
+    }
+
+
+def context(build: Build, robot, target: Target) -> dict:
+    """Every value the templates place, for the package's (first) robot."""
+    js = joints(robot)
+    plugin, ik_package = IK_PLUGINS[target.ik_solver]
+    return {
+        "version": __version__, "source": comment(build.source_name), "package": target.package,
+        "distro": target.distro.name, "ros": target.ros,
+        "robot": robot.name, "stem": robot.file_stem, "sequence": robot.sequence, "dof": robot.dof,
+        "library": comment(robot.library.name), "group": srdf_backend.GROUP,
+        "virtual_parent": VIRTUAL_JOINT_PARENT, "virtual_child": srdf_backend.BASE_LINK,
         "controller": ARM_CONTROLLER, "joint_state_controller": JOINT_STATE_CONTROLLER,
         "joint_state_broadcaster": JOINT_STATE_BROADCASTER,
-        "joints": [_joint_ctx(j, iface) for j in js],
-        "home_flow": "{" + ", ".join(f"{j.name}: {real(j.home)}" for j in js) + "}",
+        "joints": [_joint_ctx(j, target.command_interface) for j in js],
         "home_origin": _home_origin(robot),
         "update_rate": str(UPDATE_RATE), "joint_state_rate": real(JOINT_STATE_RATE),
         "goal_time": real(GOAL_TIME), "goal_tolerance": real(GOAL_TOLERANCE),
@@ -280,127 +211,126 @@ def robot_context(build: Build, robot, package: str) -> dict:
         "accel_ramp_time": num(ACCEL_RAMP_TIME),
         "velocity_scaling": real(VELOCITY_SCALING), "acceleration_scaling": real(ACCELERATION_SCALING),
         "ik": {
-            "solver": solver, "plugin": IK_SOLVERS[solver][0],
-            "alternative": alternative, "alternative_plugin": IK_SOLVERS[alternative][0],
+            "solver": target.ik_solver, "plugin": plugin, "package": ik_package,
+            "others": [s for s in target.distro.ik_solvers if s != target.ik_solver],
             "timeout": real(IK_TIMEOUT), "resolution": real(IK_RESOLUTION),
             # a pose has 6 DoF: an arm with fewer joints can reach positions, not orientations
             "position_only": "true" if robot.dof < 6 else "false",
         },
-        "command_interface": iface, "mock_plugin": MOCK_PLUGIN,
-        "scene": _scene(robot),
-        "files": robot_files(stem),
-    }
-
-
-def robot_files(stem: str) -> dict[str, str]:
-    """Every per-robot path, relative to the package root (templates and tests use these)."""
-    return {
-        "ros_controllers": f"config/{stem}_ros_controllers.yaml",
-        "ros2_controllers": f"config/{stem}_ros2_controllers.yaml",
-        "moveit_controllers": f"config/{stem}_moveit_controllers.yaml",
-        "simple_moveit_controllers": f"config/{stem}_simple_moveit_controllers.yaml",
-        "kinematics": f"config/{stem}_kinematics.yaml",
-        "joint_limits": f"config/{stem}_joint_limits.yaml",
-        "initial_positions": f"config/{stem}_initial_positions.yaml",
-        "scene": f"config/{stem}.scene",
-        "srdf": f"config/{stem}.srdf",  # written by the SRDF backend
-        "urdf": f"urdf/{stem}.urdf",  # written by the URDF backend
-        "description": f"urdf/{stem}_ros.urdf.xacro",
-        "ros2_control": f"urdf/{stem}.ros2_control.xacro",
-        "demo_launch": f"launch/{stem}_demo.launch.py",
-        "display_launch_ros2": f"launch/{stem}_display.launch.py",
-        "display_launch_ros1": f"launch/{stem}_display.launch",
-    }
-
-
-PACKAGE_FILES = {
-    "package": "package.xml",
-    "cmake": "CMakeLists.txt",
-    "rviz2_display": "config/ros2_display.rviz",
-    "rviz2_moveit": "config/ros2_moveit.rviz",
-    "rviz1_display": "config/ros1_display.rviz",
-}
-
-
-def _urdf_body(text: str) -> str:
-    """The children of <robot> in a URDF document, as text (the ROS xacro wraps them)."""
-    start = text.index(">", text.index("<robot ")) + 1
-    end = text.rindex("</robot>")
-    return text[start:end].strip("\n")
-
-
-# --- package-level files -------------------------------------------------------------------------
-
-# (package, condition) pairs; condition None = both ROS versions.
-def exec_depends(solvers: set[str]) -> list[dict]:
-    both = ["controller_manager", "joint_state_publisher", "joint_state_publisher_gui", "joint_trajectory_controller",
-            "moveit_simple_controller_manager", "robot_state_publisher", "xacro"]
-    both += [IK_SOLVERS[s][1] for s in sorted(solvers)]
-    ros1 = ["effort_controllers", "joint_state_controller", "rviz"]
-    ros2 = ["ament_index_python", "hardware_interface", "joint_state_broadcaster", "launch", "launch_ros",
-            "moveit_configs_utils", "moveit_planners_ompl", "moveit_ros_move_group", "moveit_ros_planning",
-            "moveit_ros_visualization", "rviz2", "tf2_ros"]
-    out = [{"name": n, "condition": None} for n in sorted(set(both))]
-    out += [{"name": n, "condition": "$ROS_VERSION == 1"} for n in sorted(set(ros1))]
-    out += [{"name": n, "condition": "$ROS_VERSION == 2"} for n in sorted(set(ros2))]
-    return out
-
-
-def package_context(build: Build, package: str) -> dict:
-    robots = build.design.robots
-    summary = ", ".join(f"{r.name} = {r.sequence}" for r in robots)
-    return {
-        "version": __version__, "source": comment(build.source_name),
-        "source_comment": comment(build.source_name), "package": package,
+        "command_interface": target.command_interface, "mock_plugin": MOCK_PLUGIN,
+        "scene": _scene(robot), "files": robot_files(robot.file_stem),
         "package_version": PACKAGE_VERSION, "license": PACKAGE_LICENSE,
         "maintainer": MAINTAINER[0], "maintainer_email": MAINTAINER[1],
-        "description": text_line(f"URDF, ros_control / ros2_control and MoveIt configuration of {build.source_name} "
-                                 f"({summary}), MOIRs Mark-2 modules, generated by modc {__version__}."),
-        "depends": exec_depends({ik_solver(build)}),
-        "robots": [{"name": r.name, "stem": r.file_stem, "files": robot_files(r.file_stem)} for r in robots],
-        "directories": ["config", "launch", "meshes", "urdf"],
+        "robots": ", ".join(f"{r.name} = {r.sequence}" for r in build.design.robots),
+        "depends": exec_depends(target),
+        # mjcf/ when that backend is in this build (it runs before this one)
+        "directories": ["config", "launch", "meshes", *(["mjcf"] if any(f.startswith("mjcf/") for f in build.files) else []),
+                        "urdf"],
     }
+
+
+# --- package.xml: what the package runs, per ROS version (every one released in the target distro)
+
+ROS2_DEPENDS = ("controller_manager", "hardware_interface", "joint_state_broadcaster", "joint_state_publisher",
+                "joint_state_publisher_gui", "joint_trajectory_controller", "moveit_configs_utils",
+                "moveit_kinematics", "moveit_planners", "moveit_ros_move_group", "moveit_ros_visualization",
+                "moveit_ros_warehouse", "moveit_setup_assistant", "moveit_simple_controller_manager",
+                "robot_state_publisher", "rviz2", "rviz_common", "rviz_default_plugins", "tf2_ros", "xacro")
+ROS1_DEPENDS = ("controller_manager", "effort_controllers", "joint_state_controller", "joint_state_publisher",
+                "joint_state_publisher_gui", "joint_trajectory_controller", "moveit_fake_controller_manager",
+                "moveit_kinematics", "moveit_planners", "moveit_ros_move_group", "moveit_ros_visualization",
+                "moveit_ros_warehouse", "moveit_setup_assistant", "moveit_simple_controller_manager",
+                "robot_state_publisher", "rviz", "tf2_ros", "xacro")
+
+
+def exec_depends(target: Target) -> list[str]:
+    base = ROS2_DEPENDS if target.ros == 2 else ROS1_DEPENDS
+    return sorted({*base, IK_PLUGINS[target.ik_solver][1]})
+
+
+# --- the file tables ------------------------------------------------------------------------------
+
+def ros2_files(stem: str) -> dict[str, str]:
+    """Package path -> template, ROS 2 (MoveIt 2 Setup Assistant)."""
+    files = {
+        ".setup_assistant": "ros/ros2/setup_assistant.yaml.j2",
+        "package.xml": "ros/ros2/package.xml.j2",
+        "CMakeLists.txt": "ros/ros2/CMakeLists.txt.j2",
+        "config/kinematics.yaml": "ros/kinematics.yaml.j2",
+        "config/joint_limits.yaml": "ros/joint_limits.yaml.j2",
+        "config/pilz_cartesian_limits.yaml": "ros/cartesian_limits.yaml.j2",
+        "config/initial_positions.yaml": "ros/ros2/initial_positions.yaml.j2",
+        "config/moveit_controllers.yaml": "ros/ros2/moveit_controllers.yaml.j2",
+        "config/ros2_controllers.yaml": "ros/ros2/ros2_controllers.yaml.j2",
+        "config/moveit.rviz": "ros/ros2/moveit.rviz.j2",
+    }
+    files.update({f"launch/{name}.launch.py": "ros/ros2/launch.py.j2" for name in ROS2_LAUNCHES})
+    return files
+
+
+def ros1_files(stem: str) -> dict[str, str]:
+    """Package path -> template, ROS 1 (MoveIt 1 Setup Assistant)."""
+    files = {
+        ".setup_assistant": "ros/ros1/setup_assistant.yaml.j2",
+        "package.xml": "ros/ros1/package.xml.j2",
+        "CMakeLists.txt": "ros/ros1/CMakeLists.txt.j2",
+        "config/kinematics.yaml": "ros/kinematics.yaml.j2",
+        "config/joint_limits.yaml": "ros/joint_limits.yaml.j2",
+        "config/cartesian_limits.yaml": "ros/cartesian_limits.yaml.j2",
+        "config/fake_controllers.yaml": "ros/ros1/fake_controllers.yaml.j2",
+        "config/simple_moveit_controllers.yaml": "ros/ros1/simple_moveit_controllers.yaml.j2",
+        "config/ros_controllers.yaml": "ros/ros1/ros_controllers.yaml.j2",
+        "config/ompl_planning.yaml": "ros/ros1/ompl_planning.yaml.j2",
+        "config/sensors_3d.yaml": "ros/ros1/sensors_3d.yaml.j2",
+        "launch/moveit.rviz": "ros/ros1/moveit.rviz.j2",
+        f"launch/{stem}_moveit_controller_manager.launch.xml": "ros/ros1/robot_moveit_controller_manager.launch.xml.j2",
+        f"launch/{stem}_moveit_sensor_manager.launch.xml": "ros/ros1/robot_moveit_sensor_manager.launch.xml.j2",
+    }
+    for name in ("demo.launch", "move_group.launch", "planning_context.launch", "planning_pipeline.launch.xml",
+                 "ompl_planning_pipeline.launch.xml", "trajectory_execution.launch.xml",
+                 "fake_moveit_controller_manager.launch.xml", "simple_moveit_controller_manager.launch.xml",
+                 "sensor_manager.launch.xml", "moveit_rviz.launch", "ros_controllers.launch", "setup_assistant.launch",
+                 "warehouse.launch", "warehouse_settings.launch.xml", "default_warehouse_db.launch"):
+            files[f"launch/{name}"] = f"ros/ros1/{name}.j2"
+    return files
 
 
 # --- emit ----------------------------------------------------------------------------------------
 
-def robot_outputs(build: Build, robot, package: str) -> dict[str, str]:
-    ctx = robot_context(build, robot, package)
+def robot_outputs(build: Build, robot, target: Target) -> dict[str, str]:
+    """The files every robot of the file gets."""
+    ctx = context(build, robot, target)
     f = ctx["files"]
-    out = {
-        f["ros_controllers"]: render("ros/ros_controllers.yaml.j2", ctx),
-        f["ros2_controllers"]: render("ros/ros2_controllers.yaml.j2", ctx),
-        f["moveit_controllers"]: render("ros/moveit_controllers.yaml.j2", ctx),
-        f["simple_moveit_controllers"]: render("ros/simple_moveit_controllers.yaml.j2", ctx),
-        f["kinematics"]: render("ros/kinematics.yaml.j2", ctx),
-        f["joint_limits"]: render("ros/joint_limits.yaml.j2", ctx),
-        f["initial_positions"]: render("ros/initial_positions.yaml.j2", ctx),
-        f["ros2_control"]: render("ros/ros2_control.xacro.j2", ctx),
-        f["description"]: render("ros/description.urdf.xacro.j2", {
-            **ctx, "body": Markup(_urdf_body(urdf_text(build, robot, mesh_prefix=f"package://{package}/meshes/")))}),
-        f["demo_launch"]: render("ros/demo.launch.py.j2", ctx),
-        f["display_launch_ros2"]: render("ros/display.launch.py.j2", ctx),
-        f["display_launch_ros1"]: render("ros/display.launch.j2", ctx),
-    }
+    # the URDF backend's renderer over the same physical description, with ROS mesh URIs and an
+    # inertia-free root for KDL (base_link's mass on base_link_inertia)
+    desc = kdl_root(build.description(robot))
+    mesh_prefix = f"package://{target.package}/meshes/"
+    out = {f["description"]: render("urdf.xml.j2", urdf_backend.context(desc, robot, build.source_name, mesh_prefix))}
+    if target.ros == 2:
+        out[f["urdf_xacro"]] = render("ros/ros2/robot.urdf.xacro.j2", ctx)
+        out[f["ros2_control"]] = render("ros/ros2/ros2_control.xacro.j2", ctx)
     if ctx["scene"] is not None:
         out[f["scene"]] = render("ros/environment.scene.j2", ctx)
     return out
 
 
 def emit_package(build: Build) -> dict[str, str]:
-    package = ros_package(build)
+    robots = build.design.robots
+    if not robots:
+        return {}
+    target = resolve(build)
     out: dict[str, str] = {}
-    for robot in build.design.robots:
-        out.update(robot_outputs(build, robot, package))
-    pctx = package_context(build, package)
-    out[PACKAGE_FILES["package"]] = render("ros/package.xml.j2", pctx)
-    out[PACKAGE_FILES["cmake"]] = render("ros/CMakeLists.txt.j2", pctx)
-    out[PACKAGE_FILES["rviz2_display"]] = render("ros/ros2_display.rviz.j2", pctx)
-    out[PACKAGE_FILES["rviz2_moveit"]] = render("ros/ros2_moveit.rviz.j2", pctx)
-    out[PACKAGE_FILES["rviz1_display"]] = render("ros/ros1_display.rviz.j2", pctx)
+    for robot in robots:
+        out.update(robot_outputs(build, robot, target))
+    main = robots[0]
+    ctx = context(build, main, target)
+    table = ros2_files(main.file_stem) if target.ros == 2 else ros1_files(main.file_stem)
+    for rel, template in table.items():
+        name = rel.rsplit("/", 1)[-1]
+        out[rel] = render(template, {**ctx, "file": name, "launch": name.split(".", 1)[0]})
     return dict(sorted(out.items()))
 
 
-@register("ros", "ROS package: package.xml, CMakeLists.txt, controllers (ROS 1/2), MoveIt config, launch files")
+@register("ros", "ROS package: the MoveIt Setup Assistant's layout for ROS 2 (or ROS 1), package.xml, launch files")
 def emit(build: Build):
     return emit_package(build)

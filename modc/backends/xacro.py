@@ -4,6 +4,7 @@
                                      module library the file's robots use, parameterised by variant
     urdf/mod<n>_<name>_macro.xacro   the arm as one macro (prefix, optional parent mount, mesh_root)
     urdf/mod<n>_<name>.urdf.xacro    the robot: args prefix and mesh_root, one instance of the arm
+    config/mod<n>_<name>_macro.srdf.xacro   its SRDF collision pairs, a macro (prefix): xacro_srdf.py
 
 `xacro urdf/mod<n>_<name>.urdf.xacro` expands to a URDF equivalent to urdf/mod<n>_<name>.urdf:
 same joints (joint_1..joint_n, limits), same base_link/link_i/tool0/payload frames, same rigid
@@ -36,6 +37,7 @@ from . import Build, register
 from .format import num, vec
 from .templates import comment, render
 from .urdf import MATERIALS
+from .xacro_srdf import macro_srdf_text
 
 LIBRARY_FILE = "modc_modules.xacro"
 DEFAULT_MESH_ROOT = "../meshes"  # relative to the expanded URDF placed in OUT/urdf/, like the .urdf
@@ -342,6 +344,7 @@ def xacro_files(build: Build) -> dict[str, str]:
         ctx = robot_context(build, r, by_robot[id(r)], source)
         files[f"urdf/{ctx['macro_file']}"] = render("xacro/robot_macro.xacro.j2", ctx)
         files[f"urdf/{r.file_stem}.urdf.xacro"] = render("xacro/robot.urdf.xacro.j2", ctx)
+        files[f"config/{r.file_stem}_macro.srdf.xacro"] = macro_srdf_text(build, r, ctx["macro"], source)
     return files
 
 

@@ -108,8 +108,12 @@ HEAVY = {
     "pybullet": "pybullet",
     "pybullet_data": "pybullet",
     "ompl": "ompl",
-    "trimesh": "trimesh",
     "PIL": "pillow",
+    "mujoco": "mujoco",
+    "viser": "viser",
+    "cma": "cma",
+    "dask": "dask",
+    "distributed": "distributed",
 }
 SOURCE_SUFFIXES = (".mod", ".yaml", ".yml")
 

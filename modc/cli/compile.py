@@ -1,7 +1,7 @@
 """`modc FILE -o OUT`: check, build every backend, write OUT atomically."""
 from __future__ import annotations
 
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -17,18 +17,36 @@ from .app import (
     usage_errors,
 )
 
+OnlyOpt = Annotated[str | None, typer.Option(help="comma-separated backends to run (default: all; `modc backends`)")]
+SamplesOpt = Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")]
+SeedOpt = Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")]
+TorqueOpt = Annotated[TorqueLevel | None,
+                      typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")]
+# ROS package options (README "Use in ROS 2 / ROS 1"; precedence in modc.backends.ros_target.distro_for)
+RosOpt = Annotated[int | None, typer.Option(
+    "--ros", help="ROS package for ROS 1 (noetic) or ROS 2 (jazzy); default: $ROS_DISTRO, $ROS_VERSION, else 2")]
+DistroOpt = Annotated[str | None, typer.Option(help="target distro: noetic, humble or jazzy (overrides --ros)")]
+IkOpt = Annotated[str | None, typer.Option(help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's)")]
+PackageOpt = Annotated[str | None, typer.Option(help="ROS package name (default: <robot>_moveit_config)")]
+InterfaceOpt = Annotated[str | None, typer.Option(help="ros2_control command interface: position (default) or effort")]
+
 
 @app.command("compile")
 def compile_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
     out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
     library: LibraryOpt = None,
-    only: Annotated[Optional[str], typer.Option(help="comma-separated backends to run (default: all); see `modc backends`")] = None,
+    only: OnlyOpt = None,
     force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
-    collision_samples: Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")] = 10_000,
-    seed: Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")] = 0,
+    collision_samples: SamplesOpt = 10_000,
+    seed: SeedOpt = 0,
     smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
-    torque: Annotated[Optional[TorqueLevel], typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")] = None,
+    torque: TorqueOpt = None,
+    ros: RosOpt = None,
+    ros_distro: DistroOpt = None,
+    ik_solver: IkOpt = None,
+    ros_package: PackageOpt = None,
+    command_interface: InterfaceOpt = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
 ):
@@ -37,10 +55,11 @@ def compile_cmd(
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
     try:
-        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=(torque or TorqueLevel.error).value)
+        severity = (torque or TorqueLevel.error).value
+        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=severity)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not checked.ok:
         from ..diagnostics.render import summary
@@ -65,7 +84,8 @@ def compile_cmd(
         if not ok:
             _err(f"modc: smoke test failed; nothing written to {out}")
             raise typer.Exit(EXIT_ERRORS)
-    files = build(checked, selected, collision_samples=collision_samples, seed=seed)
+    ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
+    files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     with usage_errors("compile", writing=out):
         write_tree(files, out, force=force)
     if verbose:
@@ -74,3 +94,22 @@ def compile_cmd(
     if not quiet:
         robots = ", ".join(f"{r.file_stem} ({r.sequence})" for r in checked.design.robots)
         _err(f"modc: {len(files)} files written to {out}: {robots}")
+
+
+def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface) -> dict:
+    """Build fields of the ROS backend. The environment ($ROS_DISTRO, $ROS_VERSION) is read here
+    and only here, below the command-line options (README "Use in ROS 2 / ROS 1")."""
+    import os
+
+    from ..backends import Build
+    from ..backends.ros_target import RosOptionError, distro_for, resolve
+
+    try:
+        options = {"ros_distro": distro_for(ros, ros_distro, dict(os.environ)), "ik_solver": ik_solver,
+                   "ros_package": ros_package, "command_interface": command_interface}
+        if selected is None or "ros" in selected:
+            resolve(Build(checked.design, **options))
+    except RosOptionError as e:
+        _err(f"modc: {e}")
+        raise typer.Exit(EXIT_USAGE) from None
+    return options

@@ -20,6 +20,7 @@ PAYLOAD_RADIUS = 0.02  # m: a payload is modelled as a solid sphere this size ar
 # inertia; a microgram-scale inertial keeps every consumer's dynamics right.
 FRAME_MASS = 1e-6
 FRAME_RADIUS = 1e-3
+BASE_INERTIA_LINK = "base_link_inertia"  # see kdl_root
 
 
 @dataclass(frozen=True)
@@ -209,6 +210,19 @@ def describe(robot: Robot) -> Description:
         links.append(Link("payload", inertial=sphere(robot.payload.mass, PAYLOAD_RADIUS, (0.0, 0.0, 0.0))))
         joints.append(Joint("payload_joint", "fixed", "tool0", "payload", T))
     return Description(robot.name, links, joints, robot.file_stem)
+
+
+def kdl_root(desc: Description) -> Description:
+    """The same arm with an inertia-free root: base_link's mass on a fixed child base_link_inertia
+    at the same frame, as ur_description does. KDL (robot_state_publisher, MoveIt) ignores a root
+    link's inertia and warns about it; PyBullet gives a link without <inertial> 1 kg, so only the
+    ROS description takes this form. The total mass is unchanged."""
+    base = desc.links[0]
+    if base.inertial is None:
+        return desc
+    links = [Link(base.name, list(base.visuals)), *desc.links[1:], Link(BASE_INERTIA_LINK, inertial=base.inertial)]
+    joint = Joint(f"{BASE_INERTIA_LINK}_joint", "fixed", base.name, BASE_INERTIA_LINK, np.eye(4))
+    return Description(desc.name, links, [*desc.joints, joint], desc.file_stem)
 
 
 def library_mass(robot: Robot) -> float:
