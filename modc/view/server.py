@@ -1,0 +1,260 @@
+"""The page itself, drawn with viser (a maintained 3D web viewer whose built web client ships in
+its wheel: everything is served from this process, nothing is fetched from the internet).
+
+Scene tree: /world/base sits at T_world_base; under it the cell (obstacles, targets) and one
+node per link, moved as the joints move; the part meshes hang under their link nodes. The GUI
+(right-hand panel) is rebuilt whenever a new arm comes in; values set from Python fire viser's
+callbacks with no client, which the handlers ignore.
+"""
+from __future__ import annotations
+
+import contextlib
+import html
+import io
+import math
+import threading
+import time
+
+import numpy as np
+
+from ..kinematics import transform
+from .arm import OBSTACLE_RGB, TARGET_RADIUS, TARGET_RGB, Arm
+from .page import Page
+
+TICK = 0.05  # s between looks at the file and playback steps: a saved file shows well within a second
+
+
+def _wxyz(T: np.ndarray) -> np.ndarray:
+    from viser.transforms import SO3
+
+    return SO3.from_matrix(T[:3, :3]).wxyz
+
+
+def torque_table(arm: Arm, q) -> str:
+    """HTML of the gravity torque of each joint, coloured by level against τnom / τmax."""
+    rows = []
+    for j in arm.torques(q):
+        share = min(abs(j.tau) / j.tau_max, 1.0) * 100
+        r, g, b = j.rgb
+        rows.append(
+            f'<tr data-level="{j.level}"><td>{html.escape(j.name)} ({html.escape(j.unit)})</td>'
+            f'<td style="text-align:right">{j.tau:+.2f}</td><td>{j.tau_nom:g} / {j.tau_max:g}</td>'
+            f'<td style="width:35%"><div style="background:#ddd;height:10px"><div style="width:{share:.0f}%;'
+            f'height:10px;background:rgb({r},{g},{b})"></div></div></td></tr>')
+    return ('<table style="width:100%;font-size:0.8em;border-collapse:collapse">'
+            '<tr><th align="left">joint</th><th>τ N·m</th><th>τnom / τmax</th><th></th></tr>'
+            + "".join(rows) + "</table>")
+
+
+class View:
+    def __init__(self, server, page: Page):
+        self.server = server
+        self.page = page
+        self.lock = threading.RLock()
+        self._generation = (-1, -1)  # (design index, arm generation) on show
+        self._diagnostics: str | None = None
+        self._nodes: list = []
+        self._gui: list = []
+        self._links: dict = {}
+        self._sliders: list = []
+        gui = server.gui
+        server.scene.set_up_direction("+z")
+        server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1, section_size=0.5)
+        self._title = gui.add_markdown("")
+        if len(page.sources) > 1:
+            prev, nxt = gui.add_button("◀ previous design"), gui.add_button("next design ▶")
+            prev.on_click(lambda e: self._go(-1))
+            nxt.on_click(lambda e: self._go(+1))
+        self._errors = gui.add_markdown("", visible=False)
+        self._rebuild()
+
+    # -- building -----------------------------------------------------------------------------
+
+    def _clear(self) -> None:
+        for h in self._nodes + self._gui:
+            h.remove()
+        self._nodes, self._gui, self._links, self._sliders = [], [], {}, []
+
+    def _rebuild(self) -> None:
+        page, arm = self.page, self.page.arm
+        self._clear()
+        self._generation = (page.index, page.source.generation)
+        self._title.content = f"**{html.escape(page.caption)}**" + (
+            f"  \nrobot `{arm.robot.name}`: {arm.robot.sequence}" if arm is not None else "  \nno good arm yet")
+        self._show_diagnostics()
+        if arm is None:
+            return
+        scene, gui = self.server.scene, self.server.gui
+        T = arm.T_world_base
+        self._nodes.append(scene.add_frame("/world/base", show_axes=False, position=T[:3, 3], wxyz=_wxyz(T)))
+        for ob in arm.robot.obstacles:
+            T_ob = transform(ob.origin.xyz, ob.origin.rpy)
+            kw = dict(color=OBSTACLE_RGB, opacity=0.6, position=T_ob[:3, 3], wxyz=_wxyz(T_ob))
+            name = f"/world/base/cell/{ob.name}"
+            if ob.shape == "box":
+                h = scene.add_box(name, dimensions=tuple(ob.size), **kw)
+            elif ob.shape == "sphere":
+                h = scene.add_icosphere(name, radius=ob.size[0], **kw)
+            else:
+                h = scene.add_cylinder(name, radius=ob.size[0], height=ob.size[1], **kw)
+            self._nodes.append(h)
+        for t in arm.robot.targets:
+            name = f"/world/base/targets/{t.name}"
+            self._nodes.append(scene.add_icosphere(name, radius=TARGET_RADIUS, color=TARGET_RGB, position=tuple(t.xyz)))
+            self._nodes.append(scene.add_label(f"{name}/label", t.name, position=(0.0, 0.0, 0.03)))
+        for link in arm.description.links:
+            self._links[link.name] = scene.add_frame(f"/world/base/{link.name}", show_axes=link.name == "tool0",
+                                                     axes_length=0.05, axes_radius=0.003)
+            self._nodes.append(self._links[link.name])
+        for s in arm.shapes():
+            name = f"/world/base/{s.link}/{s.name}"
+            self._nodes.append(scene.add_mesh_simple(name, s.vertices, s.faces, color=s.rgb))
+        self._camera(arm)
+
+        joints = gui.add_folder("Joints")
+        self._gui.append(joints)
+        with joints:
+            for i, (name, (lo, hi)) in enumerate(zip(arm.joint_names, arm.limits, strict=True)):
+                unit = arm.robot.units[i].name
+                s = gui.add_slider(f"{name} ({unit}) °", min=round(math.degrees(lo), 1), max=round(math.degrees(hi), 1),
+                                   step=0.1, initial_value=round(math.degrees(page.q[i]), 1))
+                s.on_update(self._on_slider(i))
+                self._sliders.append(s)
+        poses = gui.add_folder("Poses")
+        self._gui.append(poses)
+        with poses:
+            for name, _ in arm.poses:
+                b = gui.add_button(name)
+                b.on_click(self._on_pose(name))
+        readout = gui.add_folder("tool0 and torques")
+        self._gui.append(readout)
+        with readout:
+            self._tool = gui.add_markdown("")
+            self._torques = gui.add_html("")
+        if page.source.trajectory is not None:
+            traj = page.source.trajectory
+            play = gui.add_folder("Trajectory")
+            self._gui.append(play)
+            with play:
+                run, stop = gui.add_button("play"), gui.add_button("pause")
+                self._time = gui.add_slider("t (s)", min=0.0, max=round(traj.t[-1], 3), step=0.01, initial_value=0.0)
+                run.on_click(lambda e: self._locked(page.play))
+                stop.on_click(lambda e: self._locked(page.pause))
+                self._time.on_update(self._on_time)
+        self._show_pose()
+
+    def _camera(self, arm: Arm) -> None:
+        reach = sum(np.linalg.norm(j.T_parent_child[:3, 3]) for j in arm.description.joints) + 0.2
+        c = arm.T_world_base[:3, 3]
+        self.server.initial_camera.look_at = tuple(c + (0.0, 0.0, reach / 3))
+        self.server.initial_camera.position = tuple(c + np.array((1.2, -1.0, 0.8)) * reach)
+
+    def _show_diagnostics(self) -> None:
+        text = self.page.source.diagnostics
+        if text == self._diagnostics:
+            return
+        self._diagnostics = text
+        head = "**errors: showing the last good arm**" if self.page.source.errors and self.page.arm is not None else (
+            "**errors**" if self.page.source.errors else "**warnings**")
+        self._errors.content = f"{head}\n\n```\n{text}\n```" if text else ""
+        self._errors.visible = bool(text)
+
+    def _show_pose(self) -> None:
+        page, arm = self.page, self.page.arm
+        if arm is None:
+            return
+        for name, T in arm.link_poses(page.q).items():
+            if name in self._links:
+                self._links[name].position = T[:3, 3]
+                self._links[name].wxyz = _wxyz(T)
+        for s, x in zip(self._sliders, page.q, strict=True):
+            s.value = round(math.degrees(x), 1)
+        x, y, z = arm.tool0(page.q)
+        self._tool.content = f"tool0 in base_link: ({x:.4f}, {y:.4f}, {z:.4f}) m"
+        self._torques.content = torque_table(arm, page.q)
+        if page.source.trajectory is not None:
+            self._time.value = round(page.t, 3)
+
+    # -- events -------------------------------------------------------------------------------
+
+    def _locked(self, action) -> None:
+        with self.lock:
+            action()
+            self._show_pose()
+
+    def _on_slider(self, i: int):
+        def handler(event) -> None:
+            if event.client is None:  # our own update of the slider
+                return
+            self._locked(lambda: self.page.set_joint(i, math.radians(event.target.value)))
+        return handler
+
+    def _on_pose(self, name: str):
+        return lambda event: self._locked(lambda: self.page.go_pose(name))
+
+    def _on_time(self, event) -> None:
+        if event.client is not None:
+            self._locked(lambda: self.page.seek(event.target.value, stop=True))
+
+    def _go(self, delta: int) -> None:
+        with self.lock:
+            self.page.go(delta)
+            self._rebuild()
+
+    def step(self, dt: float) -> None:
+        """Look at the file and move playback on; called every TICK by run()."""
+        with self.lock:
+            self.page.poll()
+            if self._generation != (self.page.index, self.page.source.generation):
+                self._rebuild()
+            else:
+                self._show_diagnostics()
+                if self.page.tick(dt):
+                    self._show_pose()
+
+
+class PortBusy(OSError):
+    pass
+
+
+def check_port(host: str, port: int) -> None:
+    """viser moves to the next free port when one is taken; the user asked for this one."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind((host, port))
+        except OSError as e:
+            raise PortBusy(f"port {port} on {host} is busy ({e.strerror or e}); choose another with --port") from None
+
+
+def start(page: Page, host: str = "127.0.0.1", port: int = 8080):
+    """A running viser server showing the page; returns (server, view). port 0: any free port."""
+    import viser
+
+    if port:
+        check_port(host, port)
+    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner; modc prints the address itself
+        server = viser.ViserServer(host=host, port=port, label="modc view", verbose=False)
+    server.gui.configure_theme(show_share_button=False, control_width="large")  # the share link would leave the machine
+    if port and server.get_port() != port:  # taken between the check and the bind
+        server.stop()
+        raise PortBusy(f"port {port} on {host} is busy; choose another with --port")
+    return server, View(server, page)
+
+
+def run(view: View, stop: threading.Event | None = None) -> None:
+    """Serve until Ctrl-C (or `stop` is set)."""
+    last = time.monotonic()
+    try:
+        while stop is None or not stop.is_set():
+            time.sleep(TICK)
+            now = time.monotonic()
+            view.step(now - last)
+            last = now
+    except KeyboardInterrupt:
+        pass
+    finally:
+        with contextlib.redirect_stdout(io.StringIO()):
+            view.server.stop()
