@@ -1,9 +1,9 @@
 """The page itself, drawn with viser (a maintained 3D web viewer whose built web client ships in
 its wheel: everything is served from this process, nothing is fetched from the internet).
 
-Scene tree: /world/base sits at T_world_base; under it the cell (obstacles, targets) and one
-node per link, moved as the joints move; the part meshes hang under their link nodes. The GUI
-(right-hand panel) is rebuilt whenever a new arm comes in; values set from Python fire viser's
+Scene tree: /armN (N counts the arms shown) is base_link, at T_world_base; under it the cell
+(obstacles, targets) and one node per link, moved as the joints move; the part meshes hang under
+their link nodes. The GUI (right-hand panel) is rebuilt whenever a new arm comes in; values set from Python fire viser's
 callbacks with no client, which the handlers ignore.
 """
 from __future__ import annotations
@@ -21,6 +21,8 @@ from ..kinematics import transform
 from .arm import OBSTACLE_RGB, TARGET_RADIUS, TARGET_RGB, Arm
 from .page import Page
 
+CAMERA_DIRECTION = np.array((0.62, -0.62, 0.48))  # from the scene's centre: in front, to the right, above
+CAMERA_DISTANCE = 2.2  # bounding-sphere radii, so the scene fills the view beside the control panel
 TICK = 0.05  # s between looks at the file and playback steps: a saved file shows well within a second
 
 
@@ -31,19 +33,22 @@ def _wxyz(T: np.ndarray) -> np.ndarray:
 
 
 def torque_table(arm: Arm, q) -> str:
-    """HTML of the gravity torque of each joint, coloured by level against τnom / τmax."""
+    """HTML of the gravity torque of each joint: a bar of |τ| / τmax coloured by level, with a
+    tick at τnom."""
     rows = []
     for j in arm.torques(q):
-        share = min(abs(j.tau) / j.tau_max, 1.0) * 100
         r, g, b = j.rgb
-        rows.append(
-            f'<tr data-level="{j.level}"><td>{html.escape(j.name)} ({html.escape(j.unit)})</td>'
-            f'<td style="text-align:right">{j.tau:+.2f}</td><td>{j.tau_nom:g} / {j.tau_max:g}</td>'
-            f'<td style="width:35%"><div style="background:#ddd;height:10px"><div style="width:{share:.0f}%;'
-            f'height:10px;background:rgb({r},{g},{b})"></div></div></td></tr>')
+        share = min(abs(j.tau) / j.tau_max, 1.0) * 100
+        bar = (f'<div style="position:relative;background:#ddd;height:10px">'
+               f'<div style="width:{share:.0f}%;height:10px;background:rgb({r},{g},{b})">'
+               f'</div><div style="position:absolute;top:-2px;left:{j.tau_nom / j.tau_max * 100:.0f}%;width:2px;'
+               f'height:14px;background:#444"></div></div>')
+        rows.append(f'<tr data-level="{j.level}"><td>{html.escape(j.name)} ({html.escape(j.unit)})</td>'
+                    f'<td style="text-align:right;padding-right:8px">{round(j.tau, 2) + 0.0:+.2f}</td>'
+                    f'<td>{j.tau_nom:g} / {j.tau_max:g}</td><td style="width:30%">{bar}</td></tr>')
     return ('<table style="width:100%;font-size:0.8em;border-collapse:collapse">'
-            '<tr><th align="left">joint</th><th>τ N·m</th><th>τnom / τmax</th><th></th></tr>'
-            + "".join(rows) + "</table>")
+            '<tr><th align="left">joint</th><th align="right" style="padding-right:8px">τ N·m</th>'
+            '<th align="left">τnom / τmax</th><th></th></tr>' + "".join(rows) + "</table>")
 
 
 class View:
@@ -54,6 +59,7 @@ class View:
         self._generation = (-1, -1)  # (design index, arm generation) on show
         self._diagnostics: str | None = None
         self._nodes: list = []
+        self._shown = 0
         self._gui: list = []
         self._links: dict = {}
         self._sliders: list = []
@@ -71,11 +77,15 @@ class View:
     # -- building -----------------------------------------------------------------------------
 
     def _clear(self) -> None:
-        for h in self._nodes + self._gui:
+        for h in self._nodes[:1] + self._gui:  # the arm's root node takes everything under it along
             h.remove()
         self._nodes, self._gui, self._links, self._sliders = [], [], {}, []
 
     def _rebuild(self) -> None:
+        self._build()
+        self.server.flush()
+
+    def _build(self) -> None:
         page, arm = self.page, self.page.arm
         self._clear()
         self._generation = (page.index, page.source.generation)
@@ -86,11 +96,13 @@ class View:
             return
         scene, gui = self.server.scene, self.server.gui
         T = arm.T_world_base
-        self._nodes.append(scene.add_frame("/world/base", show_axes=False, position=T[:3, 3], wxyz=_wxyz(T)))
+        self._shown += 1
+        base = f"/arm{self._shown}"  # fresh names for every arm: browsers never see a name removed and re-added
+        self._nodes.append(scene.add_frame(base, show_axes=False, position=T[:3, 3], wxyz=_wxyz(T)))
         for ob in arm.robot.obstacles:
             T_ob = transform(ob.origin.xyz, ob.origin.rpy)
             kw = dict(color=OBSTACLE_RGB, opacity=0.6, position=T_ob[:3, 3], wxyz=_wxyz(T_ob))
-            name = f"/world/base/cell/{ob.name}"
+            name = f"{base}/cell/{ob.name}"
             if ob.shape == "box":
                 h = scene.add_box(name, dimensions=tuple(ob.size), **kw)
             elif ob.shape == "sphere":
@@ -99,15 +111,15 @@ class View:
                 h = scene.add_cylinder(name, radius=ob.size[0], height=ob.size[1], **kw)
             self._nodes.append(h)
         for t in arm.robot.targets:
-            name = f"/world/base/targets/{t.name}"
+            name = f"{base}/targets/{t.name}"
             self._nodes.append(scene.add_icosphere(name, radius=TARGET_RADIUS, color=TARGET_RGB, position=tuple(t.xyz)))
             self._nodes.append(scene.add_label(f"{name}/label", t.name, position=(0.0, 0.0, 0.03)))
         for link in arm.description.links:
-            self._links[link.name] = scene.add_frame(f"/world/base/{link.name}", show_axes=link.name == "tool0",
+            self._links[link.name] = scene.add_frame(f"{base}/{link.name}", show_axes=link.name == "tool0",
                                                      axes_length=0.05, axes_radius=0.003)
             self._nodes.append(self._links[link.name])
         for s in arm.shapes():
-            name = f"/world/base/{s.link}/{s.name}"
+            name = f"{base}/{s.link}/{s.name}"
             self._nodes.append(scene.add_mesh_simple(name, s.vertices, s.faces, color=s.rgb))
         self._camera(arm)
 
@@ -141,13 +153,17 @@ class View:
                 run.on_click(lambda e: self._locked(page.play))
                 stop.on_click(lambda e: self._locked(page.pause))
                 self._time.on_update(self._on_time)
-        self._show_pose()
+        self._move()
 
     def _camera(self, arm: Arm) -> None:
-        reach = sum(np.linalg.norm(j.T_parent_child[:3, 3]) for j in arm.description.joints) + 0.2
-        c = arm.T_world_base[:3, 3]
-        self.server.initial_camera.look_at = tuple(c + (0.0, 0.0, reach / 3))
-        self.server.initial_camera.position = tuple(c + np.array((1.2, -1.0, 0.8)) * reach)
+        """New browsers look at the arm at home, its cell and targets (what `modc render` frames)."""
+        from ..sim.scene import extent_points
+
+        pts = extent_points(arm.robot, arm.poses[0][1], arm.T_world_base)
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        centre, radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.2)
+        self.server.initial_camera.look_at = tuple(centre)
+        self.server.initial_camera.position = tuple(centre + CAMERA_DIRECTION * CAMERA_DISTANCE * radius)
 
     def _show_diagnostics(self) -> None:
         text = self.page.source.diagnostics
@@ -158,8 +174,14 @@ class View:
             "**errors**" if self.page.source.errors else "**warnings**")
         self._errors.content = f"{head}\n\n```\n{text}\n```" if text else ""
         self._errors.visible = bool(text)
+        self.server.flush()
 
     def _show_pose(self) -> None:
+        with self.server.atomic():  # every link moves in the same frame
+            self._move()
+        self.server.flush()
+
+    def _move(self) -> None:
         page, arm = self.page, self.page.arm
         if arm is None:
             return
