@@ -21,8 +21,7 @@ from ..kinematics import transform
 from .arm import OBSTACLE_RGB, TARGET_RADIUS, TARGET_RGB, Arm
 from .page import Page
 
-CAMERA_DIRECTION = np.array((0.62, -0.62, 0.48))  # from the scene's centre: in front, to the right, above
-CAMERA_DISTANCE = 2.2  # bounding-sphere radii, so the scene fills the view beside the control panel
+CAMERA_DISTANCE = 2.0  # bounding-sphere radii, so the scene fills the view beside the control panel
 TICK = 0.05  # s between looks at the file and playback steps: a saved file shows well within a second
 
 
@@ -71,7 +70,7 @@ class View:
             prev, nxt = gui.add_button("◀ previous design"), gui.add_button("next design ▶")
             prev.on_click(lambda e: self._go(-1))
             nxt.on_click(lambda e: self._go(+1))
-        self._errors = gui.add_markdown("", visible=False)
+        self._errors = gui.add_html("", visible=False)
         self._rebuild()
 
     # -- building -----------------------------------------------------------------------------
@@ -156,23 +155,28 @@ class View:
         self._move()
 
     def _camera(self, arm: Arm) -> None:
-        """New browsers look at the arm at home, its cell and targets (what `modc render` frames)."""
+        """New browsers look at what `modc render` frames (the arm at home, its cell and targets)
+        from render's canonical view (front left, above, as RViz's default orbit camera)."""
+        from ..sim.render import VIEWS
         from ..sim.scene import extent_points
 
         pts = extent_points(arm.robot, arm.poses[0][1], arm.T_world_base)
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         centre, radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.2)
+        az, el = (math.radians(a) for a in VIEWS[0])
+        direction = np.array((math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)))
         self.server.initial_camera.look_at = tuple(centre)
-        self.server.initial_camera.position = tuple(centre + CAMERA_DIRECTION * CAMERA_DISTANCE * radius)
+        self.server.initial_camera.position = tuple(centre + direction * CAMERA_DISTANCE * radius)
 
     def _show_diagnostics(self) -> None:
         text = self.page.source.diagnostics
         if text == self._diagnostics:
             return
         self._diagnostics = text
-        head = "**errors: showing the last good arm**" if self.page.source.errors and self.page.arm is not None else (
-            "**errors**" if self.page.source.errors else "**warnings**")
-        self._errors.content = f"{head}\n\n```\n{text}\n```" if text else ""
+        errors, arm = self.page.source.errors, self.page.arm
+        head = "errors: showing the last good arm" if errors and arm is not None else "errors" if errors else "warnings"
+        self._errors.content = (f'<b style="color:#b42318">{head}</b><pre style="white-space:pre-wrap;font-size:0.72em;'
+                                f'margin:4px 0">{html.escape(text)}</pre>') if text else ""
         self._errors.visible = bool(text)
         self.server.flush()
 
