@@ -6,6 +6,7 @@ installed (CI: apt-get install chromium)."""
 from __future__ import annotations
 
 import base64
+import contextlib
 import io
 import itertools
 import json
@@ -81,8 +82,9 @@ def _wait(cond, timeout: float, what: str, every: float = 0.2):
     raise AssertionError(f"timed out waiting for {what}")
 
 
-@pytest.fixture
-def browser():
+@contextlib.contextmanager
+def chromium():
+    """Headless Chromium with a fresh profile, driven over DevTools; stopped and removed after."""
     profile = tempfile.mkdtemp(prefix="modc-view-chromium-")
     proc = subprocess.Popen([BROWSER, *FLAGS, f"--user-data-dir={profile}", "about:blank"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -104,6 +106,12 @@ def browser():
         except subprocess.TimeoutExpired:
             proc.kill()
         shutil.rmtree(profile, ignore_errors=True)
+
+
+@pytest.fixture
+def browser():
+    with chromium() as tools:
+        yield tools
 
 
 def arm_pixels(img: np.ndarray) -> int:
@@ -207,6 +215,79 @@ def test_saving_the_file_updates_the_page_within_a_second(browser, tmp_path):
         print(f"save -> sent: diagnostics {sent_error:.2f} s, new arm {sent_arm:.2f} s; "
               f"save -> in the page: diagnostics {shown_error:.2f} s, new arm {shown_arm:.2f} s")
         assert sent_error < 1.0 and sent_arm < 1.0, (sent_error, sent_arm)
+    finally:
+        stop.set()
+        loop.join(timeout=10)
+
+
+def _settle(browser, server) -> None:
+    """The page is connected and its panel laid out (the torque table is the last part to come),
+    so buttons stay where a click is aimed."""
+    _wait(lambda: server.get_clients() and "τnom" in browser.js("document.body.textContent"), 60, "the panel")
+    time.sleep(1.0)
+
+
+def _click(browser, label: str) -> None:
+    """A real click on the button whose text is label (the mouse at its centre)."""
+    box = browser.js(f"""(() => {{ const b = [...document.querySelectorAll('button')]
+        .find(b => b.textContent.trim() === {json.dumps(label)});
+        if (!b) return null;
+        const r = b.getBoundingClientRect(); return [r.x + r.width / 2, r.y + r.height / 2]; }})()""")
+    assert box, f"no button {label!r} in the page"
+    for kind in ("mousePressed", "mouseReleased"):
+        browser.call("Input.dispatchMouseEvent", type=kind, x=box[0], y=box[1], button="left", clickCount=1)
+
+
+def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
+    import math
+    import threading
+
+    from modc.sim.trajectory import Trajectory
+    from modc.view.page import Ranking
+    from modc.view.server import run
+
+    d = tmp_path / "designs"
+    d.mkdir()
+    (d / "a.mod").write_text("robot a {\n    chain H1 - L4(port=45deg) - L1\n    pose ready (30, -40, 60) deg\n}\n",
+                             encoding="utf-8")
+    (d / "b.mod").write_text("robot b {\n    chain H1 - L4(port=45deg) - L3 - L1\n}\n", encoding="utf-8")
+    ranking = {"designs": [{"rank": 1, "file": "a.mod"}, {"rank": 2, "file": "b.mod"}]}
+    (d / "ranking.json").write_text(json.dumps(ranking), encoding="utf-8")
+    page = Page.for_ranking(Ranking(d / "ranking.json"))
+    server, view = start(page, port=0)
+    stop = threading.Event()
+    loop = threading.Thread(target=run, args=(view, stop), daemon=True)
+    loop.start()
+    try:
+        browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
+        _wait(lambda: browser.js(SLIDERS) == 3, 60, "design 1's 3 sliders")
+        _settle(browser, server)
+        _wait(lambda: _click(browser, "ready") or page.q[0] == pytest.approx(math.radians(30)), 20, "the ready pose")
+        _wait(lambda: browser.js("[...document.querySelectorAll('input')].map(i => i.value).includes('30')"), 30,
+              "the sliders to show the pose")
+        _click(browser, "next design ▶")
+        _wait(lambda: browser.js(SLIDERS) == 4 and page.index == 1, 60, "design 2's 4 sliders")
+        assert "design 2 of 2" in browser.js("document.body.textContent")
+        _click(browser, "◀ previous design")
+        _wait(lambda: browser.js(SLIDERS) == 3 and page.index == 0, 60, "design 1 again")
+    finally:
+        stop.set()
+        loop.join(timeout=10)
+
+    q = ((0.0, 0.0, 0.0), (0.3, 0.2, 0.1), (0.6, 0.4, 0.2))
+    traj = Trajectory(("joint_1", "joint_2", "joint_3"), (0.0, 0.5, 1.0), q)
+    page = Page([Source(FARM, traj=traj)])
+    server, view = start(page, port=0)
+    stop = threading.Event()
+    loop = threading.Thread(target=run, args=(view, stop), daemon=True)
+    loop.start()
+    try:
+        browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
+        _wait(lambda: browser.js(SLIDERS) == 4, 60, "3 joint sliders and the time slider")
+        _settle(browser, server)
+        _wait(lambda: page.t > 0 or _click(browser, "play"), 20, "playback to start")
+        _wait(lambda: not page.playing, 20, "playback to run to the end")
+        assert page.t == 1.0 and page.q == pytest.approx((0.6, 0.4, 0.2))
     finally:
         stop.set()
         loop.join(timeout=10)
