@@ -307,3 +307,35 @@ def test_ctrl_c_stops_cleanly():
             p.kill()
     assert p.returncode == 0, err
     assert "Traceback" not in err and "stopped" in out
+
+
+def test_torque_table_colours_each_joint_by_level(tmp_path):
+    from modc.view.arm import LEVEL_RGB
+    from modc.view.server import torque_table
+
+    f = tmp_path / "heavy.mod"
+    f.write_text("robot heavy {\n    chain H1 - H4(pivot=-90deg) - L3\n    payload 5 kg\n}\n", encoding="utf-8")
+    arm = Arm(check_file(f).design.robots[0])
+    table = torque_table(arm, (0.0, math.pi / 2, 0.0))
+    rows = table.split("<tr data-level=")[1:]
+    assert [r.split('"')[1] for r in rows] == ["ok", "over-nominal", "over-peak"]
+    for row, level in zip(rows, ("ok", "over-nominal", "over-peak"), strict=True):
+        assert "background:rgb({},{},{})".format(*LEVEL_RGB[level]) in row
+    assert "12 / 30.5" in rows[0] and "3.6 / 6.8" in rows[2]  # τnom / τmax of the H and L actuators
+
+
+def test_user_text_reaches_the_page_escaped(tmp_path):
+    from modc.view.server import start
+
+    ranking = _ranking(tmp_path)
+    doc = json.loads(ranking.read_text(encoding="utf-8"))
+    doc["designs"][1]["chain"] = "<img src=x onerror=alert(1)>"
+    ranking.write_text(json.dumps(doc), encoding="utf-8")
+    server, view = start(Page.for_ranking(Ranking(ranking)), port=0)
+    try:
+        assert "&lt;img src=x" in view._title.content and "<img" not in view._title.content
+        _write(ranking.parent / "d1.mod", GOOD.replace("robot arm {", "robot arm { <b>"))
+        view.step(0.05)
+        assert "&lt;b&gt;" in view._errors.content and "<b>" not in view._errors.content.split("</b>", 1)[1]
+    finally:
+        server.stop()

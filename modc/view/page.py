@@ -56,7 +56,8 @@ class Source:
         self._stamp = _stamp(self.path)
         try:
             checked = check_file(self.path, self.library)
-            robot = choose_robot(checked.design, self.robot_name, say="--robot NAME") if checked.ok else None
+            say = '--robot NAME, or "robot" in the trajectory file' if self.traj is not None else "--robot NAME"
+            robot = choose_robot(checked.design, self.robot_name, say=say) if checked.ok else None
         except (InputError, RobotChoiceError) as e:
             if strict:
                 raise

@@ -65,7 +65,7 @@ class View:
         gui = server.gui
         server.scene.set_up_direction("+z")
         server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1, section_size=0.5)
-        self._title = gui.add_markdown("")
+        self._title = gui.add_html("")  # HTML, escaped: file names and ranking.json text are the user's
         if len(page.sources) > 1:
             prev, nxt = gui.add_button("◀ previous design"), gui.add_button("next design ▶")
             prev.on_click(lambda e: self._go(-1))
@@ -88,8 +88,9 @@ class View:
         page, arm = self.page, self.page.arm
         self._clear()
         self._generation = (page.index, page.source.generation)
-        self._title.content = f"**{html.escape(page.caption)}**" + (
-            f"  \nrobot `{arm.robot.name}`: {arm.robot.sequence}" if arm is not None else "  \nno good arm yet")
+        who = (f"robot <code>{html.escape(arm.robot.name)}</code>: {html.escape(arm.robot.sequence)}" if arm is not None
+               else "no good arm yet")
+        self._title.content = f"<b>{html.escape(page.caption)}</b><br>{who}"
         self._show_diagnostics()
         if arm is None:
             return
