@@ -22,9 +22,9 @@ def view_cmd(
     Saving the file updates the page; an error shows its diagnostics and keeps the last good arm.
     Ctrl-C stops it."""
     from ..view.page import Page, Ranking, Source, ViewError, read_trajectory
-    from ..view.server import PortBusy, run, start
+    from ..view.server import ServeError, run, start
 
-    with usage_errors("view", (ViewError, PortBusy)):
+    with usage_errors("view", (ViewError, ServeError)):
         if file.endswith(".json"):
             if traj is not None:
                 raise ViewError("--traj plays on one file, not on a ranking")

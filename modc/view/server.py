@@ -240,8 +240,8 @@ class View:
                     self._show_pose()
 
 
-class PortBusy(OSError):
-    pass
+class ServeError(OSError):
+    """The page cannot be served: the port is taken, or viser is not installed (exit 2)."""
 
 
 def check_port(host: str, port: int) -> None:
@@ -253,12 +253,15 @@ def check_port(host: str, port: int) -> None:
         try:
             s.bind((host, port))
         except OSError as e:
-            raise PortBusy(f"port {port} on {host} is busy ({e.strerror or e}); choose another with --port") from None
+            raise ServeError(f"port {port} on {host} is busy ({e.strerror or e}); choose another with --port") from None
 
 
 def start(page: Page, host: str = "127.0.0.1", port: int = 8080):
     """A running viser server showing the page; returns (server, view). port 0: any free port."""
-    import viser
+    try:
+        import viser
+    except ImportError:
+        raise ServeError("modc view needs the viser package: pip install viser") from None
 
     if port:
         check_port(host, port)
@@ -267,7 +270,7 @@ def start(page: Page, host: str = "127.0.0.1", port: int = 8080):
     server.gui.configure_theme(show_share_button=False, control_width="large")  # the share link would leave the machine
     if port and server.get_port() != port:  # taken between the check and the bind
         server.stop()
-        raise PortBusy(f"port {port} on {host} is busy; choose another with --port")
+        raise ServeError(f"port {port} on {host} is busy; choose another with --port")
     return server, View(server, page)
 
 
