@@ -262,7 +262,7 @@ def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
         browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
         _wait(lambda: browser.js(SLIDERS) == 3, 60, "design 1's 3 sliders")
         _settle(browser, server)
-        _wait(lambda: _click(browser, "ready") or page.q[0] == pytest.approx(math.radians(30)), 20, "the ready pose")
+        _wait(lambda: _click(browser, "ready") or page.q[0] == pytest.approx(math.radians(30)), 60, "the ready pose")
         _wait(lambda: browser.js("[...document.querySelectorAll('input')].map(i => i.value).includes('30')"), 30,
               "the sliders to show the pose")
         _click(browser, "next design ▶")
@@ -285,8 +285,8 @@ def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
         browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
         _wait(lambda: browser.js(SLIDERS) == 4, 60, "3 joint sliders and the time slider")
         _settle(browser, server)
-        _wait(lambda: page.t > 0 or _click(browser, "play"), 20, "playback to start")
-        _wait(lambda: not page.playing, 20, "playback to run to the end")
+        _wait(lambda: page.t > 0 or _click(browser, "play"), 60, "playback to start")
+        _wait(lambda: not page.playing, 60, "playback to run to the end")
         assert page.t == 1.0 and page.q == pytest.approx((0.6, 0.4, 0.2))
     finally:
         stop.set()

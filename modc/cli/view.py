@@ -8,6 +8,18 @@ import typer
 from .app import EXIT_OK, LibraryOpt, _err, app, usage_errors
 
 
+def _open_browser(url: str) -> bool:
+    """Open the page in the user's browser. On Linux without a display, Python's webbrowser would
+    fall back to a text browser that takes over the terminal: don't try."""
+    import os
+    import sys
+    import webbrowser
+
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        return False
+    return webbrowser.open(url)
+
+
 @app.command("view")
 def view_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form), or the ranking.json of `modc design`")],
@@ -38,10 +50,8 @@ def view_cmd(
         server, view = start(page, port=port)
     url = f"http://127.0.0.1:{server.get_port()}/"
     print(f"modc view: {url}  (Ctrl-C stops)", flush=True)
-    if not no_browser:
-        import webbrowser
-
-        webbrowser.open(url)
+    if not no_browser and not _open_browser(url):
+        _err("modc view: no display to open a browser on; open the address above yourself")
     run(view)
     print("modc view: stopped")
     raise typer.Exit(EXIT_OK)
