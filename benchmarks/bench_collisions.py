@@ -82,7 +82,6 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     cpu = pin_one_core()
-    from modc.backends import srdf
     from modc.physical import collisions
 
     fast_runs, naive_runs = (3, 1) if args.quick else (9, 3)
@@ -93,9 +92,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'example/robot':<26}{'dof':>4}{'load':>8}{'fast wall':>11}{'fast cpu':>10}{'naive wall':>12}{'naive cpu':>11}"
           f"{'ratio':>8}{'exact':>8}{'same':>6}", file=out)
     for stem, b, r in _robots(args.all):
-        files = srdf.robot_files(b, r)
-        rel = f"urdf/{r.file_stem}.urdf"
-        load, geo = _time(lambda: collisions.load(files, rel), fast_runs)
+        load, geo = _time(lambda: collisions.geometry(b.description(r)), fast_runs)
         fast, mf = _time(lambda: collisions.compute(geo, args.samples, args.seed), fast_runs)
         naive, mn = _time(lambda: collisions.compute_naive(geo, args.samples, args.seed), naive_runs)
         same = mf.disabled == mn.disabled and mf.enabled == mn.enabled

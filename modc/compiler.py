@@ -72,7 +72,7 @@ def check_text(text: str, path: str = "<string>", library: str | None = None, **
     ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
     design = run_all(design, ctx)
-    return Checked(design, ctx.diagnostics, {path: text}, tree)
+    return Checked(design, ctx.diagnostics, {**ctx.sources, path: text}, tree)
 
 
 def check_file(path: str | os.PathLike, library: str | None = None, **options) -> Checked:

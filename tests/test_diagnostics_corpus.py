@@ -14,14 +14,17 @@ Expectation comments (``#`` comments in all three formats):
                                              unclosed-block, reported where the file ends (one
                                              line past a final newline), and in CSV files, whose
                                              data lines cannot carry comments
+    # expect-in FILE:N: SEVERITY[code], ...  reported on line N of another file, named relative to
+                                             the case (a library fixture the case refers to)
     # corpus-xfail: REASON                   the case is a known bug: the tests comparing
                                              expectations are xfail(strict=False)
     # corpus-analyses: torque                check with these analyses on (as compile and
                                              `modc check` do; `modc lint` does not run them)
 
-"Reported on line L" means ``diagnostic.span.line == L``. Each case is checked the way the
-product checks it (``check_file`` for .mod/.yaml, ``convert_table`` for .csv) and the set of
-(line, severity, code) reported must equal the set expected: nothing missing, nothing extra.
+"Reported on line L" means ``diagnostic.span.line == L`` (and, for ``expect-in``, ``span.file`` is
+FILE). Each case is checked the way the product checks it (``check_file`` for .mod/.yaml,
+``convert_table`` for .csv) and the set of (line, severity, code) reported must equal the set
+expected: nothing missing, nothing extra.
 A file ``check_file`` rejects with ``InputError`` (bad-encoding) counts as reporting that one
 diagnostic. Lines are counted on the raw bytes decoded with replacement characters, so a corpus
 file need not be valid UTF-8. The same expectations are checked through the command line
@@ -36,6 +39,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import re
 import subprocess
 import sys
@@ -52,7 +56,7 @@ CORPUS_DIR = HERE / "diagnostics"
 CASES = sorted([*CORPUS_DIR.glob("*.mod"), *CORPUS_DIR.glob("*.yaml"), *CORPUS_DIR.glob("*.csv")])
 
 SEVERITIES = ("error", "warning", "note")
-_EXPECT = re.compile(r"#\s*expect(?:-line\s+(?P<n>\d+))?\s*:(?P<items>[^#]*)")
+_EXPECT = re.compile(r"#\s*expect(?:-line\s+(?P<n>\d+)|-in\s+(?P<file>[^\s:]+):(?P<in>\d+))?\s*:(?P<items>[^#]*)")
 _ITEM = re.compile(r"^\s*(?P<sev>[a-z]+)\[(?P<code>[a-z0-9-]+)\]\s*$")
 _XFAIL = re.compile(r"#\s*corpus-xfail:\s*(?P<reason>.+)")
 _ANALYSES = re.compile(r"#\s*corpus-analyses:\s*(?P<names>[a-z, -]+)")
@@ -80,12 +84,15 @@ def source_text(path: Path) -> str:
     return path.read_bytes().decode("utf-8-sig", errors="replace")
 
 
-def expectations(path: Path) -> set[tuple[int, str, str]]:
-    """{(line, severity, code)} written in the file's `# expect` comments."""
+def expectations(path: Path) -> set[tuple[int | str, str, str]]:
+    """{(line, severity, code)} written in the file's `# expect` comments; line is "FILE:N" for
+    a line of another file (expect-in)."""
     out = set()
     for i, line in enumerate(source_text(path).split("\n"), start=1):
         for m in _EXPECT.finditer(line):
-            at = int(m.group("n")) if m.group("n") else i
+            at: int | str = int(m.group("n")) if m.group("n") else i
+            if m.group("file"):
+                at = f"{m.group('file')}:{m.group('in')}"
             for item in m.group("items").split(","):
                 im = _ITEM.match(item)
                 assert im, f"{path.name}:{i}: malformed expectation {item!r} (write severity[code])"
@@ -142,12 +149,19 @@ def diagnostics_of(path: Path) -> list[Diagnostic]:
         raise
 
 
-def reported(diags: list[Diagnostic]) -> set[tuple[int, str, str]]:
-    return {(d.span.line, d.severity.value, d.code) for d in diags}
+def where(path: Path, file: str, line: int) -> int | str:
+    """A reported line as expectations write it: N in the case itself, "FILE:N" in another file."""
+    if file == str(path) or not Path(file).is_file():
+        return line
+    return f"{Path(os.path.relpath(file, path.parent)).as_posix()}:{line}"
+
+
+def reported(diags: list[Diagnostic], path: Path) -> set[tuple[int | str, str, str]]:
+    return {(where(path, d.span.file, d.span.line), d.severity.value, d.code) for d in diags}
 
 
 def _show(items) -> str:
-    return "\n".join(f"    line {ln}: {sev}[{code}]" for ln, sev, code in sorted(items)) or "    (none)"
+    return "\n".join(f"    line {ln}: {sev}[{code}]" for ln, sev, code in sorted(items, key=str)) or "    (none)"
 
 
 # --- the corpus ----------------------------------------------------------------------------------
@@ -160,7 +174,7 @@ def test_corpus_is_not_empty():
 def test_corpus(path: Path):
     expected = expectations(path)
     assert expected, f"{path.name} has no `# expect` comment"
-    got = reported(run_case(path))
+    got = reported(run_case(path), path)
     missing, extra = expected - got, got - expected
     assert not missing and not extra, (
         f"{path.name}:\n  missing (expected, not reported):\n{_show(missing)}\n"
@@ -242,7 +256,10 @@ def _check_each(path: Path, check) -> None:
     assert diags
     for d in diags:
         try:
-            check(d, text, str(path))
+            if where(path, d.span.file, d.span.line) == d.span.line:
+                check(d, text, str(path))
+            else:  # a diagnostic inside another file (a library): checked against that file
+                check(d, source_text(Path(d.span.file)), d.span.file)
         except AssertionError:
             if (path.suffix, d.code) in SPAN_BUGS:
                 pytest.xfail(SPAN_BUGS[path.suffix, d.code])
@@ -267,8 +284,8 @@ OFFSET_BUGS: dict = {}
 def test_corpus_json_offsets_match_lines(path: Path):
     """JSON output carries character offsets (for editors); they agree with line and column.
     (Not for CSV tables: their diagnostics are only shown as text, by dh2mod.)"""
-    text = source_text(path)
     for item in json.loads(render_json(diagnostics_of(path)))["diagnostics"]:
+        text = source_text(path if where(path, item["file"], 1) == 1 else Path(item["file"]))
         start = item["start"]
         assert 0 <= start <= len(text), item
         if item["code"] == "bad-encoding":
@@ -329,7 +346,7 @@ def test_corpus_through_the_command_line(path: Path, capsys):
         return
     rc, out, err = run_lint(capsys, str(path), "--format", "json")
     assert "Traceback" not in err
-    got = {(d["line"], d["severity"], d["code"]) for d in json.loads(out)["diagnostics"]}
+    got = {(where(path, d["file"], d["line"]), d["severity"], d["code"]) for d in json.loads(out)["diagnostics"]}
     lint_expected = {e for e in expected if e[2] not in ANALYSIS_CODES}
     assert got == lint_expected
     assert rc == _exit_code_for(path, lint_expected)

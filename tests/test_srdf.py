@@ -253,7 +253,7 @@ def test_fast_and_naive_classifications_agree():
         c = check_file(ROOT / "examples" / f"{name}.mod")
         b = _build(c)
         for r in _robots(b):
-            geo = collisions.load(srdf.robot_files(b, r), f"urdf/{r.file_stem}.urdf")
+            geo = collisions.geometry(b.description(r))
             fast = collisions.compute(geo, samples=1500, seed=3)
             naive = collisions.compute_naive(geo, samples=1500, seed=3)
             assert fast.disabled == naive.disabled and fast.enabled == naive.enabled, name
@@ -268,7 +268,7 @@ def test_batch_forward_kinematics_matches_pinocchio():
     c = check_file(ROOT / "examples" / "example_b.mod")
     b = _build(c)
     (r,) = _robots(b)
-    geo = collisions.load(srdf.robot_files(b, r), f"urdf/{r.file_stem}.urdf")
+    geo = collisions.geometry(b.description(r))
     Q = np.random.default_rng(RESEED).uniform(-3, 3, size=(50, geo.model.nq))
     R, p = collisions.batch_placements(geo.model, Q)
     data = geo.model.createData()

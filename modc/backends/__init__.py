@@ -38,6 +38,7 @@ def load_all() -> dict[str, Backend]:
     from . import srdf  # noqa: F401
     from . import ros  # noqa: F401
     from . import xacro  # noqa: F401
+    from . import mjcf  # noqa: F401
     from . import report  # noqa: F401
 
     return BACKENDS

@@ -5,7 +5,7 @@ from ..physical.meshes import stl_bytes
 from . import Build, register
 
 
-@register("meshes", "binary STL meshes of the parts: meshes/*.stl", heavy=True)
+@register("meshes", "binary STL meshes of the parts: meshes/*.stl")
 def emit(build: Build):
     parts = {}
     for r in build.design.robots:

@@ -8,7 +8,8 @@ description of the URDF the urdf backend emits.
     group_state     "home" (Robot.home: the pose named home, else MoveIt's default values), then every
                     other named pose
     disable_collisions   the self-collision matrix of modc.physical.collisions: seeded and
-                    deterministic, computed on the emitted URDF and meshes with pinocchio + coal
+                    deterministic, computed with pinocchio + coal on the collision meshes the URDF references
+                    (built in memory from the same Description)
 
 Options, read from the Build when present (the CLI sets them), else the defaults:
     build.collision_samples   random configurations for Never/Always (default 10,000; 0 = only
@@ -24,7 +25,7 @@ from ..model import Robot, Transform
 from ..physical import collisions
 from . import Build, register
 from .format import num
-from .templates import render
+from .templates import comment, render
 
 GROUP = "arm"
 TOOL_GROUP = "tool"
@@ -45,28 +46,13 @@ def options(build: Build) -> tuple[int, int]:
     return samples, seed
 
 
-def robot_files(build: Build, robot: Robot) -> dict[str, str | bytes]:
-    """The emitted URDF and the meshes it references, as they appear in the output tree
-    (taken from earlier backends' output when present, else generated the same way)."""
-    from ..physical.meshes import stl_bytes
-    from .urdf import urdf_text
-
-    rel = f"urdf/{robot.file_stem}.urdf"
-    files: dict[str, str | bytes] = {rel: build.files.get(rel) or urdf_text(build, robot)}
-    for name, part in build.description(robot).parts.items():
-        mesh = f"meshes/{name}.stl"
-        files[mesh] = build.files.get(mesh) or stl_bytes(part)
-    return files
-
-
 def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
     """The robot's self-collision matrix, computed once per build (emit and warnings share it)."""
     samples, seed = options(build)
     cache = build.__dict__.setdefault(_CACHE, {})
     key = (robot.name, samples, seed)
     if key not in cache:
-        files = robot_files(build, robot)
-        cache[key] = collisions.cached_compute(files, f"urdf/{robot.file_stem}.urdf", samples, seed)
+        cache[key] = collisions.cached_matrix(build.description(robot), samples, seed)
     return cache[key]
 
 
@@ -87,13 +73,6 @@ def warnings(build: Build) -> list[str]:
     return [w for r in build.design.robots for w in robot_warnings(r, collision_matrix(build, r))]
 
 
-def _comment(text: str) -> str:
-    """XML comments may not contain '--' or end with '-'."""
-    while "--" in text:
-        text = text.replace("--", "- -")
-    return text.rstrip("-")
-
-
 def has_tool(robot: Robot) -> bool:
     return robot.tool != Transform() or robot.payload is not None
 
@@ -109,10 +88,10 @@ def context(build: Build, robot: Robot) -> dict:
         links = [TIP_LINK] + [j.child for j in desc.joints if j.parent == TIP_LINK]
         tool = {"group": TOOL_GROUP, "links": links, "parent_link": parent}
     return {
-        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": _comment(build.source_name),
-        "library": robot.library.name, "version": __version__,
+        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
+        "library": comment(robot.library.name), "version": __version__,
         "samples": matrix.samples, "seed": matrix.seed, "always_percent": collisions.ALWAYS_PERCENT,
-        "warnings": [_comment(w) for w in robot_warnings(robot, matrix)],
+        "warnings": [comment(w) for w in robot_warnings(robot, matrix)],
         "group": GROUP, "base_link": BASE_LINK, "tip_link": TIP_LINK, "tool": tool,
         "states": [{"name": name, "joints": [{"name": j, "value": num(v)} for j, v in zip(joints, q, strict=True)]}
                    for name, q in states],

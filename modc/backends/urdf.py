@@ -6,7 +6,7 @@ from ..kinematics import matrix_rpy
 from ..physical.assembly import Description
 from . import Build, register
 from .format import num, vec
-from .templates import render
+from .templates import comment, render
 
 # name -> RGBA; parts pick a material by role
 MATERIALS = {
@@ -27,11 +27,11 @@ def context(desc: Description, robot, source: str, mesh_prefix: str) -> dict:
     for link in desc.links:
         inertial = None
         if link.inertial is not None:
-            I = link.inertial.inertia
+            inertia = link.inertial.inertia
             inertial = {
                 "mass": num(link.inertial.mass), "xyz": vec(link.inertial.com),
-                "ixx": num(I[0, 0]), "ixy": num(I[0, 1]), "ixz": num(I[0, 2]),
-                "iyy": num(I[1, 1]), "iyz": num(I[1, 2]), "izz": num(I[2, 2]),
+                "ixx": num(inertia[0, 0]), "ixy": num(inertia[0, 1]), "ixz": num(inertia[0, 2]),
+                "iyy": num(inertia[1, 1]), "iyz": num(inertia[1, 2]), "izz": num(inertia[2, 2]),
             }
         visuals = [{
             **_origin(v.T_link_part), "mesh": f"{mesh_prefix}{v.part.mesh}.stl",
@@ -45,11 +45,12 @@ def context(desc: Description, robot, source: str, mesh_prefix: str) -> dict:
         joints.append({
             "name": j.name, "type": j.kind, "parent": j.parent, "child": j.child, **_origin(j.T_parent_child),
             "limit": None if lim is None else {
-                "lower": num(lim.lower), "upper": num(lim.upper), "effort": num(lim.effort), "velocity": num(lim.velocity)},
+                "lower": num(lim.lower), "upper": num(lim.upper), "effort": num(lim.effort),
+                "velocity": num(lim.velocity)},
         })
     return {
-        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": source,
-        "library": robot.library.name, "version": __version__,
+        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(source),
+        "library": comment(robot.library.name), "version": __version__,
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()],
         "links": links, "joints": joints,
     }

@@ -18,11 +18,13 @@ function of its length and port twist (box formulas below, checked against parts
 """
 from __future__ import annotations
 
+import keyword
 import math
 import re
 from dataclasses import dataclass
 
 import numpy as np
+from markupsafe import Markup
 
 from .. import __version__
 from ..kinematics import A_J, matrix_rpy
@@ -32,7 +34,7 @@ from ..physical.inertia import Inertial, combine, part_inertial
 from ..physical.parts import Part, Primitive, unit_parts
 from . import Build, register
 from .format import num, vec
-from .templates import render
+from .templates import comment, render
 from .urdf import MATERIALS
 
 LIBRARY_FILE = "modc_modules.xacro"
@@ -89,19 +91,25 @@ def _ident(name: str) -> str:
     return s if s and not s[0].isdigit() else f"lib_{s}"
 
 
-def _comment(text: str) -> str:
-    """Text safe inside an XML comment, in ASCII (xacro opens files in the locale's encoding)."""
-    text = text.encode("ascii", "backslashreplace").decode("ascii")
-    return re.sub(r"-{2,}", "-", text).strip("-")
-
+# Library data reaches xacro expressions (${...}), which xacro evaluates as Python. Strings go in
+# only through _str and keys only through _key, which refuse anything that could end the literal or
+# the expression; the library schema (modc.names) already keeps such values out, these make it hold
+# by construction. Their results are Markup: trusted xacro source that autoescape leaves as is.
 
 def _str(s: str) -> str:
-    if _UNSAFE.search(s) or "'" in s:
+    if _UNSAFE.search(s) or "'" in s or not s.isprintable():
         raise ValueError(f"cannot place {s!r} in a xacro expression")
     return f"'{s}'"
 
 
-def _pydict(d: dict) -> str:
+def _key(k: str) -> str:
+    """A keyword argument of dict(...): an ASCII identifier that is not a Python keyword."""
+    if not (k.isascii() and k.isidentifier()) or keyword.iskeyword(k):
+        raise ValueError(f"cannot use {k!r} as a key in a xacro expression")
+    return k
+
+
+def _pydict(d: dict) -> Markup:
     """A Python dict(...) expression (xacro expressions may not contain braces)."""
     items = []
     for k, v in d.items():
@@ -111,8 +119,17 @@ def _pydict(d: dict) -> str:
             v = _str(v)
         else:
             v = num(v)
-        items.append(f"{k}={v}")
-    return "dict(" + ", ".join(items) + ")"
+        items.append(f"{_key(k)}={v}")
+    return Markup("dict(" + ", ".join(items) + ")")
+
+
+def _trusted(value):
+    """modc's own xacro source (LINK_MODULE) as Markup, so autoescape keeps its quotes."""
+    if isinstance(value, dict):
+        return {k: _trusted(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return type(value)(_trusted(v) for v in value)
+    return Markup(value) if isinstance(value, str) else value
 
 
 def _inertial(i: Inertial) -> dict:
@@ -237,7 +254,7 @@ def library_units(lib: Library) -> list[dict]:
     for v in lib.variants:
         for k in sorted(lib.units):
             data = unit_data(lib, v, k)
-            units.append({"name": f"{v}{k}", "fields": [(key, _pydict(val) if isinstance(val, dict) else num(val))
+            units.append({"name": _key(f"{v}{k}"), "fields": [(key, _pydict(val) if isinstance(val, dict) else num(val))
                                                          for key, val in data.items()]})
     if len(_UNITS_CACHE) >= _UNITS_CACHE_SIZE:
         _UNITS_CACHE.clear()
@@ -256,17 +273,17 @@ def library_context(entry: LibraryEntry) -> dict:
             "twist1": vec((t.x01, 0.0, t.z01)), "joint": vec((0.0, 0.0, t.z12)),
             "x23": num(t.x23), "units": ", ".join(f"{v}{k}" for v in lib.variants),
         })
-    return {"ident": entry.ident, "name": lib.name, "description": _comment(lib.description),
+    return {"ident": entry.ident, "name": comment(lib.name), "description": comment(lib.description),
             "units_property": f"{entry.ident}_units", "units": units, "kinds": kinds}
 
 
 def modules_text(entries: list[LibraryEntry], source: str) -> str:
     return render("xacro/modc_modules.xacro.j2", {
-        "version": __version__, "source": _comment(source),
+        "version": __version__, "source": comment(source),
         "libraries": [library_context(e) for e in entries],
-        "library_names": ", ".join(e.library.name for e in entries),
+        "library_names": comment(", ".join(e.library.name for e in entries)),
         "materials": _pydict({k: vec(v) for k, v in MATERIALS.items()}),
-        "link_module": LINK_MODULE, "mesh_root": DEFAULT_MESH_ROOT,
+        "link_module": _trusted(LINK_MODULE), "mesh_root": DEFAULT_MESH_ROOT,
     })
 
 
@@ -293,7 +310,7 @@ def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) 
         lo, hi = robot.joint_range(n)
         if (lo, hi) != (math.radians(v.lower_deg), math.radians(v.upper_deg)):  # narrowed by `limit`
             params += [("lower", num(lo)), ("upper", num(hi))]
-        units.append({"n": n, "name": u.name, "macro": f"{entry.ident}_unit{u.kind}", "variant": u.variant,
+        units.append({"n": n, "name": u.name, "macro": f"{entry.ident}_unit{u.kind}", "variant": _key(u.variant),
                       "parent": parent, "params": params})
         parent = last_frame(n, t.link)
     links = {l.name: l for l in desc.links}
@@ -303,8 +320,8 @@ def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) 
         payload = {"inertial": _inertial_strings(links["payload"].inertial), **_pose(joints["payload_joint"].T_parent_child)}
     tool = robot.tool
     return {
-        "version": __version__, "source": _comment(source), "robot": robot.name, "sequence": robot.sequence,
-        "name": robot.file_stem, "macro": macro_name(robot), "library": robot.library.name,
+        "version": __version__, "source": comment(source), "robot": robot.name, "sequence": robot.sequence,
+        "name": robot.file_stem, "macro": macro_name(robot), "library": comment(robot.library.name),
         "library_file": LIBRARY_FILE, "macro_file": f"{robot.file_stem}_macro.xacro",
         "mesh_root": DEFAULT_MESH_ROOT, "units": units,
         "tool": {"parent": parent, "xyz": vec(tool.xyz), "rpy": vec(tool.rpy),

@@ -24,15 +24,16 @@ def sim_cmd(
     robot: Annotated[Optional[str], typer.Option(help="simulate only this robot of the file")] = None,
     srdf_from: Annotated[Optional[str], typer.Option("--srdf-from", help="a compile output OUT/ whose config/*.srdf disabled collision pairs are honoured")] = None,
     library: LibraryOpt = None,
+    engine: Annotated[str, typer.Option(help="physics engine: pybullet (the URDF) or mujoco (the MJCF)")] = "pybullet",
 ):
-    """PyBullet smoke test: load every robot, hold home and every named pose with the actuators'
-    peak torque, check tracking, self-collision, the environment, FK and holding torques.
-    Exit 1 on any failure, saying what failed."""
+    """Smoke test (PyBullet, or MuJoCo with --engine mujoco): load every robot, hold home and
+    every named pose with the actuators' peak torque, check tracking, self-collision, the
+    environment, FK and holding torques. Exit 1 on any failure, saying what failed."""
     from ..sim.scene import UsageError
     from ..sim.smoke import run_sim
 
     with usage_errors("sim", (UsageError,)):
-        ok, lines, checked = run_sim(file, library=library, robot=robot, out_dir=srdf_from)
+        ok, lines, checked = run_sim(file, library=library, robot=robot, out_dir=srdf_from, engine=engine)
     _print_diagnostics(checked.diagnostics, checked.sources)
     for line in lines:
         print(line)

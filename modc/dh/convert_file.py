@@ -6,7 +6,8 @@ import math
 import re
 from pathlib import Path
 
-from ..diagnostics import Diagnostic, Span
+from .. import names
+from ..diagnostics import Diagnostic, Span, codes
 from ..model import Design, Robot
 from ..model.write import robot_text
 from ..passes import Context, run_all
@@ -15,8 +16,9 @@ from .table import read_csv
 
 
 def _name(path: str) -> str:
-    stem = re.sub(r"\W", "_", Path(path).stem) or "arm"
-    return stem if re.match(r"[A-Za-z_]", stem) else f"arm_{stem}"
+    """The file's stem as a robot name (modc.names' identifier rule: ASCII, at most MAX_NAME)."""
+    stem = re.sub(r"[^A-Za-z0-9_]", "_", Path(path).stem) or "arm"
+    return (stem if re.match(r"[A-Za-z_]", stem) else f"arm_{stem}")[: names.MAX_NAME]
 
 
 def convert_table(text: str, path: str, name: str | None = None, fit_links: bool = False,
@@ -25,6 +27,11 @@ def convert_table(text: str, path: str, name: str | None = None, fit_links: bool
     if any(d.is_error for d in diags):
         return "", diags, False
     where = Span.point(path)
+    problem = names.identifier_problem(name or _name(path))
+    if problem:  # only --name can break the rule
+        bad = codes.INVALID_NAME.at(Span.point("<command line>"), what="robot", name=names.shown(name or ""),
+                                    problem=problem, rule=names.IDENTIFIER_RULE)
+        return "", [*diags, bad], False
     robot = Robot(name=name or _name(path), dh=tuple(rows), dh_fit_links=fit_links, span=where, name_span=where)
     ctx = Context(diagnostics=diags, library_override=library)
     design = run_all(Design(path=path, robots=(robot,)), ctx)

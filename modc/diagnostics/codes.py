@@ -191,6 +191,9 @@ NO_PATH = _register("no-path", E, "no collision-free motion to a target was foun
 # --- names, poses, limits, environment ---------------------------------------------------------
 DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",
     "robot '{name}' is defined twice", "rename one of them; output files are named after robots")
+INVALID_NAME = _register("invalid-name", E, "a name that is not an identifier, or too long",
+    "{what} name '{name}' is not allowed: {problem}",
+    "names are {rule}: they become XML, file and ROS names")
 DUPLICATE_NAME = _register("duplicate-name", E, "two poses, targets or obstacles with one name",
     "'{name}' is already defined in robot '{robot}'", "names of poses, targets and obstacles must be unique")
 POSE_ARITY = _register("pose-arity", E, "a pose with the wrong number of joint values",

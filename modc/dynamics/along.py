@@ -30,7 +30,7 @@ def torques(dyn: Dynamics, t, Q) -> np.ndarray:
         return np.array([dyn.gravity(Q[0])])
     V = np.gradient(Q, t, axis=0)
     A = np.gradient(V, t, axis=0)
-    return np.array([dyn.rnea(q, v, a) for q, v, a in zip(Q, V, A)])
+    return np.array([dyn.rnea(q, v, a) for q, v, a in zip(Q, V, A, strict=True)])
 
 
 def peaks(dyn: Dynamics, traj) -> list[JointPeak]:
@@ -40,9 +40,11 @@ def peaks(dyn: Dynamics, traj) -> list[JointPeak]:
     traj = traj.in_order(names)
     tau = np.abs(torques(dyn, traj.t, traj.q))
     out = []
+    lib = robot.library
+    assert lib is not None
     for i, name in enumerate(names):
         k = int(np.argmax(tau[:, i]))
-        act = robot.library.variants[robot.units[i].variant].actuator
+        act = lib.variants[robot.units[i].variant].actuator
         out.append(JointPeak(name, robot.units[i].name, float(tau[k, i]), tuple(traj.q[k]), act.torque_nominal,
                              act.torque_peak, t=float(traj.t[k])))
     return out

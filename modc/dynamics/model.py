@@ -1,5 +1,6 @@
-"""A pinocchio model of a checked robot, built from the URDF modc emits (so that what is
-analysed is exactly what users load). SI units; gravity in base_link follows the base placement.
+"""A pinocchio model of a checked robot, built in memory from the same Description the URDF
+backend renders (modc.physical.multibody; tests/test_multibody.py checks it equals pinocchio's
+reading of the emitted URDF). SI units; gravity in base_link follows the base placement.
 
     dyn = Dynamics(robot)
     dyn.rnea(q, v, a)        # inverse dynamics: joint torques, N·m
@@ -10,39 +11,39 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import rpy_matrix
-from ..model import Robot
+from ..diagnostics.span import NOWHERE
+from ..model import Payload, Robot
+from ..physical.multibody import gravity
 
-G_WORLD = np.array([0.0, 0.0, -9.81])
+PayloadOverride = tuple[float, tuple[float, float, float]]  # (kg, centre of mass in tool0, m)
 
 
-def urdf_for(robot: Robot, payload: tuple[float, tuple[float, float, float]] | None = None) -> str:
-    from ..backends import Build
-    from ..backends.urdf import urdf_text
-    from ..model import Design, Payload
-
-    if payload is not None:
-        robot = robot.model_copy(update={"payload": Payload(mass=payload[0], com=payload[1])})
-    design = Design(path="<dynamics>", robots=(robot,))
-    return urdf_text(Build(design), robot, mesh_prefix="")
+def with_payload(robot: Robot, payload: PayloadOverride | None) -> Robot:
+    """The robot carrying another payload (None: the file's own)."""
+    if payload is None:
+        return robot
+    span = robot.payload.span if robot.payload is not None else NOWHERE
+    return robot.model_copy(update={"payload": Payload(mass=payload[0], com=payload[1], span=span)})
 
 
 class Dynamics:
-    def __init__(self, robot: Robot, payload: tuple[float, tuple[float, float, float]] | None = None):
+    def __init__(self, robot: Robot, payload: PayloadOverride | None = None):
         import pinocchio as pin
+
+        from ..physical import multibody
+        from ..physical.assembly import describe
 
         self.pin = pin
         self.robot = robot
-        self.model = pin.buildModelFromXML(urdf_for(robot, payload))
-        # base_link may be mounted tilted (`base … rpy`): gravity as seen in base_link
-        self.model.gravity.linear = rpy_matrix(robot.base.rpy).T @ G_WORLD
+        self.model = multibody.model(describe(with_payload(robot, payload)), gravity=gravity(robot))
         self.data = self.model.createData()
         self.nq = self.model.nq
         self.lower = np.array(self.model.lowerPositionLimit)
         self.upper = np.array(self.model.upperPositionLimit)
 
     def rnea(self, q, v, a) -> np.ndarray:
-        return np.array(self.pin.rnea(self.model, self.data, np.asarray(q, float), np.asarray(v, float), np.asarray(a, float)))
+        q, v, a = (np.asarray(x, float) for x in (q, v, a))
+        return np.array(self.pin.rnea(self.model, self.data, q, v, a))
 
     def gravity(self, q) -> np.ndarray:
         return np.array(self.pin.computeGeneralizedGravity(self.model, self.data, np.asarray(q, float)))

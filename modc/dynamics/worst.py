@@ -5,14 +5,22 @@ are reproducible), then refine the best samples of every joint by projected grad
 with pinocchio's analytic derivatives dg/dq, stopping where the projected gradient vanishes (a
 local maximum on the box). Starting from many well-spread samples makes missing the global
 maximum unlikely; the tests compare with a dense grid.
+
+The result is a pure function of the arm's Description (inertials, joints, limits), gravity, the
+actuators' torques and the search's parameters, so it is cached on disk under their digest
+(modc.cache): a compile whose arm has not changed needs no pinocchio at all.
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
 
-from .model import Dynamics
+from .. import cache
+from .model import Dynamics, PayloadOverride, gravity, with_payload
+
+ALGORITHM = "1"  # bump when worst_case() could give another result for the same input
 
 
 @dataclass(frozen=True)
@@ -94,6 +102,7 @@ def worst_case(dyn: Dynamics, samples: int = 512, refine: int = 4, seed: int = 0
             val, q = _ascend(dyn, i, Q[k].copy())
             if val > best_val:
                 best_val, best_q = val, q
+        assert best_q is not None and lib is not None
         best_val, best_q = _canonical(dyn, i, best_val, best_q)
         act = lib.variants[robot.units[i].variant].actuator
         out.append(JointWorst(f"joint_{i + 1}", robot.units[i].name, float(best_val), tuple(float(x) for x in best_q),
@@ -103,9 +112,28 @@ def worst_case(dyn: Dynamics, samples: int = 512, refine: int = 4, seed: int = 0
 
 def analyse(robot, payload_mass: float | None = None) -> list[JointWorst]:
     """The worst case for a checked robot; payload_mass (kg) replaces the file's payload mass,
-    keeping its centre of mass (tool0's origin if the file has none)."""
-    payload = None
+    keeping its centre of mass (tool0's origin if the file has none). Cached by content."""
+    payload: PayloadOverride | None = None
     if payload_mass is not None:
         com = robot.payload.com if robot.payload is not None else (0.0, 0.0, 0.0)
         payload = (payload_mass, com)
-    return worst_case(Dynamics(robot, payload))
+    key = _key(robot, payload)
+    hit = cache.get("torque", key)
+    if hit is not None:
+        return [JointWorst(j[0], j[1], j[2], tuple(j[3]), j[4], j[5]) for j in json.loads(hit)]
+    result = worst_case(Dynamics(robot, payload))
+    cache.put("torque", key, json.dumps([[j.name, j.variant, j.tau, list(j.q), j.tau_nom, j.tau_max]
+                                         for j in result]).encode())
+    return result
+
+
+def _key(robot, payload: PayloadOverride | None) -> str:
+    """Everything worst_case() reads: the described arm, gravity, the actuators, the defaults."""
+    from ..physical.assembly import describe
+
+    lib = robot.library
+    actuators = [(u.name, lib.variants[u.variant].actuator.torque_nominal, lib.variants[u.variant].actuator.torque_peak)
+                 for u in robot.units]
+    defaults = worst_case.__defaults__
+    return cache.key(ALGORITHM, describe(with_payload(robot, payload)).fingerprint(), gravity(robot).tobytes(),
+                     repr(actuators), repr(defaults)) + ".json"

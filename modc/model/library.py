@@ -4,22 +4,43 @@ All lengths in metres, masses in kilograms, torques in N·m; fields ending in _d
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 from functools import cache
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+
+from .. import names
+from ..diagnostics import Span
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
 
+def _rule(problem: Callable[[str], str | None]) -> AfterValidator:
+    def check(text: str) -> str:
+        why = problem(text)
+        if why:
+            raise ValueError(why)
+        return text
+    return AfterValidator(check)
+
+
+# A library file is input like a .mod file: every string in it reaches outputs (XML, xacro, YAML
+# comments, mesh file names), so each obeys one of modc.names' rules.
+VariantName = Annotated[str, _rule(names.variant_problem)]
+Label = Annotated[str, _rule(names.label_problem)]
+Text = Annotated[str, _rule(names.text_problem)]
+
+
 class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
 
 class Actuator(_Frozen):
-    model: str
+    model: Text
     mass: float = Field(gt=0, description="kg (paper Table 1)")
     rpm: float = Field(gt=0, description="rated speed, rev/min (paper Table 1)")
     torque_nominal: float = Field(gt=0, description="N·m (paper Table 1)")
@@ -60,7 +81,7 @@ class LinkModule(_Frozen):
 
 
 class Variant(_Frozen):
-    description: str
+    description: Text
     actuator: Actuator
     casings: Casings
     twist_unit: TwistUnit
@@ -132,25 +153,25 @@ class Twists(_Frozen):
 class Rules(_Frozen):
     """Assembly rules (paper section 3, rules 1-4)."""
 
-    first_variant: str
-    last_variant: str
-    may_follow: dict[str, list[str]]
+    first_variant: VariantName
+    last_variant: VariantName
+    may_follow: dict[VariantName, list[VariantName]]
     min_dof: int = Field(1, ge=1)
     max_dof: int = Field(ge=1)
 
 
 class Control(_Frozen):
-    p: float
-    i: float
-    d: float
+    p: float = Field(gt=0, description="proportional gain, actuator units (paper section 4.4)")
+    i: float = Field(ge=0)
+    d: float = Field(ge=0)
 
 
 class Library(_Frozen):
-    name: str
-    description: str
-    source: str
-    variants: dict[str, Variant]
-    units: dict[int, UnitType]
+    name: Label
+    description: Text
+    source: Text
+    variants: dict[VariantName, Variant]
+    units: dict[Annotated[int, Field(ge=1, le=99)], UnitType]  # unit type numbers: H1..H4
     twists: Twists
     link_length_min: float = Field(gt=0)
     link_length_max: float = Field(gt=0)
@@ -184,7 +205,47 @@ class Library(_Frozen):
 
 
 class LibraryError(Exception):
-    pass
+    """A library that cannot be used; span points into the library file when the problem has a
+    place there (text is that file, for the caret excerpt), else it is None."""
+
+    def __init__(self, message: str, span: Span | None = None, text: str | None = None):
+        super().__init__(message)
+        self.span, self.text = span, text
+
+
+def _node_span(file: str, node) -> Span:
+    s, e = node.start_mark, node.end_mark
+    if e.line != s.line:  # a block: point at its first line only
+        return Span(file, s.line + 1, s.column + 1, s.line + 1, s.column + 2, s.index, s.index + 1)
+    end_col, end = max(e.column + 1, s.column + 2), max(e.index, s.index + 1)
+    return Span(file, s.line + 1, s.column + 1, e.line + 1, end_col, s.index, end)
+
+
+def _where(text: str, file: str, loc: tuple) -> Span:
+    """Where a validation error's location (pydantic's loc) is in the library's YAML: the value
+    when it is a scalar, else its key; the deepest part of loc the file has."""
+    import yaml
+
+    try:
+        node = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    except yaml.YAMLError:
+        node = None
+    if node is None:
+        return Span.point(file)
+    key = None
+    for part in loc:
+        if part == "[key]" and key is not None:
+            return _node_span(file, key)
+        if isinstance(node, yaml.MappingNode):
+            hit = next(((k, v) for k, v in node.value if k.value == str(part)), None)
+        elif isinstance(node, yaml.SequenceNode) and isinstance(part, int) and 0 <= part < len(node.value):
+            hit = (key, node.value[part])
+        else:
+            hit = None
+        if hit is None:
+            break
+        key, node = hit
+    return _node_span(file, node if isinstance(node, yaml.ScalarNode) or key is None else key)
 
 
 @cache
@@ -194,19 +255,23 @@ def _load_path(path: str, mtime: float) -> Library:
     from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
 
     try:
-        data = yaml.load(Path(path).read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        text = Path(path).read_text(encoding="utf-8")
+        data = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     except (OSError, UnicodeDecodeError) as e:
         raise LibraryError(str(e)) from None
     except yaml.YAMLError as e:
-        raise LibraryError(f"YAML error: {e}") from None
+        mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
+        span = Span.point(path, mark.line + 1, mark.column + 1, mark.index) if mark else None
+        raise LibraryError(f"YAML error: {getattr(e, 'problem', None) or e}", span, text) from None
     from pydantic import ValidationError
 
     try:
         return Library.model_validate(data)
     except ValidationError as e:
         first = e.errors()[0]
-        loc = ".".join(str(p) for p in first["loc"])
-        raise LibraryError(f"{loc}: {first['msg']}" if loc else first["msg"]) from None
+        loc = ".".join(str(p) for p in first["loc"] if p != "[key]")
+        message = first["msg"].removeprefix("Value error, ")
+        raise LibraryError(f"{loc}: {message}" if loc else message, _where(text, path, first["loc"]), text) from None
 
 
 def resolve(ref: str, relative_to: Path | None = None) -> Path | None:
@@ -233,7 +298,12 @@ def load(ref: str = "mark2", relative_to: Path | None = None) -> Library:
     path = resolve(ref, relative_to)
     if path is None:
         raise LibraryError(f"library '{ref}' not found")
-    return _load_path(str(path.resolve()), path.stat().st_mtime)
+    try:
+        return _load_path(str(path.resolve()), path.stat().st_mtime)
+    except LibraryError as e:  # point at the file as the user named it, not at its resolved path
+        if e.span is not None:
+            e.span = dataclasses.replace(e.span, file=str(path))
+        raise
 
 
 def default() -> Library:

@@ -6,6 +6,7 @@ import difflib
 import math
 from pathlib import Path
 
+from .. import names
 from ..diagnostics import REGISTRY, Diagnostic, codes
 from ..syntax import ast
 from . import quantities as Q
@@ -22,6 +23,15 @@ class _Lowerer:
 
     def error(self, d: Diagnostic) -> None:
         self.diags.append(d)
+
+    def name(self, n: ast.Name, what: str) -> bool:
+        """The one identifier rule (modc.names), for both input forms: the .mod grammar already
+        lexes names this way but not their length; the YAML form takes any string."""
+        problem = names.identifier_problem(n.text)
+        if problem:
+            self.error(codes.INVALID_NAME.at(n.span, what=what, name=names.shown(n.text), problem=problem,
+                                             rule=names.IDENTIFIER_RULE))
+        return problem is None
 
     def _scale(self, unit: str | None, kind: str, what: str, span) -> float | None:
         table = Q.KINDS[kind]
@@ -85,8 +95,10 @@ class _Lowerer:
                 values[key] = v
         return values, spans
 
-    def unit(self, u: ast.Unit) -> UnitSpec:
+    def unit(self, u: ast.Unit) -> UnitSpec | None:
         values, spans = self.params(u.params, UNIT_PARAMS)
+        if not self.name(u.name, "unit"):
+            return None
         return UnitSpec(name=u.name.text, span=u.span, param_spans=spans, **values)
 
     def dh(self, table: ast.DH) -> tuple[DHRow, ...]:
@@ -111,7 +123,10 @@ class _Lowerer:
         rpy = self.vector(p.rpy, "an angle", f"{p.keyword} orientation") if p.rpy else None
         return Transform(xyz=xyz or (0.0, 0.0, 0.0), rpy=rpy or (0.0, 0.0, 0.0))
 
-    def robot(self, r: ast.Robot, source_dir: str | None) -> Robot:
+    def robot(self, r: ast.Robot, source_dir: str | None) -> Robot | None:
+        """The robot, or None when its name or a unit's is invalid (its statements are still checked)."""
+        named = self.name(r.name, "robot")
+        rname = _say(r.name)
         fields: dict = {}
         seen: dict[str, object] = {}
         poses, limits, obstacles, targets, allow = [], [], [], [], set()
@@ -121,12 +136,15 @@ class _Lowerer:
                 kind = st.keyword
             if kind in ONCE:
                 if kind in seen:
-                    self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=r.name.text))
+                    self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=rname))
                     continue
                 seen[kind] = st
             match st:
                 case ast.Chain():
-                    fields["units"] = tuple(self.unit(u) for u in st.units)
+                    units = [self.unit(u) for u in st.units]
+                    # a chain with a bad unit name is not checked further: the rest would only mislead
+                    named = named and None not in units
+                    fields["units"] = tuple(u for u in units if u is not None)
                 case ast.DH():
                     fields["dh"] = self.dh(st)
                     fields["dh_fit_links"] = st.fit_links
@@ -142,40 +160,42 @@ class _Lowerer:
                     if mass is not None and com is not None:
                         fields["payload"] = Payload(mass=mass, com=com, span=st.span)
                 case ast.Pose():
-                    q = self.vector(st.values, "an angle", f"pose '{st.name.text}'", n=None)
-                    if q is not None:
+                    q = self.vector(st.values, "an angle", f"pose '{_say(st.name)}'", n=None)
+                    if self.name(st.name, "pose") and q is not None:
                         poses.append(Pose(name=st.name.text, q=q, span=st.span))
                 case ast.Limit():
-                    v = self.vector(st.values, "an angle", f"limit of '{st.joint.text}'", n=2)
-                    if v is not None:
+                    v = self.vector(st.values, "an angle", f"limit of '{_say(st.joint)}'", n=2)
+                    if self.name(st.joint, "joint") and v is not None:
                         limits.append(JointLimit(joint=st.joint.text, lower=v[0], upper=v[1], span=st.span))
                 case ast.Box() | ast.Sphere() | ast.Cylinder():
                     o = self.obstacle(st)
                     if o is not None:
                         obstacles.append(o)
                 case ast.Target():
-                    xyz = self.vector(st.at, "a length", f"target '{st.name.text}'")
-                    if xyz is not None:
+                    xyz = self.vector(st.at, "a length", f"target '{_say(st.name)}'")
+                    if self.name(st.name, "target") and xyz is not None:
                         targets.append(Target(name=st.name.text, xyz=xyz, span=st.span))
                 case ast.Allow():
                     for c in st.codes:
                         if c.text in REGISTRY and REGISTRY[c.text].allowable:
                             allow.add(c.text)
                         else:
-                            names = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
-                            self.error(codes.UNKNOWN_ALLOW.at(c.span, name=c.text, allowable=names))
+                            allowable = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
+                            self.error(codes.UNKNOWN_ALLOW.at(c.span, name=_say(c), allowable=allowable))
         if "chain" in seen and "dh" in seen:
-            self.error(codes.CHAIN_AND_DH.at(seen["dh"].span, robot=r.name.text))
+            self.error(codes.CHAIN_AND_DH.at(seen["dh"].span, robot=rname))
             fields.pop("dh")
         elif "chain" not in seen and "dh" not in seen:
-            self.error(codes.MISSING_CHAIN.at(r.name.span, robot=r.name.text))
+            self.error(codes.MISSING_CHAIN.at(r.name.span, robot=rname))
+        if not named:
+            return None
         return Robot(
             name=r.name.text, poses=tuple(poses), limits=tuple(limits), obstacles=tuple(obstacles),
             targets=tuple(targets), allow=frozenset(allow), span=r.span, name_span=r.name.span, **fields,
         )
 
     def obstacle(self, st) -> Obstacle | None:
-        name = st.name.text
+        name = _say(st.name)
         at = self.vector(st.at, "a length", f"position of '{name}'")
         rpy = self.vector(st.rpy, "an angle", f"orientation of '{name}'") if getattr(st, "rpy", None) else (0.0, 0.0, 0.0)
         match st:
@@ -189,12 +209,18 @@ class _Lowerer:
                 r = self.quantity(st.radius, "a length", f"radius of cylinder '{name}'")
                 h = self.quantity(st.length, "a length", f"length of cylinder '{name}'")
                 size, shape = (None if r is None or h is None else (r, h)), "cylinder"
-        if at is None or rpy is None or size is None:
+        if not self.name(st.name, shape) or at is None or rpy is None or size is None:
             return None
-        return Obstacle(name=name, shape=shape, size=size, origin=Transform(xyz=at, rpy=rpy), span=st.span)
+        return Obstacle(name=st.name.text, shape=shape, size=size, origin=Transform(xyz=at, rpy=rpy), span=st.span)
+
+
+def _say(n: ast.Name) -> str:
+    """A name as messages quote it: as written when valid, else escaped and cut short."""
+    return n.text if names.identifier_problem(n.text) is None else names.shown(n.text)
 
 
 def lower(file: ast.File, diags: list[Diagnostic]) -> Design:
     source_dir = str(Path(file.path).parent) if not file.path.startswith("<") else None
     low = _Lowerer(diags)
-    return Design(path=file.path, robots=tuple(low.robot(r, source_dir) for r in file.robots))
+    robots = (low.robot(r, source_dir) for r in file.robots)
+    return Design(path=file.path, robots=tuple(r for r in robots if r is not None))

@@ -6,11 +6,23 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, SkipValidation
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, SkipValidation
 
+from .. import names
 from ..diagnostics import NOWHERE, Span
 from .library import Library
 
+
+def _identifier(text: str) -> str:
+    problem = names.identifier_problem(text)
+    if problem:
+        raise ValueError(problem)
+    return text
+
+
+# Every user-given name in the model (robot, unit, pose, target, obstacle, joint reference) is one
+# of these: lowering reports a bad one as invalid-name, so no backend can ever see another string.
+Name = Annotated[str, AfterValidator(_identifier)]
 Vec3 = tuple[float, float, float]
 SpanField = Annotated[SkipValidation[Span], Field(default=NOWHERE, exclude=True, repr=False)]
 
@@ -29,7 +41,7 @@ class Transform(_M):
 class UnitSpec(_M):
     """One modular unit of the chain, e.g. H4(pivot=-90deg, port=45deg)."""
 
-    name: str
+    name: Name
     variant: str = ""  # filled once the library is known
     kind: int = 0
     pivot: float = 0.0  # rad, twist in the adaptive twist unit (rotation about y, eq. 4)
@@ -56,20 +68,20 @@ class Payload(_M):
 
 
 class Pose(_M):
-    name: str
+    name: Name
     q: tuple[float, ...]  # rad, joint_1 first
     span: SpanField
 
 
 class JointLimit(_M):
-    joint: str
+    joint: Name
     lower: float
     upper: float
     span: SpanField
 
 
 class Obstacle(_M):
-    name: str
+    name: Name
     shape: Literal["box", "sphere", "cylinder"]
     size: tuple[float, ...]  # box: (x, y, z); sphere: (r,); cylinder: (r, length along z)
     origin: Transform
@@ -77,7 +89,7 @@ class Obstacle(_M):
 
 
 class Target(_M):
-    name: str
+    name: Name
     xyz: Vec3  # m, in base_link
     span: SpanField
 
@@ -89,7 +101,7 @@ def default_position(lower: float, upper: float) -> float:
 
 
 class Robot(_M):
-    name: str
+    name: Name
     library_ref: str = "mark2"
     library_dir: str | None = None  # where a relative library path is resolved
     library: Library | None = None  # resolved by the resolve_library pass

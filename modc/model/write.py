@@ -36,7 +36,8 @@ def vec(values, unit: str) -> str:
 
 
 def robot_text(robot: Robot, comments: list[str] = ()) -> str:
-    lines = [f"# {c}" if c else "#" for c in comments]
+    # a comment ends at a line break: text from outside (a file name) must not start a new line
+    lines = [f"# {' '.join(c.splitlines())}" if c else "#" for c in comments]
     lines.append(f"robot {robot.name} {{")
     lines.append("    chain " + " - ".join(unit_text(robot, i) for i in range(robot.dof)))
     if robot.library_ref != "mark2":

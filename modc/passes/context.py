@@ -15,6 +15,7 @@ class Context:
     analyses: frozenset[str] = frozenset()
     torque_severity: str = "error"  # error | warning | off: how an over-peak joint is reported
     payload_override: float | None = None  # `check --payload MASS`, kg at tool0
+    sources: dict[str, str] = field(default_factory=dict)  # other files diagnostics point into (libraries)
 
     def report(self, d: Diagnostic, robot: Robot | None = None) -> None:
         # `allow CODE` in a robot block silences that robot's allowable rule diagnostics.

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .. import names
 from ..diagnostics import codes
 from ..model import Design
 from ..model import library as lib
@@ -19,7 +20,10 @@ def run(design: Design, ctx: Context) -> Design:
         except lib.LibraryError as e:
             code = codes.LIBRARY_NOT_FOUND if "not found" in str(e) else codes.LIBRARY_INVALID
             span = r.library_span if r.library_ref == ref and r.library_span.file != "<unknown>" else r.name_span
-            ctx.report(code.at(span, name=ref, detail=str(e), builtins=", ".join(lib.BUILTIN)))
+            if e.span is not None:  # a problem inside the library file: point at it there
+                span = e.span
+                ctx.sources[span.file] = e.text or ""
+            ctx.report(code.at(span, name=names.shown(ref, 200), detail=str(e), builtins=", ".join(lib.BUILTIN)))
             robots.append(r)
             continue
         units = []

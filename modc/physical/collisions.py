@@ -13,10 +13,12 @@ Every pair of links that carry collision geometry gets at most one reason to be 
               Assistant), drawn uniformly within the joint limits from a seeded PCG64 stream.
 Other pairs stay enabled: MoveIt checks them while planning.
 
-What is tested is exactly what MoveIt loads: pinocchio's GeometryModel built from the emitted
-URDF's <collision> meshes, tested by coal (BVH meshes, so coal's mesh-mesh semantics, which are
-FCL's and MoveIt's: surfaces that cross or touch collide; a mesh wholly inside another one does
-not). No geometry test is hand-written here.
+What is tested is what MoveIt loads: the <collision> meshes of the emitted URDF, here built in
+memory from the arm's Description (modc.physical.multibody: the STL files' triangles as coal BVH
+models, placed as pinocchio's URDF parser places them; tests/test_multibody.py checks both give
+the same matrix), tested by coal (BVH meshes, so coal's mesh-mesh semantics, which are FCL's and
+MoveIt's: surfaces that cross or touch collide; a mesh wholly inside another one does not). No
+geometry test is hand-written here. load() reads an emitted URDF instead (the consumer check).
 
 Speed (10,000 samples of a 6-DoF arm well under 0.5 s on one core; see
 benchmarks/bench_collisions.py for the figure next to a naive all-mesh-pairs anchor) comes from
@@ -31,20 +33,23 @@ three things, none of which can change a result:
      would be conservative for Never but would wrongly disable pairs as Default or Always.)
   3. the exact test of a link pair is one pinocchio call over all its mesh pairs, stopping at
      the first collision (coal's BVH rejects far meshes at the root).
-Samples are drawn and visited in order on one thread, so the result depends only on the URDF,
-the meshes, the sample count and the seed: same input -> same matrix on any machine and thread
+Samples are drawn and visited in order on one thread, so the result depends only on the arm's
+geometry and joints, the sample count and the seed: same input -> same matrix on any machine and thread
 count (barring floating-point differences in coal for meshes that touch to within rounding;
 the filter's margin keeps near-contacts out of the broad phase's hands).
 """
 from __future__ import annotations
 
-import tempfile
-import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+
+from ..model.robot import default_position
+from .assembly import Description
+from .multibody import enclosing_sphere, hull_points
 
 DEFAULT_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling density"
 DEFAULT_SEED = 0
@@ -77,7 +82,7 @@ class CollisionMatrix:
 
     @property
     def links_without_geometry(self) -> tuple[str, ...]:
-        return tuple(l for l in self.links if l not in self.geometry_links)
+        return tuple(name for name in self.links if name not in self.geometry_links)
 
     def reason(self, a: str, b: str) -> str | None:
         for p in self.disabled:
@@ -88,23 +93,39 @@ class CollisionMatrix:
 
 @dataclass
 class Geometry:
-    """A pinocchio model and collision GeometryModel of one URDF, plus its link graph."""
+    """A pinocchio model and collision GeometryModel of one arm, plus its link graph."""
 
-    model: object  # pin.Model
-    geom_model: object  # pin.GeometryModel (collision meshes)
+    model: Any  # pin.Model
+    geom_model: Any  # pin.GeometryModel (collision meshes)
     links: tuple[str, ...]
     edges: tuple[tuple[str, str], ...]  # (parent, child) per URDF joint
     objects: dict[str, list[int]]  # link -> indices into geom_model.geometryObjects
 
     @property
     def geometry_links(self) -> tuple[str, ...]:
-        return tuple(l for l in self.links if self.objects.get(l))
+        return tuple(name for name in self.links if self.objects.get(name))
+
+
+def geometry(desc: Description) -> Geometry:
+    """The arm's collision model, built in memory from its Description (no files)."""
+    from . import multibody
+
+    model = multibody.model(desc)
+    geom_model = multibody.geometry(desc, model)
+    links = tuple(link.name for link in desc.links)
+    objects: dict[str, list[int]] = {name: [] for name in links}
+    for i, go in enumerate(geom_model.geometryObjects):
+        objects[model.frames[go.parentFrame].name].append(i)
+    return Geometry(model, geom_model, links, tuple((j.parent, j.child) for j in desc.joints), objects)
 
 
 def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
     """Load a URDF and the meshes it references from an output tree held in memory
     ({relative path: content}, as backends produce it): the files are written to a temporary
     directory so that pinocchio resolves relative mesh paths exactly as a user's tools do."""
+    import tempfile
+    import xml.etree.ElementTree as ET
+
     import pinocchio as pin
 
     from ..files import write_files
@@ -118,9 +139,10 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
                                            package_dirs=[str(urdf_file.parent)])
         text = urdf_file.read_text(encoding="utf-8")
     xml = ET.fromstring(text)
-    links = tuple(l.get("name") for l in xml.findall("link"))
-    edges = tuple((j.find("parent").get("link"), j.find("child").get("link")) for j in xml.findall("joint"))
-    objects: dict[str, list[int]] = {l: [] for l in links}
+    links = tuple(str(link.get("name")) for link in xml.findall("link"))
+    edges = tuple((str(j.find("parent").get("link")), str(j.find("child").get("link")))  # type: ignore[union-attr]
+                  for j in xml.findall("joint"))
+    objects: dict[str, list[int]] = {name: [] for name in links}
     for i, go in enumerate(geom_model.geometryObjects):
         objects[model.frames[go.parentFrame].name].append(i)
     return Geometry(model, geom_model, links, edges, objects)
@@ -129,7 +151,7 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
 def adjacent_pairs(links: tuple[str, ...], edges, has_geometry) -> set[frozenset[str]]:
     """MoveIt's connection graph: joint-connected links, with geometry-less links removed
     and their neighbours connected to each other (repeated until none is left)."""
-    graph: dict[str, set[str]] = {l: set() for l in links}
+    graph: dict[str, set[str]] = {name: set() for name in links}
     for a, b in edges:
         graph[a].add(b)
         graph[b].add(a)
@@ -155,9 +177,8 @@ def joint_limits(model) -> tuple[np.ndarray, np.ndarray]:
 
 
 def default_configuration(lower, upper) -> np.ndarray:
-    """MoveIt's default joint values: 0 when the range contains it, else the middle."""
-    lo, hi = np.asarray(lower, float), np.asarray(upper, float)
-    return np.where((lo <= 0.0) & (0.0 <= hi), 0.0, (lo + hi) / 2)
+    """MoveIt's default joint values (modc.model.robot.default_position, joint by joint)."""
+    return np.array([default_position(float(lo), float(hi)) for lo, hi in zip(lower, upper, strict=True)])
 
 
 def sample_configurations(lower, upper, samples: int, seed: int) -> np.ndarray:
@@ -191,9 +212,8 @@ def batch_placements(model, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return R, p
     for j in range(1, nj):
         jm = model.joints[j]
-        axis = _REVOLUTE_AXES.get(jm.shortname())
-        if axis is None:
-            axis = np.asarray(jm.extract().axis, float)
+        known = _REVOLUTE_AXES.get(jm.shortname())
+        axis = np.asarray(jm.extract().axis if known is None else known, float)
         M = model.jointPlacements[j]
         parent = model.parents[j]
         Rpar = R[:, parent].reshape(N * 3, 3)
@@ -207,22 +227,6 @@ def batch_placements(model, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         s_, c_ = np.repeat(np.sin(angle), 3)[:, None], np.repeat(1.0 - np.cos(angle), 3)[:, None]
         R[:, j] = (R0 + s_ * R0K + c_ * (R0K @ K)).reshape(N, 3, 3)
     return R, p
-
-
-def _points(geometry) -> np.ndarray:
-    """Points whose convex hull contains the geometry: a mesh's vertices, else the corners of
-    its local bounding box (URDF boxes, cylinders and spheres)."""
-    if hasattr(geometry, "vertices"):
-        return np.asarray(geometry.vertices(), float)
-    geometry.computeLocalAABB()
-    lo, hi = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
-    return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-
-
-def _sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
-    """A sphere containing the points: centre of their bounding box, radius to the farthest."""
-    c = (points.min(axis=0) + points.max(axis=0)) / 2
-    return c, float(np.sqrt(((points - c) ** 2).sum(axis=1)).max())
 
 
 class _Checker:
@@ -250,16 +254,17 @@ class _Checker:
         # a bounding sphere per mesh and per link, in the frame of the joint that carries it
         self.spheres: dict[int, tuple[int, np.ndarray, float]] = {}  # geometry index -> sphere
         self.link_spheres: dict[str, tuple[int, np.ndarray, float]] = {}
-        for link in sorted({l for pr in pairs for l in pr}, key=geo.links.index):
+        for link in sorted({name for pr in pairs for name in pr}, key=geo.links.index):
             pts = []
             for k in geo.objects[link]:
                 o = gm.geometryObjects[k]
-                v = _points(o.geometry) @ np.asarray(o.placement.rotation).T
+                v = hull_points(o.geometry) @ np.asarray(o.placement.rotation).T
                 v += np.asarray(o.placement.translation)
-                self.spheres[k] = (o.parentJoint, *_sphere(v))
+                self.spheres[k] = (o.parentJoint, *enclosing_sphere(v))
                 pts.append(v)
             assert len({gm.geometryObjects[k].parentJoint for k in geo.objects[link]}) == 1
-            self.link_spheres[link] = (gm.geometryObjects[geo.objects[link][0]].parentJoint, *_sphere(np.vstack(pts)))
+            joint = gm.geometryObjects[geo.objects[link][0]].parentJoint
+            self.link_spheres[link] = (joint, *enclosing_sphere(np.vstack(pts)))
         self.exact_tests = 0
 
     def broad_phase(self, Q: np.ndarray) -> np.ndarray:
@@ -315,7 +320,7 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
     links = geo.links
     glinks = geo.geometry_links
     all_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]]
-    adjacent = adjacent_pairs(links, geo.edges, lambda l: bool(geo.objects.get(l)))
+    adjacent = adjacent_pairs(links, geo.edges, lambda name: bool(geo.objects.get(name)))
     reasons: dict[tuple[str, str], str] = {p: "Adjacent" for p in all_pairs if frozenset(p) in adjacent}
     candidates = [p for p in all_pairs if p not in reasons]
 
@@ -389,19 +394,15 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
 ALGORITHM = "1"  # bump when compute() could classify any pair differently
 
 
-def cached_compute(files: Mapping[str, str | bytes], urdf_path: str, samples: int = DEFAULT_SAMPLES,
-                   seed: int = DEFAULT_SEED) -> CollisionMatrix:
-    """compute() on the emitted files, through the disk cache: the matrix is a pure function of
-    the URDF, its meshes, the sample count and the seed, so a hit equals a fresh computation
-    (per-pair counts and stats are not kept)."""
+def cached_matrix(desc: Description, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_SEED) -> CollisionMatrix:
+    """compute() on the arm's geometry, through the disk cache: the matrix is a pure function of
+    the Description (links, joints, limits, parts), the sample count and the seed, so a hit
+    equals a fresh computation (per-pair counts and stats are not kept)."""
     import json
 
     from .. import cache
 
-    parts = [ALGORITHM, str(samples), str(seed), urdf_path]
-    for rel in sorted(files):
-        parts += [rel, files[rel]]
-    name = cache.key(*parts) + ".json"
+    name = cache.key(ALGORITHM, str(samples), str(seed), desc.fingerprint()) + ".json"
     hit = cache.get("collisions", name)
     if hit is not None:
         d = json.loads(hit)
@@ -409,7 +410,7 @@ def cached_compute(files: Mapping[str, str | bytes], urdf_path: str, samples: in
             links=tuple(d["links"]), geometry_links=tuple(d["geometry_links"]),
             disabled=tuple(Pair(*p) for p in d["disabled"]), enabled=tuple(tuple(p) for p in d["enabled"]),
             samples=d["samples"], seed=d["seed"], default_q=tuple(d["default_q"]))
-    matrix = compute(load(files, urdf_path), samples=samples, seed=seed)
+    matrix = compute(geometry(desc), samples=samples, seed=seed)
     doc = {"links": matrix.links, "geometry_links": matrix.geometry_links,
            "disabled": [[p.link1, p.link2, p.reason] for p in matrix.disabled], "enabled": matrix.enabled,
            "samples": matrix.samples, "seed": matrix.seed, "default_q": matrix.default_q}
@@ -424,7 +425,7 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
 
     links, glinks = geo.links, geo.geometry_links
     all_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]]
-    adjacent = adjacent_pairs(links, geo.edges, lambda l: bool(geo.objects.get(l)))
+    adjacent = adjacent_pairs(links, geo.edges, lambda name: bool(geo.objects.get(name)))
     reasons = {p: "Adjacent" for p in all_pairs if frozenset(p) in adjacent}
     candidates = [p for p in all_pairs if p not in reasons]
     gm = geo.geom_model.copy()
@@ -467,5 +468,5 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
 
 
 __all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "CollisionMatrix", "Geometry", "Pair",
-           "adjacent_pairs", "batch_placements", "compute", "compute_naive", "default_configuration", "joint_limits",
-           "load", "sample_configurations"]
+           "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive", "default_configuration",
+           "geometry", "joint_limits", "load", "sample_configurations"]

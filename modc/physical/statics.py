@@ -21,13 +21,14 @@ class Statics:
         self.robot = robot
         self.chain = Chain(robot)
         desc = describe(robot)
-        by_name = {l.name: l for l in desc.links}
+        by_name = {link.name: link for link in desc.links}
         # bodies rigid with link_i (i = 1..n), payload folded into link_n at its tool0 offset
         self.masses = []
         self.coms = []  # in the link (joint) frame
         n = robot.dof
         for i in range(1, n + 1):
             inert = by_name[f"link_{i}"].inertial
+            assert inert is not None
             m, c = inert.mass, inert.com
             if i == n and robot.payload is not None:
                 T = self.chain.T_last_tool()
@@ -41,7 +42,8 @@ class Statics:
         n = len(frames)
         P = np.array([f["T_base_joint"][:3, 3] for f in frames])
         Z = np.array([f["T_base_joint"][:3, 2] for f in frames])
-        C = np.array([f["T_base_joint"][:3, :3] @ c + f["T_base_joint"][:3, 3] for f, c in zip(frames, self.coms)])
+        C = np.array([f["T_base_joint"][:3, :3] @ c + f["T_base_joint"][:3, 3]
+                      for f, c in zip(frames, self.coms, strict=True)])
         M = np.array(self.masses)
         tau = np.empty(n)
         for i in range(n):

@@ -1,12 +1,12 @@
 """Collision checking for planning: pinocchio + coal, double precision, on the geometry the
 compiler emits.
 
-The robot is exactly what `modc FILE -o OUT` writes: the URDF's <collision> meshes (loaded by
-pinocchio from the urdf and meshes backends' output, through modc.physical.collisions.load, as
-the SRDF backend does), tested by coal as BVH meshes. The environment is the file's obstacles,
-in base_link, as coal primitives attached to the universe (base_link is the root and never
-moves): box (size = full extents), sphere (radius), cylinder (radius, length along its z), each
-placed by its origin (xyz, then URDF roll-pitch-yaw).
+The robot is what `modc FILE -o OUT` writes: the URDF's <collision> meshes, built in memory
+from the robot's Description (modc.physical.collisions.geometry, as the SRDF backend does; or
+read from emitted files when given), tested by coal as BVH meshes. The environment is the file's
+obstacles, in base_link, as coal primitives attached to the universe (base_link is the root and
+never moves): box (size = full extents), sphere (radius), cylinder (radius, length along its
+z), each placed by its origin (xyz, then URDF roll-pitch-yaw).
 
 Pairs that are checked:
     robot vs environment   every moving link with geometry vs every obstacle. base_link never
@@ -17,7 +17,7 @@ Pairs that are checked:
                            Default (touching in the default pose by construction) or Always.
                            The SRDF's Never pairs stay checked: never colliding in 10,000 random
                            poses is a sampling result, not a guarantee, and checking them is cheap.
-The matrix is modc.physical.collisions.compute with the SRDF's defaults (same samples, same
+The matrix is modc.physical.collisions.cached_matrix with the SRDF's defaults (same samples, same
 seed), so "disabled" means what the emitted SRDF says.
 
 Clearance and certified motions. A configuration is valid when every checked pair is more than
@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import Robot
+from ..physical.multibody import hull_points, obstacle_geometry
 
 DEFAULT_MARGIN = 0.005  # m kept between the arm and obstacles, and between links, while planning
 STATIC_TOLERANCE = 1e-3  # m: base_link may touch (penetrate by less than this) a fixed obstacle
@@ -54,47 +55,10 @@ class Contact:
         return f"{self.a} with {other}"
 
 
-def robot_files(robot: Robot) -> dict[str, str | bytes]:
-    """The URDF and meshes of one robot, as `modc FILE -o OUT` writes them (urdf/…, meshes/…)."""
-    from ..backends.build import Build
-    from ..backends.srdf import robot_files as srdf_robot_files
-    from ..model import Design
-
-    return srdf_robot_files(Build(Design(path=f"{robot.name}.mod", robots=(robot,))), robot)
-
-
-def obstacle_geometry(obstacle):
-    """coal geometry and pinocchio placement (in base_link) of one obstacle."""
-    import coal
-    import pinocchio as pin
-
-    from ..kinematics import rpy_matrix
-
-    s = obstacle.size
-    if obstacle.shape == "box":
-        g = coal.Box(float(s[0]), float(s[1]), float(s[2]))  # full side lengths
-    elif obstacle.shape == "sphere":
-        g = coal.Sphere(float(s[0]))
-    elif obstacle.shape == "cylinder":
-        g = coal.Cylinder(float(s[0]), float(s[1]))  # radius, full length along z
-    else:  # pragma: no cover - the model admits only the three shapes
-        raise ValueError(f"unknown obstacle shape {obstacle.shape!r}")
-    M = pin.SE3(rpy_matrix(obstacle.origin.rpy), np.array(obstacle.origin.xyz, dtype=float))
-    return g, M
-
-
 def _box_corners(geometry) -> np.ndarray:
     """The 8 corners of a geometry's bounding box in its own frame."""
-    v = _vertices(geometry)
+    v = hull_points(geometry)
     lo, hi = v.min(axis=0), v.max(axis=0)
-    return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
-
-
-def _vertices(geometry) -> np.ndarray:
-    if hasattr(geometry, "vertices"):
-        return np.asarray(geometry.vertices(), float)
-    geometry.computeLocalAABB()
-    lo, hi = np.asarray(geometry.aabb_local.min_), np.asarray(geometry.aabb_local.max_)
     return np.array([[(lo, hi)[i][0], (lo, hi)[j][1], (lo, hi)[k][2]] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
 
 
@@ -106,15 +70,18 @@ class CollisionChecker:
         import pinocchio as pin
 
         from ..physical import collisions
+        from ..physical.assembly import describe
 
         self.pin = pin
         self.robot = robot
-        files = robot_files(robot) if files is None else files
-        geo = collisions.load(files, f"urdf/{robot.file_stem}.urdf")
+        desc = describe(robot)
+        # files: the emitted URDF and meshes ({relative path: content}) to check instead of the
+        # in-memory geometry (they describe the same arm; the tests compare the two)
+        geo = collisions.geometry(desc) if files is None else collisions.load(files, f"urdf/{robot.file_stem}.urdf")
         self.geo = geo
         self.model = geo.model
         self.data = self.model.createData()
-        self.matrix = collisions.compute(geo) if matrix is None else matrix
+        self.matrix = collisions.cached_matrix(desc) if matrix is None else matrix
         self.tool_frame = self.model.getFrameId("tool0")
         names = [self.model.names[j] for j in range(1, self.model.njoints)]
         want = [f"joint_{i}" for i in range(1, robot.dof + 1)]
@@ -141,8 +108,9 @@ class CollisionChecker:
         disabled = {frozenset((p.link1, p.link2)) for p in self.matrix.disabled
                     if p.reason in ("Adjacent", "Default", "Always")}
         glinks = geo.geometry_links
-        self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:] if frozenset((a, b)) not in disabled]
-        moving = [l for l in glinks if l != "base_link"]
+        self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]
+                           if frozenset((a, b)) not in disabled]
+        moving = [name for name in glinks if name != "base_link"]
         pairs: list[tuple[int, int]] = []
         for a, b in self.self_pairs:
             pairs += [(i, j) for i in objects[a] for j in objects[b]]
@@ -198,7 +166,8 @@ class CollisionChecker:
         self.set_margin(margin)
         try:
             pin.computeCollisions(self.model, self.data, self.gm, self.gd, np.asarray(q, float), False)
-            return self._named(p for p, r in zip(self.gm.collisionPairs, self.gd.collisionResults) if r.isCollision())
+            return self._named(p for p, r in zip(self.gm.collisionPairs, self.gd.collisionResults, strict=True)
+                               if r.isCollision())
         finally:
             self.set_margin(saved)
 
@@ -209,9 +178,10 @@ class CollisionChecker:
         q = np.clip(np.zeros(self.model.nq), self.lower, self.upper)
         pin.computeCollisions(self.model, self.data, self.gm_static, self.gd_static, q, False)
         deep = []
-        for p, r in zip(self.gm_static.collisionPairs, self.gd_static.collisionResults):
+        for p, r in zip(self.gm_static.collisionPairs, self.gd_static.collisionResults, strict=True):
             # coal's penetration_depth is a signed distance: negative inside
-            if r.isCollision() and min(r.getContact(k).penetration_depth for k in range(r.numContacts())) < -STATIC_TOLERANCE:
+            depth = min((r.getContact(k).penetration_depth for k in range(r.numContacts())), default=0.0)
+            if r.isCollision() and depth < -STATIC_TOLERANCE:
                 deep.append(p)
         return self._named(deep)
 
@@ -227,8 +197,9 @@ class CollisionChecker:
 
     def clearance(self, q) -> tuple[float, Contact | None]:
         """Smallest distance over the checked pairs at q (m; a negative value means in collision,
-        not necessarily the deepest penetration), and that pair. Pairs are visited in order of a lower bound (the distance between their world
-        axis-aligned boxes) and the search stops once the bound exceeds the best distance."""
+        not necessarily the deepest penetration), and that pair. Pairs are visited in order of a
+        lower bound (the distance between their world axis-aligned boxes) and the search stops
+        once the bound exceeds the best distance."""
         pin = self.pin
         pin.updateGeometryPlacements(self.model, self.data, self.gm, self.gd, np.asarray(q, float))
         lo = np.empty((len(self.owner), 3))
@@ -237,9 +208,9 @@ class CollisionChecker:
             M = self.gd.oMg[k]
             w = corners @ np.asarray(M.rotation).T + np.asarray(M.translation)
             lo[k], hi[k] = w.min(axis=0), w.max(axis=0)
-        I = np.array([p[0] for p in self.pairs])
-        J = np.array([p[1] for p in self.pairs])
-        gap = np.maximum(0.0, np.maximum(lo[J] - hi[I], lo[I] - hi[J]))
+        first = np.array([p[0] for p in self.pairs])
+        second = np.array([p[1] for p in self.pairs])
+        gap = np.maximum(0.0, np.maximum(lo[second] - hi[first], lo[first] - hi[second]))
         bound = np.sqrt((gap ** 2).sum(axis=1))
         best, which = math.inf, None
         for k in np.argsort(bound, kind="stable"):
@@ -261,7 +232,7 @@ class CollisionChecker:
         n = model.nq
         rho = np.zeros(model.njoints)  # farthest geometry point of each joint's body, from its origin
         for go in gm.geometryObjects:
-            v = _vertices(go.geometry) @ np.asarray(go.placement.rotation).T + np.asarray(go.placement.translation)
+            v = hull_points(go.geometry) @ np.asarray(go.placement.rotation).T + np.asarray(go.placement.translation)
             rho[go.parentJoint] = max(rho[go.parentJoint], float(np.sqrt((v ** 2).sum(axis=1)).max()))
         offset = [float(np.linalg.norm(model.jointPlacements[j].translation)) for j in range(model.njoints)]
         R = np.zeros(n)
@@ -314,5 +285,4 @@ def bisection_order(n: int) -> list[int]:
     return out
 
 
-__all__ = ["DEFAULT_MARGIN", "STATIC_TOLERANCE", "CollisionChecker", "Contact", "bisection_order", "obstacle_geometry",
-           "robot_files"]
+__all__ = ["DEFAULT_MARGIN", "STATIC_TOLERANCE", "CollisionChecker", "Contact", "bisection_order", "obstacle_geometry"]

@@ -29,11 +29,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..model import Robot
+from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
 from .contacts import CollisionQueries
 
-TARGET_RADIUS = 0.012  # m, the visual-only sphere marking a target
-OBSTACLE_RGBA = (0.62, 0.70, 0.78, 1.0)
-TARGET_RGBA = (0.86, 0.12, 0.22, 1.0)
 GRAVITY = 9.81  # m/s², the value modc.dynamics uses
 
 
@@ -61,18 +59,24 @@ def select_robots(checked, robot: str | None = None) -> list[Robot]:
     return list(checked.design.robots) if robot is None else [choose_robot(checked.design, robot)]
 
 
+# what an engine loads: the backends to run, then the folder and suffix of the per-robot model
+MODELS = {"urdf": (("urdf", "meshes"), "urdf", ".urdf"), "mjcf": (("urdf", "meshes", "mjcf"), "mjcf", ".xml")}
+
+
 @contextlib.contextmanager
-def compiled(checked) -> Iterator[dict[str, Path]]:
-    """The urdf and meshes backends' output written into a temporary directory (removed on exit):
-    robot name -> URDF path. The same bytes `modc FILE -o OUT` writes."""
+def compiled(checked, model: str = "urdf") -> Iterator[dict[str, Path]]:
+    """The backends' output for one model kind (MODELS: the URDF and its meshes, or the MJCF)
+    written into a temporary directory (removed on exit): robot name -> model path. The same
+    bytes `modc FILE -o OUT` writes."""
     from ..compiler import build
     from ..files import write_files
 
-    files = build(checked, ["urdf", "meshes"])
+    backends, folder, suffix = MODELS[model]
+    files = build(checked, list(backends))
     with tempfile.TemporaryDirectory(prefix="modc-sim-") as tmp:
         root = Path(tmp)
         write_files(files, root)
-        yield {r.name: root / "urdf" / f"{r.file_stem}.urdf" for r in checked.design.robots}
+        yield {r.name: root / folder / f"{r.file_stem}{suffix}" for r in checked.design.robots}
 
 
 # ------------------------------------------------------------------------------------------------

@@ -51,11 +51,13 @@ from pathlib import Path
 from . import scene
 from .contacts import srdf_disabled_pairs
 from .verdict import (  # noqa: F401  (the tolerances are part of this module's story)
+    EXPLODE_VELOCITY,
     FK_POS_TOL,
     FK_ROT_TOL,
     TRACK_TOL,
     Failure,
     Hold,
+    HoldRecorder,
     Measured,
     RobotResult,
     describe,
@@ -65,7 +67,6 @@ from .verdict import (  # noqa: F401  (the tolerances are part of this module's 
 TIME_STEP = 1e-3  # s
 HOLD_TIME = 2.0  # s of simulated time per pose
 SETTLE_WINDOW = 0.5  # s: tracking is judged over the end of the hold
-EXPLODE_VELOCITY = 50.0  # rad/s: no falling module comes near this; beyond it the simulation diverged
 WARNING_LINE = re.compile(r"warning|error|failed|cannot|unable", re.IGNORECASE)
 
 
@@ -155,33 +156,12 @@ def measure_pose(client, s, name: str, q, allowed, steps: int, window: int, time
 
 
 def _hold(client, s, qv, steps: int, window: int, time_step: float) -> Hold:
-    import numpy as np
-
-    n = len(qv)
-    worst = np.zeros(n)  # over the settle window
-    peak = np.zeros(n)  # over the whole hold
-    tau_sum, tau_n = np.zeros(n), 0  # applied torques, averaged over the settle window
-    vmax, diverged = 0.0, None
+    rec = HoldRecorder(qv, s.joint_names, steps, window, time_step)
     for k in range(steps):
         client.stepSimulation()
-        late = k >= steps - window
-        if late or k % 10 == 0:
-            qk, qdk = s.q(), s.qd()
-            if not (np.all(np.isfinite(qk)) and np.all(np.isfinite(qdk))):
-                diverged = f"joint states became NaN after {k * time_step:.3f} s"
-                break
-            vmax = max(vmax, float(np.abs(qdk).max()))
-            peak = np.maximum(peak, np.abs(qk - qv))
-            if vmax > EXPLODE_VELOCITY:
-                j = int(np.argmax(np.abs(qdk)))
-                diverged = f"{s.joint_names[j]} reached {abs(qdk[j]):.0f} rad/s after {k * time_step:.3f} s"
-                break
-            if late:
-                worst = np.maximum(worst, np.abs(qk - qv))
-                tau_sum += s.applied_torques()
-                tau_n += 1
-    return Hold(worst=worst, peak=peak, max_velocity=vmax, diverged=diverged, applied=tau_sum / max(tau_n, 1),
-                q_end=s.q(), tau_end=s.applied_torques(), efforts=tuple(s.limits[j][2] for j in s.joint_names))
+        if rec.wants(k) and not rec.sample(k, s.q(), s.qd(), s.applied_torques()):
+            break
+    return rec.hold(s.q(), s.applied_torques(), [s.limits[j][2] for j in s.joint_names])
 
 
 def allowed_from_srdf(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
@@ -202,9 +182,15 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
     return results
 
 
+ENGINES = ("pybullet", "mujoco")  # the first is the default
+
+
 def run_sim(path, library: str | None = None, robot: str | None = None, out_dir: str | Path | None = None,
-            hold_time: float = HOLD_TIME):
-    """`modc sim FILE`. Returns (ok, report lines, checked).
+            hold_time: float = HOLD_TIME, engine: str = ENGINES[0]):
+    """`modc sim FILE [--engine E]`. Returns (ok, report lines, checked).
+
+    engine: "pybullet" (this module) or "mujoco" (mujoco_engine.py, on the compiled MJCF); the
+    checks and messages are verdict.py's either way. Raises scene.UsageError for another name.
 
     checked: the modc.compiler.Checked of the file (its .diagnostics and .sources are for the
     caller to print). When it has errors nothing is simulated: (False, [], checked).
@@ -212,10 +198,17 @@ def run_sim(path, library: str | None = None, robot: str | None = None, out_dir:
     Raises modc.compiler.InputError (unreadable file) and modc.model.select.RobotChoiceError
     (unknown robot).
     """
+    if engine not in ENGINES:
+        raise scene.UsageError(f"unknown engine '{engine}' (choose from {', '.join(ENGINES)})")
     checked = scene.load_checked(path, library)
     if not checked.ok:
         return False, [], checked
-    results = simulate(checked, robot, out_dir, hold_time)
+    if engine == "mujoco":
+        from . import mujoco_engine
+
+        results = mujoco_engine.simulate(checked, robot, out_dir, hold_time)
+    else:
+        results = simulate(checked, robot, out_dir, hold_time)
     lines = [line for r in results for line in describe(r)]
     failures = sum(len(r.all_failures) for r in results)
     poses = sum(len(r.poses) for r in results)

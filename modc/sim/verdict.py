@@ -5,6 +5,9 @@ PyBullet; another engine fills the same Measured and gets the same checks and me
     result = judge_pose(robot, measured, Chain(robot), Dynamics(robot), engine="PyBullet")
     lines = describe(RobotResult(robot.name, robot.sequence, poses=[result, ...]))
 
+An engine's hold loop keeps its books with a HoldRecorder (sampling, divergence, the settle
+window), which makes the Measured's Hold.
+
 The checks and their tolerances are explained in smoke.py's docstring.
 """
 from __future__ import annotations
@@ -81,6 +84,54 @@ class Measured:
     self_contacts: list
     environment_contacts: list
     hold: Hold
+
+
+SAMPLE_EVERY = 10  # steps between samples before the settle window (every step within it)
+EXPLODE_VELOCITY = 50.0  # rad/s: no falling module comes near this; beyond it the simulation diverged
+
+
+class HoldRecorder:
+    """What an engine's hold loop records, the same for every engine: call step(k) for each
+    step k of `steps`; when it says so, sample(k, q, qd, tau) (False: the simulation diverged,
+    stop); then hold(q_end, tau_end, efforts)."""
+
+    def __init__(self, target, joint_names: list[str], steps: int, window: int, time_step: float):
+        import numpy as np
+
+        n = len(target)
+        self.target, self.joint_names, self.time_step = np.asarray(target, dtype=float), joint_names, time_step
+        self.late_from = steps - window
+        self.worst, self.peak = np.zeros(n), np.zeros(n)  # over the settle window / the whole hold
+        self.tau_sum, self.tau_n = np.zeros(n), 0  # applied torques over the settle window
+        self.vmax = 0.0
+        self.diverged: str | None = None
+
+    def wants(self, k: int) -> bool:
+        return k >= self.late_from or k % SAMPLE_EVERY == 0
+
+    def sample(self, k: int, q, qd, tau) -> bool:
+        import numpy as np
+
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+            self.diverged = f"joint states became NaN after {k * self.time_step:.3f} s"
+            return False
+        error = np.abs(np.asarray(q) - self.target)
+        self.vmax = max(self.vmax, float(np.abs(qd).max()))
+        self.peak = np.maximum(self.peak, error)
+        if self.vmax > EXPLODE_VELOCITY:
+            j = int(np.argmax(np.abs(qd)))
+            self.diverged = f"{self.joint_names[j]} reached {abs(qd[j]):.0f} rad/s after {k * self.time_step:.3f} s"
+            return False
+        if k >= self.late_from:
+            self.worst = np.maximum(self.worst, error)
+            self.tau_sum += tau
+            self.tau_n += 1
+        return True
+
+    def hold(self, q_end, tau_end, efforts) -> Hold:
+        return Hold(worst=self.worst, peak=self.peak, max_velocity=self.vmax, diverged=self.diverged,
+                    applied=self.tau_sum / max(self.tau_n, 1), q_end=q_end, tau_end=tau_end,
+                    efforts=tuple(float(e) for e in efforts))
 
 
 def _deg(x: float) -> str:
@@ -170,5 +221,5 @@ def describe(res: RobotResult) -> list[str]:
     return lines
 
 
-__all__ = ["FK_POS_TOL", "FK_ROT_TOL", "SATURATION", "TORQUE_REL", "TORQUE_TOL", "TRACK_TOL", "Failure", "Hold",
-           "Measured", "PoseResult", "RobotResult", "describe", "judge_pose"]
+__all__ = ["EXPLODE_VELOCITY", "FK_POS_TOL", "FK_ROT_TOL", "SATURATION", "TORQUE_REL", "TORQUE_TOL", "TRACK_TOL",
+           "Failure", "Hold", "HoldRecorder", "Measured", "PoseResult", "RobotResult", "describe", "judge_pose"]

@@ -9,6 +9,13 @@ from typing import Annotated, Union
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from ..names import IDENTIFIER, MAX_NAME
+
+# Names are checked while lowering (invalid-name, one rule for both forms); the schema states the rule.
+_NAME_SCHEMA = {"pattern": f"^{IDENTIFIER}$", "maxLength": MAX_NAME}
+Name = Annotated[str, Field(json_schema_extra=_NAME_SCHEMA)]
+_KEYS = {"propertyNames": _NAME_SCHEMA}
+
 Quantity = Annotated[Union[str, float], Field(description='a number with its unit, as in .mod: "45deg", "0.22 m", "500 g"')]
 Vector = Annotated[str, Field(description='a parenthesised tuple with one unit, as in .mod: "(0.3, 0, 0.25) m"')]
 
@@ -35,20 +42,20 @@ class PayloadDoc(_Doc):
 
 
 class BoxDoc(_Doc):
-    box: str = Field(description="obstacle name")
+    box: Name = Field(description="obstacle name")
     size: Vector
     at: Vector
     rpy: Vector | None = None
 
 
 class SphereDoc(_Doc):
-    sphere: str
+    sphere: Name
     radius: Quantity
     at: Vector
 
 
 class CylinderDoc(_Doc):
-    cylinder: str
+    cylinder: Name
     radius: Quantity
     length: Quantity
     at: Vector
@@ -56,16 +63,19 @@ class CylinderDoc(_Doc):
 
 
 class RobotDoc(_Doc):
-    name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    name: Name
     library: str | None = Field(None, description="built-in library name, or a path to a library YAML file")
     chain: list[Union[str, UnitItem]] = Field(description='units base first: "H1", "H4(pivot=-90deg)" or {unit: H4, pivot: -90deg}')
     base: PlacementDoc | None = None
     tool: PlacementDoc | None = None
     payload: PayloadDoc | None = None
-    poses: dict[str, Vector] = Field(default_factory=dict, description='name -> joint angles, e.g. home: "(0, 30, -45) deg"')
-    limits: dict[str, Vector] = Field(default_factory=dict, description='joint name -> "(lower, upper) deg"')
+    poses: dict[str, Vector] = Field(default_factory=dict, description='name -> joint angles, e.g. home: "(0, 30, -45) deg"',
+                                     json_schema_extra=_KEYS)
+    limits: dict[str, Vector] = Field(default_factory=dict, description='joint name -> "(lower, upper) deg"',
+                                      json_schema_extra=_KEYS)
     obstacles: list[Union[BoxDoc, SphereDoc, CylinderDoc]] = Field(default_factory=list)
-    targets: dict[str, Vector] = Field(default_factory=dict, description='name -> position of tool0 in base_link')
+    targets: dict[str, Vector] = Field(default_factory=dict, description='name -> position of tool0 in base_link',
+                                       json_schema_extra=_KEYS)
     allow: list[str] = Field(default_factory=list, description="assembly-rule codes to silence, e.g. first-variant")
 
 
