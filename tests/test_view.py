@@ -19,7 +19,7 @@ import pytest
 from modc.compiler import check_file
 from modc.dynamics.model import Dynamics
 from modc.kinematics import Chain
-from modc.view.arm import Arm, stl_triangles
+from modc.view.arm import Arm
 from modc.view.page import Page, Ranking, Source, ViewError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -69,15 +69,20 @@ def test_shapes_are_the_urdf_meshes_placed_on_their_links():
     assert bar.vertices[:, 0].max() - bar.vertices[:, 0].min() == pytest.approx(0.18, abs=1e-6)
 
 
-def test_stl_reader_reads_what_trimesh_writes():
-    import trimesh
+def test_shapes_are_the_stl_triangles_the_urdf_ships():
+    from modc.physical.meshes import stl_bytes
 
-    m = trimesh.creation.box(extents=(1, 2, 3))
-    tri = stl_triangles(trimesh.exchange.stl.export_stl(m))
-    assert tri.shape == (12, 3, 3)
-    corners = np.unique(tri.reshape(-1, 3).round(9), axis=0)
-    assert np.allclose(corners, np.unique(m.vertices.round(9), axis=0))
-    assert np.abs(tri).max(axis=(0, 1)).tolist() == pytest.approx([0.5, 1.0, 1.5])
+    arm = Arm(_robot())
+    link = next(link for link in arm.description.links if link.name == "link_1")
+    shape = next(s for s in arm.shapes() if s.link == "link_1")
+    v = link.visuals[0]
+    data = stl_bytes(v.part)
+    n = int(np.frombuffer(data, "<u4", 1, 80)[0])
+    rec = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    tri = np.frombuffer(data, rec, n, 84)["v"].astype(np.float64)
+    tri[..., 0] *= v.part.scale_x
+    tri = tri @ v.T_link_part[:3, :3].T + v.T_link_part[:3, 3]
+    assert np.allclose(shape.vertices[shape.faces], tri, atol=1e-6)
 
 
 def test_torques_are_pinocchio_gravity_against_the_actuators():

@@ -2,7 +2,8 @@
 values q, tool0, and the gravity torque of each joint against its actuator.
 
 Geometry comes from the in-memory physical model (physical.assembly.describe) and the same
-part meshes the URDF ships (physical.meshes), so the page shows exactly what modc emits.
+part tessellation the URDF's STL files are written from (physical.meshes.tessellate), so the page
+shows exactly what modc emits.
 Frames: obstacles, targets and tool0 are in base_link (as the file gives them); the page puts
 base_link at robot.base in the cell frame (T_world_base), as `modc sim` does.
 """
@@ -16,7 +17,7 @@ import numpy as np
 from ..kinematics import Rz, homogeneous, transform
 from ..model import Robot
 from ..physical.assembly import describe
-from ..physical.meshes import stl_bytes
+from ..physical.meshes import tessellate
 from ..physical.parts import Part
 
 if TYPE_CHECKING:
@@ -35,13 +36,6 @@ def part_rgb(part: Part) -> tuple[int, int, int]:
 
     r, g, b, _ = MATERIALS.get(part.color, (0.6, 0.6, 0.6, 1.0))
     return (round(r * 255), round(g * 255), round(b * 255))
-
-
-def stl_triangles(data: bytes) -> np.ndarray:
-    """Binary STL -> (n, 3, 3) float32 triangle corners (normals are recomputed by the viewer)."""
-    (n,) = np.frombuffer(data, dtype="<u4", count=1, offset=80)
-    rec = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
-    return np.frombuffer(data, dtype=rec, count=int(n), offset=84)["v"].copy()
 
 
 @dataclass(frozen=True)
@@ -70,11 +64,11 @@ class JointTorque:
 
 
 def _shape(link: str, k: int, part: Part, T_link_part: np.ndarray) -> Shape:
-    tri = stl_triangles(stl_bytes(part)).reshape(-1, 3).astype(np.float64)
-    tri[:, 0] *= part.scale_x  # link bars are meshed 1 m long, as the URDF scales them
-    v = (T_link_part[:3, :3] @ tri.T).T + T_link_part[:3, 3]
-    faces = np.arange(len(v), dtype=np.uint32).reshape(-1, 3)
-    return Shape(link, f"{part.mesh}_{k}", v.astype(np.float32), faces, part_rgb(part))
+    vertices, faces, _ = tessellate(part)  # the URDF's mesh of the part (normals: the viewer's own)
+    v = np.array(vertices, dtype=np.float64)
+    v[:, 0] *= part.scale_x  # link bars are meshed 1 m long, as the URDF scales them
+    v = v @ T_link_part[:3, :3].T + T_link_part[:3, 3]
+    return Shape(link, f"{part.mesh}_{k}", v.astype(np.float32), np.asarray(faces, dtype=np.uint32), part_rgb(part))
 
 
 class Arm:
