@@ -22,6 +22,7 @@ from .arm import OBSTACLE_RGB, TARGET_RADIUS, TARGET_RGB, Arm
 from .page import Page
 
 CAMERA_DISTANCE = 2.0  # bounding-sphere radii, so the scene fills the view beside the control panel
+PANEL_TEXT = "padding:0 0.75em;font-size:0.9em"  # HTML blocks aligned with viser's own panel text
 TICK = 0.05  # s between looks at the file and playback steps: a saved file shows well within a second
 
 
@@ -90,7 +91,7 @@ class View:
         self._generation = (page.index, page.source.generation)
         who = (f"robot <code>{html.escape(arm.robot.name)}</code>: {html.escape(arm.robot.sequence)}" if arm is not None
                else "no good arm yet")
-        self._title.content = f"<b>{html.escape(page.caption)}</b><br>{who}"
+        self._title.content = f'<div style="{PANEL_TEXT}"><b>{html.escape(page.caption)}</b><br>{who}</div>'
         self._show_diagnostics()
         if arm is None:
             return
@@ -120,7 +121,7 @@ class View:
             self._nodes.append(self._links[link.name])
         for s in arm.shapes():
             name = f"{base}/{s.link}/{s.name}"
-            self._nodes.append(scene.add_mesh_simple(name, s.vertices, s.faces, color=s.rgb))
+            self._nodes.append(scene.add_mesh_simple(name, s.vertices, s.faces, color=s.rgb, flat_shading=True))
         self._camera(arm)
 
         joints = gui.add_folder("Joints")
@@ -176,8 +177,9 @@ class View:
         self._diagnostics = text
         errors, arm = self.page.source.errors, self.page.arm
         head = "errors: showing the last good arm" if errors and arm is not None else "errors" if errors else "warnings"
-        self._errors.content = (f'<b style="color:#b42318">{head}</b><pre style="white-space:pre-wrap;font-size:0.72em;'
-                                f'margin:4px 0">{html.escape(text)}</pre>') if text else ""
+        pre = '<pre style="white-space:pre-wrap;font-size:0.72em;margin:4px 0">'
+        self._errors.content = (f'<div style="{PANEL_TEXT}"><b style="color:#b42318">{head}</b>{pre}{html.escape(text)}'
+                                '</pre></div>') if text else ""
         self._errors.visible = bool(text)
         self.server.flush()
 
