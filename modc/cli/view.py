@@ -1,0 +1,57 @@
+"""`modc view`: a live 3D view of the arm in the browser."""
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+from .app import EXIT_OK, LibraryOpt, _err, app, usage_errors
+
+
+def _open_browser(url: str) -> bool:
+    """Open the page in the user's browser. On Linux without a display, Python's webbrowser would
+    fall back to a text browser that takes over the terminal: don't try."""
+    import os
+    import sys
+    import webbrowser
+
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        return False
+    return webbrowser.open(url)
+
+
+@app.command("view")
+def view_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form), or the ranking.json of `modc design`")],
+    port: Annotated[int, typer.Option(min=0, max=65535, help="local port of the page (0: any free one)")] = 8080,
+    no_browser: Annotated[bool, typer.Option("--no-browser", help="only print the page's address")] = False,
+    traj: Annotated[str | None, typer.Option("--traj", help="trajectory JSON to play (`modc plan --json`)")] = None,
+    robot: Annotated[str | None, typer.Option(help="the robot to show (files with several robots)")] = None,
+    library: LibraryOpt = None,
+):
+    """Live 3D view in the browser: the arm in its cell with its targets, a slider per joint, the
+    named poses, tool0 and each joint's gravity torque against its actuator, trajectory playback.
+    Saving the file updates the page; an error shows its diagnostics and keeps the last good arm.
+    Ctrl-C stops it."""
+    from ..view.page import Page, Ranking, Source, ViewError, read_trajectory
+    from ..view.server import ServeError, run, start
+
+    with usage_errors("view", (ViewError, ServeError)):
+        if file.endswith(".json"):
+            if traj is not None:
+                raise ViewError("--traj plays on one file, not on a ranking")
+            page = Page.for_ranking(Ranking(file), library=library)
+        else:
+            source = Source(file, robot=robot, library=library, traj=read_trajectory(traj) if traj else None)
+            source.load(strict=True)
+            page = Page([source])
+        if page.source.diagnostics:
+            _err(page.source.diagnostics)
+        server, view = start(page, port=port)
+    url = f"http://127.0.0.1:{server.get_port()}/"
+    print(f"modc view: {url}  (Ctrl-C stops)", flush=True)
+    if not no_browser and not _open_browser(url):
+        _err("modc view: no display to open a browser on; open the address above yourself")
+    run(view)
+    print("modc view: stopped")
+    raise typer.Exit(EXIT_OK)

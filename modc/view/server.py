@@ -1,0 +1,292 @@
+"""The page itself, drawn with viser (a maintained 3D web viewer whose built web client ships in
+its wheel: everything is served from this process, nothing is fetched from the internet).
+
+Scene tree: /armN (N counts the arms shown) is base_link, at T_world_base; under it the cell
+(obstacles, targets) and one node per link, moved as the joints move; the part meshes hang under
+their link nodes. The GUI (right-hand panel) is rebuilt whenever a new arm comes in; values set from Python fire viser's
+callbacks with no client, which the handlers ignore.
+"""
+from __future__ import annotations
+
+import contextlib
+import html
+import io
+import math
+import threading
+import time
+
+import numpy as np
+
+from ..kinematics import transform
+from .arm import OBSTACLE_RGB, TARGET_RADIUS, TARGET_RGB, Arm
+from .page import Page
+
+CAMERA_DISTANCE = 2.0  # bounding-sphere radii, so the scene fills the view beside the control panel
+PANEL_TEXT = "padding:0 0.75em;font-size:0.9em"  # HTML blocks aligned with viser's own panel text
+TICK = 0.05  # s between looks at the file and playback steps: a saved file shows well within a second
+
+
+def _wxyz(T: np.ndarray) -> np.ndarray:
+    from viser.transforms import SO3
+
+    return SO3.from_matrix(T[:3, :3]).wxyz
+
+
+def torque_table(arm: Arm, q) -> str:
+    """HTML of the gravity torque of each joint: a bar of |τ| / τmax coloured by level, with a
+    tick at τnom."""
+    rows = []
+    for j in arm.torques(q):
+        r, g, b = j.rgb
+        share = min(abs(j.tau) / j.tau_max, 1.0) * 100
+        bar = (f'<div style="position:relative;background:#ddd;height:10px">'
+               f'<div style="width:{share:.0f}%;height:10px;background:rgb({r},{g},{b})">'
+               f'</div><div style="position:absolute;top:-2px;left:{j.tau_nom / j.tau_max * 100:.0f}%;width:2px;'
+               f'height:14px;background:#444"></div></div>')
+        rows.append(f'<tr data-level="{j.level}"><td>{html.escape(j.name)} ({html.escape(j.unit)})</td>'
+                    f'<td style="text-align:right;padding-right:8px">{round(j.tau, 2) + 0.0:+.2f}</td>'
+                    f'<td>{j.tau_nom:g} / {j.tau_max:g}</td><td style="width:30%">{bar}</td></tr>')
+    return ('<table style="width:100%;font-size:0.8em;border-collapse:collapse">'
+            '<tr><th align="left">joint</th><th align="right" style="padding-right:8px">τ N·m</th>'
+            '<th align="left">τnom / τmax</th><th></th></tr>' + "".join(rows) + "</table>")
+
+
+class View:
+    def __init__(self, server, page: Page):
+        self.server = server
+        self.page = page
+        self.lock = threading.RLock()
+        self._generation = (-1, -1)  # (design index, arm generation) on show
+        self._diagnostics: str | None = None
+        self._nodes: list = []
+        self._shown = 0
+        self._gui: list = []
+        self._links: dict = {}
+        self._sliders: list = []
+        gui = server.gui
+        server.scene.set_up_direction("+z")
+        server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1, section_size=0.5)
+        self._title = gui.add_html("")  # HTML, escaped: file names and ranking.json text are the user's
+        if len(page.sources) > 1:
+            prev, nxt = gui.add_button("◀ previous design"), gui.add_button("next design ▶")
+            prev.on_click(lambda e: self._go(-1))
+            nxt.on_click(lambda e: self._go(+1))
+        self._errors = gui.add_html("", visible=False)
+        self._rebuild()
+
+    # -- building -----------------------------------------------------------------------------
+
+    def _clear(self) -> None:
+        for h in self._nodes[:1] + self._gui:  # the arm's root node takes everything under it along
+            h.remove()
+        self._nodes, self._gui, self._links, self._sliders = [], [], {}, []
+
+    def _rebuild(self) -> None:
+        self._build()
+        self.server.flush()
+
+    def _build(self) -> None:
+        page, arm = self.page, self.page.arm
+        self._clear()
+        self._generation = (page.index, page.source.generation)
+        who = (f"robot <code>{html.escape(arm.robot.name)}</code>: {html.escape(arm.robot.sequence)}" if arm is not None
+               else "no good arm yet")
+        self._title.content = f'<div style="{PANEL_TEXT}"><b>{html.escape(page.caption)}</b><br>{who}</div>'
+        self._show_diagnostics()
+        if arm is None:
+            return
+        scene, gui = self.server.scene, self.server.gui
+        T = arm.T_world_base
+        self._shown += 1
+        base = f"/arm{self._shown}"  # fresh names for every arm: browsers never see a name removed and re-added
+        self._nodes.append(scene.add_frame(base, show_axes=False, position=T[:3, 3], wxyz=_wxyz(T)))
+        for ob in arm.robot.obstacles:
+            T_ob = transform(ob.origin.xyz, ob.origin.rpy)
+            kw = dict(color=OBSTACLE_RGB, opacity=0.6, position=T_ob[:3, 3], wxyz=_wxyz(T_ob))
+            name = f"{base}/cell/{ob.name}"
+            if ob.shape == "box":
+                h = scene.add_box(name, dimensions=tuple(ob.size), **kw)
+            elif ob.shape == "sphere":
+                h = scene.add_icosphere(name, radius=ob.size[0], **kw)
+            else:
+                h = scene.add_cylinder(name, radius=ob.size[0], height=ob.size[1], **kw)
+            self._nodes.append(h)
+        for t in arm.robot.targets:
+            name = f"{base}/targets/{t.name}"
+            self._nodes.append(scene.add_icosphere(name, radius=TARGET_RADIUS, color=TARGET_RGB, position=tuple(t.xyz)))
+            self._nodes.append(scene.add_label(f"{name}/label", t.name, position=(0.0, 0.0, 0.03)))
+        for link in arm.description.links:
+            self._links[link.name] = scene.add_frame(f"{base}/{link.name}", show_axes=link.name == "tool0",
+                                                     axes_length=0.05, axes_radius=0.003)
+            self._nodes.append(self._links[link.name])
+        for s in arm.shapes():
+            name = f"{base}/{s.link}/{s.name}"
+            self._nodes.append(scene.add_mesh_simple(name, s.vertices, s.faces, color=s.rgb, flat_shading=True))
+        self._camera(arm)
+
+        joints = gui.add_folder("Joints")
+        self._gui.append(joints)
+        with joints:
+            for i, (name, (lo, hi)) in enumerate(zip(arm.joint_names, arm.limits, strict=True)):
+                unit = arm.robot.units[i].name
+                s = gui.add_slider(f"{name} ({unit}) °", min=round(math.degrees(lo), 1), max=round(math.degrees(hi), 1),
+                                   step=0.1, initial_value=round(math.degrees(page.q[i]), 1))
+                s.on_update(self._on_slider(i))
+                self._sliders.append(s)
+        poses = gui.add_folder("Poses")
+        self._gui.append(poses)
+        with poses:
+            for name, _ in arm.poses:
+                b = gui.add_button(name)
+                b.on_click(self._on_pose(name))
+        readout = gui.add_folder("tool0 and torques")
+        self._gui.append(readout)
+        with readout:
+            self._tool = gui.add_markdown("")
+            self._torques = gui.add_html("")
+        if page.source.trajectory is not None:
+            traj = page.source.trajectory
+            play = gui.add_folder("Trajectory")
+            self._gui.append(play)
+            with play:
+                run, stop = gui.add_button("play"), gui.add_button("pause")
+                self._time = gui.add_slider("t (s)", min=0.0, max=round(traj.t[-1], 3), step=0.01, initial_value=0.0)
+                run.on_click(lambda e: self._locked(page.play))
+                stop.on_click(lambda e: self._locked(page.pause))
+                self._time.on_update(self._on_time)
+        self._move()
+
+    def _camera(self, arm: Arm) -> None:
+        """New browsers look at what `modc render` frames (the arm at home, its cell and targets)
+        from render's canonical view (front left, above, as RViz's default orbit camera)."""
+        from ..sim.render import VIEWS
+        from ..sim.scene import extent_points
+
+        pts = extent_points(arm.robot, arm.poses[0][1], arm.T_world_base)
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        centre, radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.2)
+        az, el = (math.radians(a) for a in VIEWS[0])
+        direction = np.array((math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)))
+        self.server.initial_camera.look_at = tuple(centre)
+        self.server.initial_camera.position = tuple(centre + direction * CAMERA_DISTANCE * radius)
+
+    def _show_diagnostics(self) -> None:
+        text = self.page.source.diagnostics
+        if text == self._diagnostics:
+            return
+        self._diagnostics = text
+        errors, arm = self.page.source.errors, self.page.arm
+        head = "errors: showing the last good arm" if errors and arm is not None else "errors" if errors else "warnings"
+        pre = '<pre style="white-space:pre-wrap;font-size:0.72em;margin:4px 0">'
+        self._errors.content = (f'<div style="{PANEL_TEXT}"><b style="color:#b42318">{head}</b>{pre}{html.escape(text)}'
+                                '</pre></div>') if text else ""
+        self._errors.visible = bool(text)
+        self.server.flush()
+
+    def _show_pose(self) -> None:
+        with self.server.atomic():  # every link moves in the same frame
+            self._move()
+        self.server.flush()
+
+    def _move(self) -> None:
+        page, arm = self.page, self.page.arm
+        if arm is None:
+            return
+        for name, T in arm.link_poses(page.q).items():
+            if name in self._links:
+                self._links[name].position = T[:3, 3]
+                self._links[name].wxyz = _wxyz(T)
+        for s, x in zip(self._sliders, page.q, strict=True):
+            s.value = round(math.degrees(x), 1)
+        x, y, z = arm.tool0(page.q)
+        self._tool.content = f"tool0 in base_link: ({x:.4f}, {y:.4f}, {z:.4f}) m"
+        self._torques.content = torque_table(arm, page.q)
+        if page.source.trajectory is not None:
+            self._time.value = round(page.t, 3)
+
+    # -- events -------------------------------------------------------------------------------
+
+    def _locked(self, action) -> None:
+        with self.lock:
+            action()
+            self._show_pose()
+
+    def _on_slider(self, i: int):
+        def handler(event) -> None:
+            if event.client is None:  # our own update of the slider
+                return
+            self._locked(lambda: self.page.set_joint(i, math.radians(event.target.value)))
+        return handler
+
+    def _on_pose(self, name: str):
+        return lambda event: self._locked(lambda: self.page.go_pose(name))
+
+    def _on_time(self, event) -> None:
+        if event.client is not None:
+            self._locked(lambda: self.page.seek(event.target.value, stop=True))
+
+    def _go(self, delta: int) -> None:
+        with self.lock:
+            self.page.go(delta)
+            self._rebuild()
+
+    def step(self, dt: float) -> None:
+        """Look at the file and move playback on; called every TICK by run()."""
+        with self.lock:
+            self.page.poll()
+            if self._generation != (self.page.index, self.page.source.generation):
+                self._rebuild()
+            else:
+                self._show_diagnostics()
+                if self.page.tick(dt):
+                    self._show_pose()
+
+
+class ServeError(OSError):
+    """The page cannot be served: the port is taken, or viser is not installed (exit 2)."""
+
+
+def check_port(host: str, port: int) -> None:
+    """viser moves to the next free port when one is taken; the user asked for this one."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind((host, port))
+        except OSError as e:
+            raise ServeError(f"port {port} on {host} is busy ({e.strerror or e}); choose another with --port") from None
+
+
+def start(page: Page, host: str = "127.0.0.1", port: int = 8080):
+    """A running viser server showing the page; returns (server, view). port 0: any free port."""
+    try:
+        import viser
+    except ImportError:
+        raise ServeError("modc view needs the viser package: pip install viser") from None
+
+    if port:
+        check_port(host, port)
+    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner; modc prints the address itself
+        server = viser.ViserServer(host=host, port=port, label="modc view", verbose=False)
+    server.gui.configure_theme(show_share_button=False, control_width="large")  # the share link would leave the machine
+    if port and server.get_port() != port:  # taken between the check and the bind
+        server.stop()
+        raise ServeError(f"port {port} on {host} is busy; choose another with --port")
+    return server, View(server, page)
+
+
+def run(view: View, stop: threading.Event | None = None) -> None:
+    """Serve until Ctrl-C (or `stop` is set)."""
+    last = time.monotonic()
+    try:
+        while stop is None or not stop.is_set():
+            time.sleep(TICK)
+            now = time.monotonic()
+            view.step(now - last)
+            last = now
+    except KeyboardInterrupt:
+        pass
+    finally:
+        with contextlib.redirect_stdout(io.StringIO()):
+            view.server.stop()

@@ -1,0 +1,349 @@
+"""`modc view` without a browser: the page model (joints -> FK and torques, poses, playback,
+re-checking the file on save, paging a ranking) and the command line around the server."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modc.compiler import check_file
+from modc.dynamics.model import Dynamics
+from modc.kinematics import Chain
+from modc.view.arm import Arm
+from modc.view.page import Page, Ranking, Source, ViewError
+
+ROOT = Path(__file__).resolve().parent.parent
+FARM = ROOT / "examples" / "farm.mod"
+
+GOOD = ("robot arm {\n    chain H1 - L4(port=45deg) - L1\n    pose ready (30, -40, 60) deg\n"
+        "    target p at (0.2, 0, 0.3) m\n}\n")
+LONGER = "robot arm {\n    chain H1 - L4(port=45deg) - L3 - L1\n}\n"
+BROKEN = "robot arm {\n    chain H1 - L4(port=45deg - L1\n}\n"
+
+
+def _robot(path=FARM):
+    c = check_file(path)
+    assert c.ok
+    return c.design.robots[0]
+
+
+def _write(path: Path, text: str) -> None:
+    """Write and move the mtime on, so a poll sees the change even within the clock's resolution."""
+    before = path.stat().st_mtime_ns if path.exists() else 0
+    path.write_text(text, encoding="utf-8")
+    st = path.stat()
+    os.utime(path, ns=(st.st_atime_ns, max(st.st_mtime_ns, before + 1_000_000)))
+
+
+def test_link_poses_follow_the_kinematics():
+    robot = _robot()
+    arm, chain = Arm(robot), Chain(robot)
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        q = [rng.uniform(lo, hi) for lo, hi in arm.limits]
+        assert np.allclose(arm.tool0(q), chain.T_base_tool(q)[:3, 3], atol=1e-12)
+        T = arm.link_poses(q)
+        for i, f in enumerate(chain.frames(q)):
+            assert np.allclose(T[f"link_{i + 1}"], f["T_base_joint"], atol=1e-12)
+
+
+def test_shapes_are_the_urdf_meshes_placed_on_their_links():
+    arm = Arm(_robot())
+    shapes = arm.shapes()
+    assert len(shapes) == sum(len(link.visuals) for link in arm.description.links)
+    assert {s.link for s in shapes} == {"base_link", "link_1", "link_2", "link_3"}
+    for s in shapes:
+        assert s.faces.max() < len(s.vertices) and len(s.faces) > 10
+    # the 180 mm link bar of the last unit is the 1 m mesh scaled to its length
+    bar = next(s for s in shapes if s.link == "link_3" and s.name.startswith("link_"))
+    assert bar.vertices[:, 0].max() - bar.vertices[:, 0].min() == pytest.approx(0.18, abs=1e-6)
+
+
+def test_shapes_are_the_stl_triangles_the_urdf_ships():
+    from modc.physical.meshes import stl_bytes
+
+    arm = Arm(_robot())
+    link = next(link for link in arm.description.links if link.name == "link_1")
+    shape = next(s for s in arm.shapes() if s.link == "link_1")
+    v = link.visuals[0]
+    data = stl_bytes(v.part)
+    n = int(np.frombuffer(data, "<u4", 1, 80)[0])
+    rec = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    tri = np.frombuffer(data, rec, n, 84)["v"].astype(np.float64)
+    tri[..., 0] *= v.part.scale_x
+    tri = tri @ v.T_link_part[:3, :3].T + v.T_link_part[:3, 3]
+    assert np.allclose(shape.vertices[shape.faces], tri, atol=1e-6)
+
+
+def test_torques_are_pinocchio_gravity_against_the_actuators():
+    robot = _robot()
+    arm, dyn = Arm(robot), Dynamics(robot)
+    q = (0.3, -0.8, 1.1)
+    got = arm.torques(q)
+    assert [j.tau for j in got] == pytest.approx(dyn.gravity(q).tolist(), abs=1e-12)
+    lib = robot.library
+    for j, u in zip(got, robot.units, strict=True):
+        act = lib.variants[u.variant].actuator
+        assert (j.tau_nom, j.tau_max, j.unit) == (act.torque_nominal, act.torque_peak, u.name)
+        want = "over-peak" if abs(j.tau) > j.tau_max else "over-nominal" if abs(j.tau) > j.tau_nom else "ok"
+        assert j.level == want
+
+
+def test_torque_level_follows_the_slider(tmp_path):
+    """5 kg at tool0: held upright every joint is fine; stretched out the shoulder is over its
+    nominal torque and the elbow over its peak."""
+    f = tmp_path / "heavy.mod"
+    f.write_text("robot heavy {\n    chain H1 - H4(pivot=-90deg) - L3\n    payload 5 kg\n}\n", encoding="utf-8")
+    page = Page([Source(f)])
+    assert [j.level for j in page.arm.torques(page.q)] == ["ok", "ok", "ok"]
+    page.set_joint(1, math.pi / 2)
+    assert [j.level for j in page.arm.torques(page.q)] == ["ok", "over-nominal", "over-peak"]
+
+
+def test_sliders_clamp_and_move_tool0():
+    page = Page([Source(FARM)])
+    arm = page.arm
+    assert page.q == arm.robot.home()
+    before = arm.tool0(page.q)
+    page.set_joint(0, 0.5)
+    assert page.q[0] == 0.5
+    assert not np.allclose(arm.tool0(page.q), before)
+    page.set_joint(1, 100.0)
+    assert page.q[1] == arm.limits[1][1]
+
+
+def test_poses_home_first():
+    page = Page([Source(FARM)])
+    assert [n for n, _ in page.arm.poses] == ["home", "ready"]
+    page.go_pose("ready")
+    assert page.q == pytest.approx(tuple(math.radians(d) for d in (90, -45, -90)))
+    page.go_pose("home")
+    assert page.q == page.arm.robot.home()
+
+
+def test_saving_rechecks_and_an_error_keeps_the_last_good_arm(tmp_path):
+    f = tmp_path / "arm.mod"
+    _write(f, GOOD)
+    page = Page([Source(f)])
+    good = page.arm
+    assert good is not None and not page.source.errors and page.source.diagnostics == ""
+    page.set_joint(0, 0.4)
+    assert not page.poll()  # nothing changed on disk
+
+    _write(f, BROKEN)
+    assert page.poll()
+    assert page.arm is good and page.source.errors
+    assert "error[" in page.source.diagnostics and f"{f}:2:" in page.source.diagnostics
+    assert page.q[0] == 0.4  # the pose stays with the arm
+
+    _write(f, GOOD.replace("pose ready (30, -40, 60) deg", "pose ready (10, -40, 60) deg"))
+    assert page.poll()
+    assert page.arm is not good and not page.source.errors and page.source.diagnostics == ""
+    assert page.q[0] == 0.4  # same joints: the sliders stay where they were
+    assert dict(page.arm.poses)["ready"][0] == pytest.approx(math.radians(10))
+
+    _write(f, LONGER)
+    assert page.poll()
+    assert page.arm.dof == 4 and page.q == page.arm.robot.home()
+
+
+def test_a_file_that_starts_broken_shows_an_arm_once_fixed(tmp_path):
+    f = tmp_path / "arm.mod"
+    _write(f, BROKEN)
+    page = Page([Source(f)])
+    assert page.arm is None and page.source.errors
+    _write(f, GOOD)
+    assert page.poll() and page.arm is not None and page.q == page.arm.robot.home()
+
+
+def test_several_robots_need_a_choice(tmp_path):
+    from modc.model.select import RobotChoiceError
+
+    f = tmp_path / "two.mod"
+    f.write_text("robot a {\n    chain H1 - L1\n}\nrobot b {\n    chain H1 - L4 - L1\n}\n", encoding="utf-8")
+    with pytest.raises(RobotChoiceError):
+        Source(f).load(strict=True)
+    s = Source(f, robot="b")
+    s.load(strict=True)
+    assert s.arm.robot.name == "b" and s.arm.dof == 3
+
+
+def _ranking(tmp_path: Path) -> Path:
+    d = tmp_path / "designs"
+    d.mkdir()
+    (d / "d1.mod").write_text(GOOD, encoding="utf-8")
+    (d / "d2.mod").write_text(LONGER, encoding="utf-8")
+    doc = {"designs": [{"rank": 2, "file": "d2.mod", "chain": "H1-L4-L3-L1", "mass_kg": 3.2},
+                       {"rank": 1, "file": "d1.mod", "chain": "H1-L4-L1", "mass_kg": 2.5}],
+           "evaluated": 7, "seconds": 1.0}
+    (d / "ranking.json").write_text(json.dumps(doc), encoding="utf-8")
+    return d / "ranking.json"
+
+
+def test_ranking_pages_through_the_designs_best_first(tmp_path):
+    page = Page.for_ranking(Ranking(_ranking(tmp_path)))
+    assert page.caption.startswith("design 1 of 2: rank 1, H1-L4-L1, 2.5 kg")
+    assert page.arm.dof == 3 and page.sources[1].arm is None  # later designs are checked when shown
+    page.go(+1)
+    assert page.caption.startswith("design 2 of 2: rank 2") and page.arm.dof == 4
+    assert page.q == page.arm.robot.home()
+    page.go(+1)
+    assert page.index == 0 and page.arm.dof == 3
+    page.go(-1)
+    assert page.index == 1
+
+
+def test_bad_ranking_is_a_usage_error(tmp_path):
+    f = tmp_path / "ranking.json"
+    for text in ("{", "[]", '{"designs": []}', '{"designs": [{"rank": 1}]}'):
+        f.write_text(text, encoding="utf-8")
+        with pytest.raises(ViewError):
+            Ranking(f)
+    with pytest.raises(ViewError):
+        Ranking(tmp_path / "missing.json")
+
+
+def _traj(tmp_path: Path, q_last) -> Path:
+    from modc.sim.trajectory import Trajectory
+
+    t = Trajectory(("joint_1", "joint_2", "joint_3"), (0.0, 1.0), ((0.0, 0.0, 0.0), tuple(q_last)))
+    p = tmp_path / "t.json"
+    p.write_text(t.dumps(), encoding="utf-8")
+    return p
+
+
+def test_playback_runs_the_trajectory(tmp_path):
+    from modc.view.page import read_trajectory
+
+    src = Source(FARM, traj=read_trajectory(str(_traj(tmp_path, (0.5, -0.3, 0.2)))))
+    page = Page([src])
+    assert src.trajectory is not None
+    page.play()
+    assert page.tick(0.5) and page.q == pytest.approx((0.25, -0.15, 0.1))
+    assert page.tick(0.7) and not page.playing and page.q == pytest.approx((0.5, -0.3, 0.2))
+    assert not page.tick(0.1)
+    page.play()  # from the end: starts over
+    assert page.tick(0.1) and page.t == pytest.approx(0.1)
+
+
+def test_a_trajectory_that_does_not_fit_is_shown_not_played(tmp_path):
+    from modc.view.page import read_trajectory
+
+    src = Source(FARM, traj=read_trajectory(str(_traj(tmp_path, (9.0, 0.0, 0.0)))))
+    page = Page([src])
+    assert src.trajectory is None and "joint_1" in src.diagnostics and "outside its range" in src.diagnostics
+    page.play()
+    assert not page.tick(0.1)
+    (tmp_path / "bad.json").write_text("{", encoding="utf-8")
+    with pytest.raises(ViewError):
+        read_trajectory(str(tmp_path / "bad.json"))
+
+
+# --- the server, without a browser -------------------------------------------------------------
+
+def test_server_serves_the_client_locally():
+    from modc.view.server import start
+
+    server, view = start(Page([Source(FARM)]), port=0)
+    try:
+        html = urllib.request.urlopen(f"http://127.0.0.1:{server.get_port()}/", timeout=10).read().decode()
+        assert "<html" in html.lower() and "viser" in html.lower()
+        view.step(0.05)
+        assert set(view._links) >= {"base_link", "link_1", "link_2", "link_3", "tool0"}
+        assert len(view._sliders) == 3
+    finally:
+        server.stop()
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _env():
+    return {**os.environ, "PYTHONPATH": str(ROOT)}
+
+
+def test_busy_port_is_a_clean_error():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        r = subprocess.run([sys.executable, "-m", "modc", "view", str(FARM), "--no-browser", "--port", str(port)],
+                           capture_output=True, text=True, env=_env(), timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert f"modc view: port {port} on 127.0.0.1 is busy" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_unknown_robot_and_bad_ranking_exit_2(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "modc", "view", str(FARM), "--no-browser", "--robot", "nope"],
+                       capture_output=True, text=True, env=_env(), timeout=120)
+    assert r.returncode == 2 and "robot-unknown" in r.stderr and "Traceback" not in r.stderr
+    (tmp_path / "ranking.json").write_text("{}", encoding="utf-8")
+    r = subprocess.run([sys.executable, "-m", "modc", "view", str(tmp_path / "ranking.json"), "--no-browser"],
+                       capture_output=True, text=True, env=_env(), timeout=120)
+    assert r.returncode == 2 and "modc view:" in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the no-display rule is Linux's")
+def test_ctrl_c_stops_cleanly():
+    """Without a display (as in CI) no browser is tried; Ctrl-C ends the server with exit 0."""
+    port = _free_port()
+    env = {k: v for k, v in _env().items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    p = subprocess.Popen([sys.executable, "-m", "modc", "view", str(FARM), "--port", str(port)],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        line = p.stdout.readline()
+        assert f"http://127.0.0.1:{port}/" in line
+        assert urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10).status == 200
+        time.sleep(0.3)
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=30)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == 0, err
+    assert "Traceback" not in err and "stopped" in out and "no display to open a browser on" in err
+
+
+def test_torque_table_colours_each_joint_by_level(tmp_path):
+    from modc.view.arm import LEVEL_RGB
+    from modc.view.server import torque_table
+
+    f = tmp_path / "heavy.mod"
+    f.write_text("robot heavy {\n    chain H1 - H4(pivot=-90deg) - L3\n    payload 5 kg\n}\n", encoding="utf-8")
+    arm = Arm(check_file(f).design.robots[0])
+    table = torque_table(arm, (0.0, math.pi / 2, 0.0))
+    rows = table.split("<tr data-level=")[1:]
+    assert [r.split('"')[1] for r in rows] == ["ok", "over-nominal", "over-peak"]
+    for row, level in zip(rows, ("ok", "over-nominal", "over-peak"), strict=True):
+        assert "background:rgb({},{},{})".format(*LEVEL_RGB[level]) in row
+    assert "12 / 30.5" in rows[0] and "3.6 / 6.8" in rows[2]  # τnom / τmax of the H and L actuators
+
+
+def test_user_text_reaches_the_page_escaped(tmp_path):
+    from modc.view.server import start
+
+    ranking = _ranking(tmp_path)
+    doc = json.loads(ranking.read_text(encoding="utf-8"))
+    doc["designs"][1]["chain"] = "<img src=x onerror=alert(1)>"
+    ranking.write_text(json.dumps(doc), encoding="utf-8")
+    server, view = start(Page.for_ranking(Ranking(ranking)), port=0)
+    try:
+        assert "&lt;img src=x" in view._title.content and "<img" not in view._title.content
+        _write(ranking.parent / "d1.mod", GOOD.replace("robot arm {", "robot arm { <b>"))
+        view.step(0.05)
+        assert "&lt;b&gt;" in view._errors.content and "<b>" not in view._errors.content.split("</b>", 1)[1]
+    finally:
+        server.stop()
