@@ -34,6 +34,9 @@ def modc(
     if light is not None:  # a sitecustomize on PYTHONPATH runs before modc
         (light / "sitecustomize.py").write_text(BLOCKER, encoding="utf-8")
         env["PYTHONPATH"] = os.pathsep.join([str(light), str(ROOT), env.get("PYTHONPATH", "")])
+        # an empty cache: a compile whose torque search and collision matrix are cached needs no
+        # pinocchio at all (test_startup), and this test is about a first compile
+        env["MODC_CACHE_DIR"] = str(light / "cache")
     return subprocess.run(
         [sys.executable, "-m", "modc", *args],
         capture_output=True,
