@@ -227,8 +227,11 @@ def _goals(job: _Job, checker, q_start):
 
     from . import ik
 
+    from ..kinematics import rpy_matrix
+
     tgt = job.target
-    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper)
+    rotation = None if tgt.rpy is None else rpy_matrix(tgt.rpy)
+    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper, rotation)
     verdict: dict[bytes, bool] = {}
 
     def free(q) -> bool:
@@ -238,7 +241,8 @@ def _goals(job: _Job, checker, q_start):
         return verdict[key]
 
     solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * job.robot.dof, job.seed,
-                               batches=IK_BATCHES, enough=free)
+                               batches=IK_BATCHES, enough=free,
+                               tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf))
     if not solutions:
         tool = solver.position(best.q)
         raise job.fail(
