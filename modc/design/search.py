@@ -103,7 +103,11 @@ def search_shape(spec: Spec, shape: Shape, seed: int) -> ShapeResult:
             tally.add(spec, shape, *split(grid[lo:lo + BATCH]), s0)
         return tally.result(shape)
 
-    import cma
+    import warnings
+
+    with warnings.catch_warnings():  # cma warns that matplotlib (for its plots) is missing
+        warnings.simplefilter("ignore")
+        import cma
 
     dims = np.array([len(a) for a in axes], float)
     x0 = np.array([float(np.argmin(np.abs(a))) + 0.5 for a in axes])  # every twist at 0
