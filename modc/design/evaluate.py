@@ -20,7 +20,7 @@ import numpy as np
 
 from ..model import Pose, Problem, Robot, UnitSpec
 from . import reach
-from .batch import forward, geometry
+from .batch import Geometry, forward, geometry
 from .screen import Obstacles, collides, segment_radii
 from .space import Shape
 
@@ -60,33 +60,53 @@ class Screened:
     solutions: list[list[list[np.ndarray]]] = field(default_factory=list)
 
 
+def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
+    k = slice(t, t + 1)
+    return reach.Targets(tg.xyz[k], tg.R[k], tg.oriented[k], tg.tol_p[k], tg.tol_r[k], tg.names[k])
+
+
 def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray, seed: int) -> Screened:
+    """Targets one at a time, farthest from the base first: a candidate leaves the batch at the
+    first target it cannot reach (most random twist settings miss the hardest one), so the rest
+    of the work is spent on candidates that may pass."""
     lib = spec.problem.cell.library
     types = [lib.units[k] for k in shape.kinds]
-    links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links)]
+    links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     tool = spec.problem.cell.tool
     g = geometry(types, pivots, ports, links, tool.xyz, tool.rpy)
-    n = shape.n
+    n, C = shape.n, len(pivots)
+    tg = spec.targets
+    T = len(tg.names)
     lo, hi = np.full(n, spec.lower), np.full(n, spec.upper)
     q0 = reach.seeds(n, SEEDS, lo, hi, seed)
-    q, ep, er = reach.solve(g, spec.targets, q0, lo, hi)
-    tg = spec.targets
-    hit = (ep <= tg.tol_p[None, :, None]) & (er <= np.where(tg.oriented, tg.tol_r, np.inf)[None, :, None])
-    if hit.any() and len(spec.obstacles.shape):
-        # only the runs that reached their target are worth a collision test
-        c, t, s_ = np.nonzero(hit)
-        sub = type(g)(g.pre[c], g.post[c], g.t1, g.flange_tool)
-        _, _, _, pts = forward(sub, q[c, t, s_][:, None, None, :], points=True)
-        hit[c, t, s_] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+    q = np.zeros((C, T, SEEDS, n))
+    ep = np.full((C, T, SEEDS), np.inf)
+    hit = np.zeros((C, T, SEEDS), bool)
+    live = np.arange(C)
+    for t in np.argsort(-np.linalg.norm(tg.xyz, axis=1), kind="stable"):
+        if live.size == 0:
+            break
+        sub = Geometry(g.pre[live], g.post[live], g.t1, g.flange_tool)
+        qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0, lo, hi)
+        h = (ept <= tg.tol_p[t]) & (ert <= (tg.tol_r[t] if tg.oriented[t] else np.inf))
+        if h.any() and len(spec.obstacles.shape):
+            # only the runs that reached their target are worth a collision test
+            c, s_ = np.nonzero(h[:, 0])
+            one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+            _, _, _, pts = forward(one, qt[c, 0, s_][:, None, None, :], points=True)
+            h[c, 0, s_] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+        q[live, t], ep[live, t], hit[live, t] = qt[:, 0], ept[:, 0], h[:, 0]
+        live = live[h[:, 0].any(-1)]
     reached = hit.any(-1)  # (C, T)
     feasible = reached.all(-1)
     closest = ep.min(-1)
-    excess = np.maximum(closest - tg.tol_p[None], 0.0) + np.where(reached, 0.0, 1e-3)
-    score = np.where(feasible, 0.0, excess.sum(-1))
+    # how far from feasible: metres missed on the targets tried, plus a metre per target not reached
+    excess = np.where(np.isfinite(closest), np.maximum(closest - tg.tol_p[None], 0.0), 0.0)
+    score = np.where(feasible, 0.0, excess.sum(-1) + (~reached).sum(-1) * 1.0)
     sols = []
     for c in np.flatnonzero(feasible):
         per_target = []
-        for t in range(len(tg.names)):
+        for t in range(T):
             order = np.argsort(ep[c, t] + 1e3 * ~hit[c, t], kind="stable")
             per_target.append([q[c, t, s] for s in order if hit[c, t, s]])
         sols.append(per_target)

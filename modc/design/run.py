@@ -21,7 +21,8 @@ from .rank import Design, key, order
 from .screen import reach_bound
 from .search import ShapeResult, search_chunk
 
-CHUNK = 2  # shapes per unit of work
+CHUNK = 1  # shapes per unit of work (a shape's search is 0.1-2 s of numpy)
+ROUND = 8  # shapes searched between two rounds of exact checks
 TRIES = 3  # twist settings verified per chain before giving up on it
 VERIFY_FACTOR = 4  # at most this many exact checks per design asked for, per number of units
 
@@ -69,9 +70,20 @@ def _map(executor: Executor | None, spec: Spec, chunks: list, seed: int):
     return executor.map(search_chunk, [spec] * len(chunks), chunks, [seed] * len(chunks))
 
 
+def _min_mass(problem: Problem, shape: space.Shape, splits) -> float:
+    masses = [_mass(problem, shape, v) for v in splits
+              if all(space.allowed(problem, x, k) for x, k in zip(v, shape.kinds, strict=True))]
+    return min(masses, default=float("inf"))
+
+
 def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
            executor: Executor | None = None, progress: Callable[[int, int, str], None] | None = None) -> Outcome:
-    """Ranked designs for a checked problem (its library resolved)."""
+    """Ranked designs for a checked problem (its library resolved).
+
+    With the default objectives (fewest modules first), chains are searched by number of units,
+    and within one number lightest shape first, ROUND shapes at a time: the search stops as soon
+    as `top` designs are checked that no unsearched shape could beat. ROUND does not depend on
+    the number of workers, so neither does where the search stops."""
     t0 = time.perf_counter()
     spec = Spec.of(problem)
     lib = problem.cell.library
@@ -81,8 +93,8 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     names = [t.name for t in problem.cell.targets]
     closest = {t: np.inf for t in names}
     far = max((float(np.linalg.norm(t.xyz)) - t.position_tolerance for t in problem.cell.targets), default=0.0)
-    accepted: list[Design] = []
-    best = ""
+    early = problem.rank[:2] == ("modules", "mass")
+    tiers = []
     for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
         splits = space.variant_splits(problem, n)
         if not splits:
@@ -93,63 +105,90 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
                             problem.cell.tool.xyz)
             if r < far:  # a target beyond any pose of this shape: no IK needed
                 for t in problem.cell.targets:
-                    gap = float(np.linalg.norm(t.xyz)) - r
-                    closest[t.name] = min(closest[t.name], max(gap, 0.0))
+                    closest[t.name] = min(closest[t.name], max(float(np.linalg.norm(t.xyz)) - r, 0.0))
                 continue
-            shapes.append(s)
-        out.shapes += len(shapes)
-        results: list[ShapeResult] = []
-        for chunk in _map(executor, spec, _chunks(shapes, CHUNK), seed):
-            for res in chunk:
-                results.append(res)
-                out.evaluated += res.evaluated
-                for t, c in zip(names, res.closest):
-                    closest[t] = min(closest[t], c)
-                if res.found and not best:
-                    best = res.shape.label()
-            if progress is not None:
-                progress(out.evaluated, len(results), best)
-        accepted += _verify_tier(problem, n, splits, results, top, out)
-        if problem.rank[0] == "modules" and len(accepted) >= top:
+            shapes.append((_min_mass(problem, s, splits), s.label(), s))
+        shapes.sort(key=lambda e: e[:2])
+        tiers.append((n, splits, shapes))
+    tally = _Verifier(problem, top, out)
+    best = ""
+    for n, splits, shapes in tiers:
+        rounds = _chunks(shapes, ROUND) if early else [shapes]
+        for k, batch in enumerate(rounds):
+            out.shapes += len(batch)
+            for chunk in _map(executor, spec, _chunks([s for _, _, s in batch], CHUNK), seed):
+                for res in chunk:
+                    out.evaluated += res.evaluated
+                    for t, c in zip(names, res.closest, strict=True):
+                        closest[t] = min(closest[t], c)
+                    if res.found and not best:
+                        best = res.shape.label()
+                    tally.add(n, splits, res)
+                if progress is not None:
+                    progress(out.evaluated, out.shapes, best)
+            # designs no unsearched shape of this size can undercut are final
+            nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) else float("inf")
+            tally.settle(n, nxt)
+            if early and tally.done(n, nxt):
+                break
+        if not early:
+            continue
+        tally.settle(n, float("inf"))
+        if len(tally.accepted) >= top:
             break
+    tally.settle(hi, float("inf"))
     out.closest = {t: (0.0 if c <= tp else float(c)) for (t, c), tp in
-                   zip(closest.items(), (t.position_tolerance for t in problem.cell.targets))}
-    out.designs = order(accepted, problem.rank)[:top]
+                   zip(closest.items(), (t.position_tolerance for t in problem.cell.targets), strict=True)}
+    out.designs = order(tally.accepted, problem.rank)[:top]
     out.seconds = time.perf_counter() - t0
     return out
 
 
-def _verify_tier(problem: Problem, n: int, splits, results: list[ShapeResult], top: int, out: Outcome) -> list[Design]:
-    """Exact checks of one tier's screened chains, cheapest first by the objectives known before
-    checking (modules, mass), until `top` pass and the next chain would rank behind them."""
-    queue = []
-    for res in results:
+class _Verifier:
+    """Exact checks in ranking order of what the screen passed: a chain is checked once every
+    chain that could rank before it has been found (settle), until `top` pass."""
+
+    def __init__(self, problem: Problem, top: int, out: Outcome):
+        self.problem, self.top, self.out = problem, top, out
+        self.pending: list[tuple] = []
+        self.accepted: list[Design] = []
+        self.keys: list[tuple] = []
+        self.checks = 0
+
+    def add(self, n: int, splits, res: ShapeResult) -> None:
         if not res.found:
-            continue
+            return
+        p = self.problem
         for variants in splits:
-            if not all(space.allowed(problem, v, k) for v, k in zip(variants, res.shape.kinds)):
+            if not all(space.allowed(p, v, k) for v, k in zip(variants, res.shape.kinds, strict=True)):
                 continue
-            mass = _mass(problem, res.shape, variants)
-            chain = "-".join(f"{v}{k}" for v, k in zip(variants, res.shape.kinds)) + res.shape.label()
-            queue.append((key(problem.rank, n, mass, None, chain), res, variants))
-    queue.sort(key=lambda e: e[0])
-    out.screened += len(queue)
-    accepted: list[Design] = []
-    checks = 0
-    last_key = None
-    for k, res, variants in queue:
-        if len(accepted) >= top and k[:2] != last_key:
-            break
-        if checks >= VERIFY_FACTOR * top + TRIES:
-            break
-        for f in res.found[:TRIES]:
-            cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
-            checks += 1
-            v = verify(problem, cand)
-            if isinstance(v, str):
-                out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: {v}")
-                continue
-            accepted.append(Design(cand, v))
-            last_key = k[:2]
-            break
-    return accepted
+            mass = _mass(p, res.shape, variants)
+            chain = "-".join(f"{v}{k}" for v, k in zip(variants, res.shape.kinds, strict=True)) + res.shape.label()
+            self.pending.append((key(p.rank, n, mass, None, chain), n, mass, res, variants))
+            self.out.screened += 1
+
+    def done(self, n: int, next_mass: float) -> bool:
+        """top designs found that rank before anything of n units not yet searched."""
+        ahead = [k for k in self.keys if k[0] < n or (k[0] == n and k[1] < next_mass)]
+        return len(ahead) >= self.top
+
+    def settle(self, n: int, below: float) -> None:
+        """Check the pending chains of up to n units lighter than `below`, best first."""
+        ready = sorted((e for e in self.pending if e[1] < n or (e[1] == n and e[2] < below)), key=lambda e: e[0])
+        self.pending = [e for e in self.pending if not (e[1] < n or (e[1] == n and e[2] < below))]
+        for k, _n, _mass, res, variants in ready:
+            better = sorted(self.keys)[: self.top]
+            if len(better) >= self.top and k[:2] > better[-1][:2]:
+                break  # ranks behind top designs already checked (equal keys still compete on margin)
+            if self.checks >= VERIFY_FACTOR * self.top * 4:
+                break
+            for f in res.found[:TRIES]:
+                cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
+                self.checks += 1
+                v = verify(self.problem, cand)
+                if isinstance(v, str):
+                    self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: {v}")
+                    continue
+                self.accepted.append(Design(cand, v))
+                self.keys.append(k)
+                break

@@ -23,7 +23,7 @@ from .evaluate import Spec, screen_batch
 from .space import Shape, port_free, twist_values
 
 EXHAUSTIVE = 1536  # twist settings enumerated outright up to this many
-BUDGET = 1536  # CMA-ES evaluations per shape beyond that
+BUDGET = 1024  # CMA-ES evaluations per shape beyond that
 BATCH = 512  # candidates screened together (numpy amortisation)
 KEEP = 6  # feasible twist settings kept per shape (simplest first)
 
@@ -65,7 +65,7 @@ class _Tally:
     def add(self, spec: Spec, shape: Shape, piv: np.ndarray, por: np.ndarray, seed: int) -> np.ndarray:
         s = screen_batch(spec, shape, piv, por, seed)
         self.evaluated += len(piv)
-        self.closest = np.minimum(self.closest, s.closest.min(0))
+        self.closest = np.minimum(self.closest, s.closest.min(0))  # inf where no candidate got that far
         self.best = min(self.best, float(s.score.min()))
         for k, c in enumerate(np.flatnonzero(s.feasible)):
             key = (tuple(float(x) for x in piv[c]), tuple(float(x) for x in por[c]))
@@ -110,11 +110,15 @@ def search_shape(spec: Spec, shape: Shape, seed: int) -> ShapeResult:
         import cma
 
     dims = np.array([len(a) for a in axes], float)
+    # CMA-ES draws from its own generator: numpy's global one is shared by the threads of a Dask
+    # worker, and drawing from it would make results depend on how shapes interleave
+    rng = np.random.default_rng(s0)
     x0 = np.array([float(np.argmin(np.abs(a))) + 0.5 for a in axes])  # every twist at 0
-    opts = {"seed": s0 + 1, "bounds": [np.zeros_like(dims).tolist(), (dims - 1e-9).tolist()], "verbose": -9,
-            "popsize": 64, "maxfevals": BUDGET, "CMA_stds": (dims / 4).tolist(), "tolfun": 0, "tolx": 1e-3}
+    opts = {"bounds": [np.zeros_like(dims).tolist(), (dims - 1e-9).tolist()], "verbose": -9,
+            "popsize": 64, "maxfevals": BUDGET, "CMA_stds": (dims / 4).tolist(), "tolfun": 0, "tolx": 1e-3,
+            "randn": lambda *shape: rng.standard_normal(shape)}
     es = cma.CMAEvolutionStrategy(x0.tolist(), 1.0, opts)
-    while not es.stop() and tally.evaluated < BUDGET and len(tally.found) < KEEP * 4:
+    while not es.stop() and tally.evaluated < BUDGET and len(tally.found) < KEEP * 2:
         xs = es.ask()
         idx = np.clip(np.floor(np.array(xs)), 0, dims - 1).astype(int)
         values = np.array([[axes[j][i] for j, i in enumerate(row)] for row in idx])
