@@ -39,7 +39,7 @@ import time  # noqa: E402
 import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # benchmarks/_common.py
+from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -177,8 +177,10 @@ def main() -> None:
     result["anchor"] = bench_timor(Path(args.timor), 10 if args.quick else 40)
     c, s, a = result["candidate"], result["solve"], result["anchor"]
     lines = [f"candidate  {c['ms_per_candidate']:.3f} ms CPU per candidate ({c['targets']} targets, {c['candidates']} "
-             f"candidates, {c['feasible']} feasible); exact check of one design {c.get('verify_ms', float('nan')):.0f} ms",
-             f"solve      {s['seconds_wall']:.1f} s wall, {s['seconds_cpu']:.1f} s CPU, {s['evaluated']:,} evaluated over "
+             f"candidates, {c['feasible']} feasible); exact check of one design "
+             f"{c.get('verify_ms', float('nan')):.0f} ms",
+             f"solve      {s['seconds_wall']:.1f} s wall, {s['seconds_cpu']:.1f} s CPU, "
+             f"{s['evaluated']:,} evaluated over "
              f"{s['shapes']} shapes; best {s['best']}"]
     if a and "ms_per_design" in a:
         ratio = a["ms_per_design"] / c["ms_per_candidate"]

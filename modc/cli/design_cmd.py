@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 from contextlib import contextmanager, nullcontext
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -77,14 +77,14 @@ def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
 @app.command("design")
 def design_cmd(
     file: Annotated[str, typer.Argument(help=".mod file with `design NAME { … }` blocks")],
-    out: Annotated[str, typer.Option("-o", "--out", help="output directory: ranking.json, one .mod per design, report.html")],
-    max_units: Annotated[Optional[int], typer.Option("--max-units", min=1, help="largest chain to try (overrides `units`)")] = None,
+    out: Annotated[str, typer.Option("-o", "--out", help="output directory: ranking.json, .mod files, report.html")],
+    max_units: Annotated[int | None, typer.Option("--max-units", min=1, help="largest chain, over `units`")] = None,
     top: Annotated[int, typer.Option("--top", min=1, help="designs to keep")] = 5,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="seed of the search: same file and seed, same ranking")] = 0,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="same file and seed, same ranking")] = 0,
     workers: Annotated[int, typer.Option("--workers", min=1, help="local worker processes")] = 1,
-    scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="a Dask scheduler address (tcp://host:8786) to run on instead")] = None,
+    scheduler: Annotated[str | None, typer.Option("--scheduler", help="run on a Dask cluster: tcp://host:8786")] = None,
     json_out: Annotated[bool, typer.Option("--json", help="print ranking.json on stdout")] = False,
-    render: Annotated[bool, typer.Option("--render/--no-render", help="pictures of the top designs in report.html")] = True,
+    render: Annotated[bool, typer.Option("--render/--no-render", help="pictures of the top designs")] = True,
     library: LibraryOpt = None,
     force: Annotated[bool, typer.Option(help="replace DIR even if modc did not create it")] = False,
 ):
@@ -101,7 +101,7 @@ def design_cmd(
         checked = check_file(file, library)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not checked.ok:
         raise typer.Exit(EXIT_ERRORS)

@@ -87,8 +87,9 @@ class Flat:
         def soa(M, rows, cols):
             return np.ascontiguousarray(np.moveaxis(M[c_idx][:, :, rows, cols], 0, -1))
 
-        return cls(soa(g.pre, slice(0, 3), slice(0, 3)), soa(g.pre, slice(0, 3), 3), soa(g.post, slice(0, 3), slice(0, 3)),
-                   soa(g.post, slice(0, 3), 3), g.flange_tool[:3, :3], g.flange_tool[:3, 3])
+        rot, col = (slice(0, 3), slice(0, 3)), (slice(0, 3), 3)
+        return cls(soa(g.pre, *rot), soa(g.pre, *col), soa(g.post, *rot), soa(g.post, *col),
+                   g.flange_tool[:3, :3], g.flange_tool[:3, 3])
 
     def take(self, keep: np.ndarray) -> Flat:
         return Flat(self.pre_R[..., keep], self.pre_t[..., keep], self.post_R[..., keep], self.post_t[..., keep],
@@ -107,7 +108,8 @@ def _apply(R, v):
 
 
 def forward_flat(f: Flat, q: np.ndarray):
-    """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0 rotation (3, 3, B) and position (3, B)."""
+    """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
+    and position (3, B)."""
     n, B = q.shape
     R = np.zeros((3, 3, B))
     R[0, 0] = R[1, 1] = R[2, 2] = 1.0

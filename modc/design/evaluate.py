@@ -124,8 +124,8 @@ class Candidate:
     solutions: tuple[tuple[tuple[float, ...], ...], ...]  # per target, per solution
 
     def units(self) -> tuple[UnitSpec, ...]:
-        return tuple(UnitSpec(name=f"{v}{k}", variant=v, kind=k, pivot=p, port=o, link=x)
-                     for v, k, p, o, x in zip(self.variants, self.shape.kinds, self.pivots, self.ports, self.shape.links))
+        parts = zip(self.variants, self.shape.kinds, self.pivots, self.ports, self.shape.links, strict=True)
+        return tuple(UnitSpec(name=f"{v}{k}", variant=v, kind=k, pivot=p, port=o, link=x) for v, k, p, o, x in parts)
 
 
 @dataclass(frozen=True)
@@ -156,7 +156,7 @@ def verify(problem: Problem, cand: Candidate) -> Verified | str:
     from ..plan.collision import CollisionChecker
 
     names = [t.name for t in problem.cell.targets]
-    first = {t: sols[0] for t, sols in zip(names, cand.solutions)}
+    first = {t: sols[0] for t, sols in zip(names, cand.solutions, strict=True)}
     text = robot_file_text(robot_for(problem, cand, first, problem.name))
     checked = check_text(text, f"{problem.name}.mod", analyses=frozenset({"torque"}))
     if not checked.ok:
@@ -169,7 +169,7 @@ def verify(problem: Problem, cand: Candidate) -> Verified | str:
     chain = Chain(robot)
     chosen: dict[str, tuple[float, ...]] = {}
     report: dict[str, dict] = {}
-    for target, sols in zip(problem.cell.targets, cand.solutions):
+    for target, sols in zip(problem.cell.targets, cand.solutions, strict=True):
         q = next((q for q in sols if checker.valid(np.asarray(q))), None)
         if q is None:
             contacts = checker.contacts(np.asarray(sols[0]))

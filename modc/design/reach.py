@@ -51,7 +51,8 @@ def seeds(n: int, count: int, lower, upper, seed: int) -> np.ndarray:
 
 def _rotation_error(Rt, R):
     """Rotation vectors (3, B) of Rt . R^T for stacks (3, 3, B): the turn that brings R onto Rt."""
-    E = np.stack([np.stack([Rt[i, 0] * R[j, 0] + Rt[i, 1] * R[j, 1] + Rt[i, 2] * R[j, 2] for j in range(3)]) for i in range(3)])
+    E = np.stack([np.stack([Rt[i, 0] * R[j, 0] + Rt[i, 1] * R[j, 1] + Rt[i, 2] * R[j, 2] for j in range(3)])
+                  for i in range(3)])
     return np.moveaxis(rotation_error(np.eye(3), np.moveaxis(E, -1, 0).transpose(0, 2, 1)), -1, 0)
 
 
@@ -66,7 +67,8 @@ class _Runs:
 
     def take(self, keep):
         out = object.__new__(_Runs)
-        out.xyz, out.R, out.oriented, out.any_oriented = self.xyz[:, keep], self.R[..., keep], self.oriented[keep], self.any_oriented
+        out.xyz, out.R, out.oriented = self.xyz[:, keep], self.R[..., keep], self.oriented[keep]
+        out.any_oriented = self.any_oriented
         return out
 
     def residual(self, R_tool, t_tool):

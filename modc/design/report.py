@@ -28,17 +28,19 @@ def _svg(o: Outcome) -> str:
 
     parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" role="img">',
              f'<rect x="{PAD}" y="{PAD}" width="{W - 2 * PAD}" height="{H - 2 * PAD}" fill="#f7f8fa" stroke="#bbb"/>',
-             f'<text x="{W / 2}" y="{H - 10}" text-anchor="middle" font-size="12">arm mass (kg), lighter is better</text>',
+             f'<text x="{W / 2}" y="{H - 10}" text-anchor="middle" font-size="12">'
+             'arm mass (kg), lighter is better</text>',
              f'<text x="14" y="{H / 2}" transform="rotate(-90 14 {H / 2})" text-anchor="middle" font-size="12">'
              'torque margin (%), higher is better</text>',
              f'<text x="{PAD}" y="{H - PAD + 14}" font-size="10">{x0:.3f}</text>',
              f'<text x="{W - PAD}" y="{H - PAD + 14}" font-size="10" text-anchor="end">{x1:.3f}</text>',
              f'<text x="{PAD - 4}" y="{H - PAD}" font-size="10" text-anchor="end">{y0:.0f}</text>',
              f'<text x="{PAD - 4}" y="{PAD + 8}" font-size="10" text-anchor="end">{y1:.0f}</text>']
-    for rank, (d, on_front) in enumerate(zip(o.designs, front), start=1):
+    for rank, (d, on_front) in enumerate(zip(o.designs, front, strict=True), start=1):
         x, y = px(d.mass, d.margin * 100)
         colour = "#c0392b" if on_front else "#7f8c8d"
-        parts.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="6" fill="{colour}"><title>{escape(d.chain())}</title></circle>')
+        parts.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="6" fill="{colour}">'
+                     f'<title>{escape(d.chain())}</title></circle>')
         parts.append(f'<text x="{x + 8:.1f}" y="{y - 8:.1f}" font-size="11">{rank}</text>')
     parts.append("</svg>")
     return "".join(parts)

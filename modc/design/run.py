@@ -44,7 +44,8 @@ class Outcome:
             name = max(far, key=lambda t: far[t])
             return f"target '{name}': no design gets closer than {_length(far[name])}"
         if self.screened and self.rejections:
-            return f"{self.screened} chains reach every target, but none passes the exact checks (first: {self.rejections[0]})"
+            return (f"{self.screened} chains reach every target, but none passes the exact checks "
+                    f"(first: {self.rejections[0]})")
         return "every target can be reached, but no chain reaches all of them without touching the cell"
 
 
@@ -57,7 +58,7 @@ def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> fl
 
     lib = problem.cell.library
     return sum(unit_mass(lib, v, k, (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0)
-               for v, k, x in zip(variants, shape.kinds, shape.links))
+               for v, k, x in zip(variants, shape.kinds, shape.links, strict=True))
 
 
 def _chunks(items: list, size: int) -> list[list]:
@@ -101,8 +102,8 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
             continue
         shapes = []
         for s in space.shapes(problem, n):
-            r = reach_bound([lib.units[k] for k in s.kinds], [x or lib.units[k].x23 for k, x in zip(s.kinds, s.links)],
-                            problem.cell.tool.xyz)
+            lengths = [x or lib.units[k].x23 for k, x in zip(s.kinds, s.links, strict=True)]
+            r = reach_bound([lib.units[k] for k in s.kinds], lengths, problem.cell.tool.xyz)
             if r < far:  # a target beyond any pose of this shape: no IK needed
                 for t in problem.cell.targets:
                     closest[t.name] = min(closest[t.name], max(float(np.linalg.norm(t.xyz)) - r, 0.0))

@@ -19,7 +19,7 @@ from ..kinematics import rpy_matrix
 
 def reach_bound(unit_types, links, tool_xyz) -> float:
     r = 0.0
-    for t, length in zip(unit_types, links):
+    for t, length in zip(unit_types, links, strict=True):
         r += float(np.hypot(t.x01, t.z01)) + t.z12 + (length if t.link else 0.0)
     return r + float(np.linalg.norm(tool_xyz))
 

@@ -43,7 +43,8 @@ def twist_values(ts) -> np.ndarray:
     count = int(math.floor((ts.max_deg - ts.min_deg) / ts.step_deg + 1e-9)) + 1
     deg = [ts.min_deg + k * ts.step_deg for k in range(count)]
     if ts.wraps:
-        deg = sorted({((d + 180.0) % 360.0) - 180.0 if d != 180.0 else 180.0 for d in deg} - ({-180.0} if 180.0 in deg else set()))
+        wrapped = {((d + 180.0) % 360.0) - 180.0 if d != 180.0 else 180.0 for d in deg}
+        deg = sorted(wrapped - ({-180.0} if 180.0 in wrapped else set()))
     return np.radians(np.array(deg, float))
 
 
@@ -56,7 +57,7 @@ def variant_splits(problem: Problem, n: int) -> list[tuple[str, ...]]:
     for seq in itertools.product(sorted(lib.variants), repeat=n):
         if seq[0] != rules.first_variant or seq[-1] != rules.last_variant:
             continue
-        if any(b not in rules.may_follow.get(a, []) for a, b in zip(seq, seq[1:])):
+        if any(b not in rules.may_follow.get(a, []) for a, b in zip(seq, seq[1:], strict=False)):
             continue
         if any(seq.count(v) > lib.variants[v].actuator.epsilon for v in lib.variants):
             continue
@@ -76,7 +77,7 @@ def shapes(problem: Problem, n: int) -> list[Shape]:
     kinds_all = sorted(lib.units)
     out = []
     for kinds in itertools.product(kinds_all, repeat=n):
-        if not any(all(allowed(problem, v, k) for v, k in zip(split, kinds)) for split in splits):
+        if not any(all(allowed(problem, v, k) for v, k in zip(split, kinds, strict=True)) for split in splits):
             continue
         choices = [(None,) if not lib.units[k].link or problem.links is None else problem.links for k in kinds]
         for links in itertools.product(*choices):

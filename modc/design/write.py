@@ -53,4 +53,5 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
 def summary_line(o: Outcome) -> str:
     best = o.designs[0]
     return (f"{o.problem.name}: {len(o.designs)} designs from {o.evaluated:,} evaluated in {o.seconds:.1f} s; "
-            f"best {best.chain()} ({best.modules} modules, {best.mass:.3f} kg, margin {math.floor(best.margin * 100)} %)")
+            f"best {best.chain()} ({best.modules} modules, {best.mass:.3f} kg, "
+            f"margin {math.floor(best.margin * 100)} %)")

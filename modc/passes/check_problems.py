@@ -39,7 +39,8 @@ def _check(p: Problem, library, ctx: Context) -> None:
             ctx.report(codes.NONPOSITIVE_SIZE.at(o.span, what=f"every dimension of {o.shape} '{o.name}'",
                                                  value=", ".join(f"{v:g} m" for v in o.size)))
     if p.cell.payload is not None and p.cell.payload.mass <= 0:
-        ctx.report(codes.NONPOSITIVE_SIZE.at(p.cell.payload.span, what="the payload mass", value=f"{p.cell.payload.mass:g} kg"))
+        ctx.report(codes.NONPOSITIVE_SIZE.at(p.cell.payload.span, what="the payload mass",
+                                             value=f"{p.cell.payload.mass:g} kg"))
     for name in p.modules or ():
         if library.split(name) is None:
             close = difflib.get_close_matches(name.upper(), library.unit_names(), n=1, cutoff=0.5)
@@ -54,7 +55,8 @@ def _check(p: Problem, library, ctx: Context) -> None:
     for length in p.links or ():
         if not (library.link_length_min <= length <= library.link_length_max):
             ctx.report(codes.LINK_LENGTH_RANGE.at(p.bound_spans.get("links", p.name_span), value=f"{length:g} m",
-                                                  low=f"{library.link_length_min:g} m", high=f"{library.link_length_max:g} m"))
+                                                  low=f"{library.link_length_min:g} m",
+                                                  high=f"{library.link_length_max:g} m"))
             break
 
 
