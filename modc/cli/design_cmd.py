@@ -31,7 +31,7 @@ def _executor(workers: int, scheduler: str | None):
 
 @contextmanager
 def _progress(enabled: bool, name: str):
-    """A rich progress line on stderr (a TTY only): screened settings per second, the first shape that works."""
+    """A rich progress line on stderr (a TTY only): twist settings screened per second, the best design so far."""
     if not enabled:
         yield None
         return
@@ -39,17 +39,15 @@ def _progress(enabled: bool, name: str):
 
     with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), transient=True,
                   console=__import__("rich.console", fromlist=["Console"]).Console(stderr=True)) as bar:
+        import time
+
         task = bar.add_task(f"design {name}", total=None)
-        start = [None]
+        start = time.perf_counter()
 
         def update(evaluated: int, shapes: int, best: str) -> None:
-            import time
-
-            now = time.perf_counter()
-            start[0] = start[0] or now
-            rate = evaluated / max(now - start[0], 1e-9) if evaluated else 0.0
-            bar.update(task, description=f"design {name}: {evaluated:,} evaluated ({rate:,.0f}/s), {shapes} shapes, "
-                                         f"first feasible shape: {best or '—'}")
+            rate = evaluated / max(time.perf_counter() - start, 1e-9)
+            bar.update(task, description=f"{name}: {evaluated:,} screened ({rate:,.0f}/s), {shapes} shapes; "
+                                         f"best {best or '—'}")
         yield update
 
 

@@ -123,13 +123,17 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
                     for t, c in zip(names, res.closest, strict=True):
                         closest[t] = min(closest[t], c)
                     if res.found and not best:
-                        best = res.shape.label()
+                        best = f"shape {res.shape.label()} (unchecked)"
                     tally.add(n, splits, res)
                 if progress is not None:
                     progress(out.evaluated, out.shapes, best)
             # designs no unsearched shape of this size can undercut are final
             nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) else float("inf")
             tally.settle(n, nxt)
+            if tally.accepted:
+                best = order(tally.accepted, problem.rank)[0].chain()
+                if progress is not None:
+                    progress(out.evaluated, out.shapes, best)
             if early and tally.done(n, nxt):
                 break
         if not early:
