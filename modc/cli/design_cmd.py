@@ -114,6 +114,7 @@ def design_cmd(
             with _progress(tty, p.name) if tty else nullcontext() as bar:
                 o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar)
             if not o.designs:
+                assert p.cell.library is not None
                 hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
                 units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
                 failed.append(codes.NO_DESIGN.at(p.name_span, units=units, name=p.name, closest=o.why_none()))

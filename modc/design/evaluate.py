@@ -70,6 +70,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     first target it cannot reach (most random twist settings miss the hardest one), so the rest
     of the work is spent on candidates that may pass."""
     lib = spec.problem.cell.library
+    assert lib is not None
     types = [lib.units[k] for k in shape.kinds]
     links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     tool = spec.problem.cell.tool
@@ -104,13 +105,13 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     excess = np.where(np.isfinite(closest), np.maximum(closest - tg.tol_p[None], 0.0), 0.0)
     score = np.where(feasible, 0.0, excess.sum(-1) + (~reached).sum(-1) * 1.0)
     sols = []
-    for c in np.flatnonzero(feasible):
+    for cand in np.flatnonzero(feasible):
         per_target = []
         for t in range(T):
-            order = np.argsort(ep[c, t] + 1e3 * ~hit[c, t], kind="stable")
-            per_target.append([q[c, t, s] for s in order if hit[c, t, s]])
+            order = np.argsort(ep[cand, t] + 1e3 * ~hit[cand, t], kind="stable")
+            per_target.append([q[cand, t, s] for s in order if hit[cand, t, s]])
         sols.append(per_target)
-    return Screened(feasible, score, closest, sols)
+    return Screened(np.asarray(feasible), np.asarray(score), closest, sols)
 
 
 @dataclass(frozen=True)

@@ -57,8 +57,11 @@ def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> fl
     from ..physical.parts import unit_mass
 
     lib = problem.cell.library
-    return sum(unit_mass(lib, v, k, (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0)
-               for v, k, x in zip(variants, shape.kinds, shape.links, strict=True))
+    assert lib is not None
+    total = 0.0
+    for v, k, x in zip(variants, shape.kinds, shape.links, strict=True):
+        total += unit_mass(lib, v, k, (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0)
+    return total
 
 
 def _chunks(items: list, size: int) -> list[list]:
@@ -120,8 +123,8 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
             for chunk in _map(executor, spec, _chunks([s for _, _, s in batch], CHUNK), seed):
                 for res in chunk:
                     out.evaluated += res.evaluated
-                    for t, c in zip(names, res.closest, strict=True):
-                        closest[t] = min(closest[t], c)
+                    for name, c in zip(names, res.closest, strict=True):
+                        closest[name] = min(closest[name], c)
                     if res.found and not best:
                         best = f"shape {res.shape.label()} (unchecked)"
                     tally.add(n, splits, res)

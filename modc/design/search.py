@@ -81,6 +81,7 @@ class _Tally:
 
 def search_shape(spec: Spec, shape: Shape, seed: int) -> ShapeResult:
     lib = spec.problem.cell.library
+    assert lib is not None
     pivot_set, port_set = twist_values(lib.twists.pivot), twist_values(lib.twists.port)
     free = port_free(spec.problem, shape, lib)
     # one variable per pivot and per port that matters

@@ -48,7 +48,8 @@ def _links(low, st: ast.Links, out: dict) -> None:
     if step is None:
         step = hi - lo if hi > lo else 1.0
     if step <= 0:
-        low.error(codes.DESIGN_BOUND.at(st.step.span, what="the link step must be positive",
+        where = st.step.span if st.step is not None else st.span
+        low.error(codes.DESIGN_BOUND.at(where, what="the link step must be positive",
                                         hint="e.g. `links 150 mm to 300 mm step 50 mm`"))
         return
     n = int(math.floor((hi - lo) / step + 1e-9)) + 1

@@ -30,10 +30,11 @@ def _library(p: Problem, ctx: Context):
 
 def _check(p: Problem, library, ctx: Context) -> None:
     names: set[str] = set()
-    for item in sorted((*p.cell.targets, *p.cell.obstacles), key=lambda x: (x.span.line, x.span.col)):
-        if item.name in names:
-            ctx.report(codes.DUPLICATE_NAME.at(item.span, name=item.name, robot=p.name))
-        names.add(item.name)
+    declared = [(t.name, t.span) for t in p.cell.targets] + [(o.name, o.span) for o in p.cell.obstacles]
+    for name, span in sorted(declared, key=lambda x: (x[1].line, x[1].col)):
+        if name in names:
+            ctx.report(codes.DUPLICATE_NAME.at(span, name=name, robot=p.name))
+        names.add(name)
     for o in p.cell.obstacles:
         if any(v <= 0 for v in o.size):
             ctx.report(codes.NONPOSITIVE_SIZE.at(o.span, what=f"every dimension of {o.shape} '{o.name}'",
