@@ -212,3 +212,33 @@ def test_modc_design_writes_compilable_robots(tmp_path, capsys):
             q = robot.pose(f"at_{t.name}").q
             assert np.linalg.norm(chain.T_base_tool(np.array(q))[:3, 3] - np.array(t.xyz)) <= t.position_tolerance
     capsys.readouterr()
+
+
+def test_verify_measures_an_oriented_target_exactly():
+    """The exact check of a chain that reaches a full pose: accepted, errors re-measured ~0; the
+    same chain with the target turned by 10° is refused, saying by how much."""
+    from modc import api
+    from modc.design.evaluate import Candidate, verify
+    from modc.design.space import Shape
+    from modc.kinematics import Chain, matrix_rpy
+
+    farm = api.load(ROOT / "examples" / "farm.mod")
+    q = np.radians([20.0, -50.0, 60.0])
+    T = Chain(farm).T_base_tool(q)
+    r, p, y = np.degrees(matrix_rpy(T[:3, :3]))
+
+    def problem_at(yaw: float):
+        return problem(f"""design posed {{
+    tool at (0.06, 0, 0) m
+    target t at ({T[0, 3]:.12f}, {T[1, 3]:.12f}, {T[2, 3]:.12f}) m rpy ({r:.12f}, {p:.12f}, {yaw:.12f}) deg
+    units 3
+}}""")
+
+    cand = Candidate(Shape((1, 4, 3), (None, None, 0.18)), ("H", "L", "L"), tuple(u.pivot for u in farm.units),
+                     tuple(u.port for u in farm.units), ((tuple(q),),))
+    ok = verify(problem_at(y), cand)
+    assert not isinstance(ok, str), ok
+    assert ok.targets["t"]["position_error_m"] < 1e-9 and ok.targets["t"]["orientation_error_deg"] < 1e-6
+    assert ok.robot.sequence == "H1-L4-L3" and ok.robot.pose("at_t") is not None
+    turned = verify(problem_at(y + 10.0), cand)
+    assert isinstance(turned, str) and "orientation off by 10°" in turned
