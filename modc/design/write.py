@@ -40,6 +40,8 @@ def ranking(outcomes: list[Outcome]) -> dict:
 
 
 def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> dict[str, str | bytes]:
+    from .. import __version__
+    from ..files import REPORT
     from .report import report_html
 
     out: dict[str, str | bytes] = {"ranking.json": json.dumps(ranking(outcomes), indent=2, allow_nan=False) + "\n"}
@@ -47,6 +49,10 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
         for rank, d in enumerate(o.designs, start=1):
             out[file_name(o.problem.name, rank)] = robot_file(o, rank, d)
     out["report.html"] = report_html(outcomes, renders or {})
+    # the marker of a directory modc wrote: `modc design` may replace it next time without --force
+    marker = {"generator": f"modc {__version__}", "command": "design",
+              "designs": [o.problem.name for o in outcomes], "outputs": sorted([*out, REPORT])}
+    out[REPORT] = json.dumps(marker, indent=2) + "\n"
     return dict(sorted(out.items()))
 
 
