@@ -242,3 +242,27 @@ def test_verify_measures_an_oriented_target_exactly():
     assert ok.robot.sequence == "H1-L4-L3" and ok.robot.pose("at_t") is not None
     turned = verify(problem_at(y + 10.0), cand)
     assert isinstance(turned, str) and "orientation off by 10°" in turned
+
+
+def test_cli_engines_give_the_same_ranking(tmp_path, capsys):
+    """`--workers 2` (a local process pool) and `--scheduler ADDRESS` (Dask) through the command line."""
+    distributed = pytest.importorskip("distributed")
+    from modc.cli import main
+
+    src = tmp_path / "small.mod"
+    src.write_text(SMALL, encoding="utf-8")
+
+    def run_cli(*extra: str) -> list:
+        with pytest.raises(SystemExit) as e, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            main(["design", str(src), "-o", str(tmp_path / "out"), "--seed", "5", "--top", "2", "--no-render",
+                  "--json", *extra])
+        stdout, err = capsys.readouterr()
+        assert (e.value.code or 0) == 0, err
+        return json.loads(stdout)["designs"]
+
+    pooled = run_cli("--workers", "2")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                                  dashboard_address=None) as cluster:
+        dasked = run_cli("--scheduler", cluster.scheduler_address)
+    assert pooled == dasked and pooled
