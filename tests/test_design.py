@@ -266,3 +266,29 @@ def test_cli_engines_give_the_same_ranking(tmp_path, capsys):
                                   dashboard_address=None) as cluster:
         dasked = run_cli("--scheduler", cluster.scheduler_address)
     assert pooled == dasked and pooled
+
+
+def test_static_torque_screen_equals_pinocchio_gravity():
+    """The screen's torques at a pose are the dynamics model's gravity torques (same parts, same masses)."""
+    from modc import api
+    from modc.design.screen import static_torques
+    from modc.dynamics.model import Dynamics
+
+    for name in ("farm", "example_a"):
+        robot = api.load(ROOT / "examples" / f"{name}.mod")
+        payload = (robot.payload.mass, robot.payload.com) if robot.payload else None
+        dyn = Dynamics(robot, payload)
+        qs = np.random.default_rng(0).uniform(-2.0, 2.0, (4, robot.dof))
+        want = np.abs([dyn.gravity(q) for q in qs])
+        assert np.abs(static_torques(robot, qs) - want).max() < 1e-4 * max(1.0, want.max())
+
+
+def test_no_design_names_the_torque_when_the_payload_is_too_heavy():
+    from modc.design import run
+
+    p = problem(SMALL.replace("payload 100 g", "payload 4 kg"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        o = run.design(p, top=1, seed=0)
+    assert not o.designs
+    assert "over peak torque at a target pose" in o.why_none()

@@ -18,7 +18,7 @@ from ..model import Problem
 from . import space
 from .evaluate import Candidate, Spec, verify
 from .rank import Design, key, order
-from .screen import reach_bound
+from .screen import reach_bound, static_torques
 from .search import ShapeResult, search_chunk
 
 CHUNK = 1  # shapes per unit of work (a shape's search is 0.1-2 s of numpy)
@@ -43,10 +43,10 @@ class Outcome:
         if far:
             name = max(far, key=lambda t: far[t])
             return f"target '{name}': no design gets closer than {_length(far[name])}"
-        if self.screened and self.rejections:
-            return (f"{self.screened} chains reach every target, but none passes the exact checks "
+        if self.rejections:
+            return (f"{len(self.rejections)} chains reach every target, but none passes the checks "
                     f"(first: {self.rejections[0]})")
-        return "every target can be reached, but no chain reaches all of them without touching the cell"
+        return "every target can be reached alone, but no chain reaches all of them without touching the cell"
 
 
 def _length(x: float) -> str:
@@ -170,10 +170,30 @@ class _Verifier:
         for variants in splits:
             if not all(space.allowed(p, v, k) for v, k in zip(variants, res.shape.kinds, strict=True)):
                 continue
+            found = tuple(f for f in res.found if self._holds(res, variants, f))
+            if not found:
+                continue
             mass = _mass(p, res.shape, variants)
             chain = "-".join(f"{v}{k}" for v, k in zip(variants, res.shape.kinds, strict=True)) + res.shape.label()
-            self.pending.append((key(p.rank, n, mass, None, chain), n, mass, res, variants))
+            kept = ShapeResult(res.shape, found, res.evaluated, res.closest, res.best_score)
+            self.pending.append((key(p.rank, n, mass, None, chain), n, mass, kept, variants))
             self.out.screened += 1
+
+    def _holds(self, res: ShapeResult, variants, f) -> bool:
+        """The static torque screen: gravity torques at the poses found for the targets (inside the
+        limits, so no more than the worst case) within every actuator's peak."""
+        from .evaluate import robot_for
+
+        lib = self.problem.cell.library
+        assert lib is not None
+        cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
+        robot = robot_for(self.problem, cand, {}, self.problem.name)
+        tau = static_torques(robot, [sols[0] for sols in f.solutions])
+        peak = np.array([lib.variants[v].actuator.torque_peak for v in variants])
+        if np.all(tau <= peak):
+            return True
+        self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: over peak torque at a target pose")
+        return False
 
     def done(self, n: int, next_mass: float) -> bool:
         """top designs found that rank before anything of n units not yet searched."""

@@ -86,3 +86,44 @@ def collides(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: 
     d = obstacles.distance(pts.reshape(-1, 3)).min(-1).reshape(R, n, 3, m) - radii[:, None]
     d[:, 0, 0, :] = np.inf
     return (d < -1e-3).reshape(R, -1).any(-1)
+
+
+G = 9.81  # m/s²
+
+
+def _part_com(part) -> np.ndarray:
+    """A part's centre of mass in its frame: its primitives' centroids weighted by volume (uniform
+    density, as the URDF's inertials are derived)."""
+    vols = np.array([p.volume for p in part.primitives])
+    centres = np.array([p.center for p in part.primitives], float)
+    return (vols[:, None] * centres).sum(0) / vols.sum()
+
+
+def static_torques(robot, qs) -> np.ndarray:
+    """|gravity torque| (N·m) per pose and joint, (len(qs), n), from the library's parts and the
+    payload: exact static torques at these poses. Poses inside the joint limits bound the worst
+    case from below, so a pose over an actuator's peak rules the chain out before any exact check."""
+    from ..kinematics import Chain, rpy_matrix
+    from ..physical.parts import unit_parts
+
+    lib = robot.library
+    chain = Chain(robot)
+    g = rpy_matrix(robot.base.rpy).T @ np.array([0.0, 0.0, -G])
+    per_unit = [unit_parts(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units]
+    out = np.zeros((len(qs), robot.dof))
+    for k, q in enumerate(qs):
+        frames = chain.frames(np.asarray(q, float))
+        bodies = []  # (first joint that carries it, mass, centre in base_link)
+        for i, (f, parts) in enumerate(zip(frames, per_unit, strict=True)):
+            for part in parts:
+                T = f[{"unit": "T_base_unit", "twist1": "T_base_twist1", "joint": "T_base_joint"}[part.frame]]
+                carried_from = i if part.frame == "joint" else i - 1
+                bodies.append((carried_from, part.mass, T[:3, :3] @ _part_com(part) + T[:3, 3]))
+        if robot.payload is not None:
+            T = chain.T_base_tool(np.asarray(q, float))
+            bodies.append((robot.dof - 1, robot.payload.mass, T[:3, :3] @ np.asarray(robot.payload.com) + T[:3, 3]))
+        for i, f in enumerate(frames):
+            p, z = f["T_base_joint"][:3, 3], f["T_base_joint"][:3, 2]
+            moment = sum((np.cross(c - p, m * g) for j, m, c in bodies if j >= i), np.zeros(3))
+            out[k, i] = abs(float(z @ moment))
+    return out
