@@ -67,6 +67,10 @@ def run(design: Design, ctx: Context) -> Design:
         library = _library(p, ctx)
         if library is not None:
             _check(p, library, ctx)
-            p = p.model_copy(update={"cell": p.cell.model_copy(update={"library": library})})
+            update: dict = {"library": library}
+            if ctx.library_override:  # the designs written must name the library they were found with
+                path = ctx.library_override not in lib.BUILTIN
+                update |= {"library_ref": ctx.library_override, "library_dir": str(Path.cwd()) if path else None}
+            p = p.model_copy(update={"cell": p.cell.model_copy(update=update)})
         problems.append(p)
     return design.model_copy(update={"problems": tuple(problems)})
