@@ -292,3 +292,23 @@ def test_no_design_names_the_torque_when_the_payload_is_too_heavy():
         o = run.design(p, top=1, seed=0)
     assert not o.designs
     assert "over peak torque at a target pose" in o.why_none()
+
+
+def test_report_html_shows_the_top_design(tmp_path, capsys):
+    """report.html is one file: the ranking, the Pareto plot and a PNG of the design in its cell, inline."""
+    pytest.importorskip("pybullet")
+    import base64
+    import re
+
+    from modc.cli import main
+
+    src = tmp_path / "small.mod"
+    src.write_text(SMALL, encoding="utf-8")
+    with pytest.raises(SystemExit) as e, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        main(["design", str(src), "-o", str(tmp_path / "out"), "--top", "1"])
+    assert (e.value.code or 0) == 0, capsys.readouterr()[1]
+    html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    pngs = re.findall(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"', html)
+    assert len(pngs) == 1 and base64.b64decode(pngs[0]).startswith(b"\x89PNG")
+    assert "<svg" in html and "small_1.mod" in html and "<script" not in html
