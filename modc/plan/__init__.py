@@ -9,7 +9,7 @@ target (SPEC section 6).
 Steps (modules of this package):
     collision.py  the compiled URDF's collision meshes + the file's obstacles, pinocchio + coal;
                   self-collision pairs from the SRDF's matrix; certified straight motions
-    ik.py         position IK of tool0 (projected Levenberg-Marquardt, many seeded starts);
+    ik.py         IK of tool0, position or full pose (projected Levenberg-Marquardt, many seeded starts);
                   the collision-free solution closest to the start pose is the goal
     planner.py    OMPL RRT-Connect in joint space, then shortcutting
     timing.py     stop-at-every-vertex trapezoidal timing within the velocity limits
