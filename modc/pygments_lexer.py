@@ -32,7 +32,7 @@ from pygments.token import (
 __all__ = ["ModLexer"]
 
 #: Keyword that opens a robot block.
-DECLARATIONS = ("robot",)
+DECLARATIONS = ("design", "robot")
 #: Keywords that start a statement inside a robot block (`row` starts a row of a `dh` block).
 STATEMENTS = (
     "allow",
@@ -51,7 +51,7 @@ STATEMENTS = (
     "tool",
 )
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
-CLAUSES = ("at", "fit-links", "length", "radius", "rpy", "size")
+CLAUSES = ("at", "fit-links", "length", "radius", "rpy", "size", "step", "to", "within")
 #: Every keyword of the language.
 KEYWORDS = frozenset(DECLARATIONS + STATEMENTS + CLAUSES)
 #: Units of measure (modc.model.quantities.ALL).
@@ -86,8 +86,8 @@ class ModLexer(RegexLexer):
         "root": [
             # a file: robot blocks
             include("common"),
-            (r"(robot)(\s+)(" + _NAME + r")", bygroups(Keyword.Declaration, Whitespace, Name.Class)),
-            (r"robot\b", Keyword.Declaration),
+            (r"(robot|design)(\s+)(" + _NAME + r")", bygroups(Keyword.Declaration, Whitespace, Name.Class)),
+            (r"(robot|design)\b", Keyword.Declaration),
             (r"\{", Punctuation, "body"),
             (_NAME, Name),
         ],

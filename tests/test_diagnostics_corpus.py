@@ -80,6 +80,7 @@ FUNCTION_CASES = {
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
     "traj-invalid": "test_traj_invalid",
+    "no-design": "test_no_design",
     **{
         code: "test_plan_errors"
         for code in (
@@ -680,3 +681,17 @@ def test_pinned_messages_are_read_and_compared(tmp_path):
     assert case.read_text(encoding="utf-8").startswith(
         "robot farm {\n    chain H1 - H4 L4   # expect: error[missing-dash] "
     )
+
+
+def test_no_design(tmp_path, capsys):
+    """`modc design` with no chain that does the tasks: exit 1, a diagnostic on the design block
+    saying what came closest, nothing written."""
+    src = tmp_path / "far.mod"
+    src.write_text("design cell {\n    target near at (0.3, 0, 0.2) m\n    target far at (3, 0, 0) m\n    units 2 to 3\n}\n",
+                   encoding="utf-8")
+    out = tmp_path / "out"
+    rc, stdout, err = run_cli(capsys, "design", str(src), "-o", str(out))
+    assert rc == 1, err
+    assert f"{src}:1:8: error[no-design]" in err, err
+    assert "target 'far': no design gets closer than 1.88 m" in err and "= hint:" in err and "Traceback" not in err
+    assert not out.exists() and stdout == ""

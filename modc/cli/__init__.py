@@ -1,5 +1,5 @@
 """Command line: `modc FILE -o OUT`, `modc lint`, `check`, `dh2mod`, `dh`, `sim`, `render`, `play`,
-`plan`, `view`, `fmt`, `lsp`, `schema`, `codes`, `backends`.
+`plan`, `view`, `design`, `fmt`, `lsp`, `schema`, `codes`, `backends`.
 
 Exit codes: 0 success, 1 diagnostics with errors (or a failed check), 2 usage or I/O error. Heavy
 libraries (numpy, jinja2, trimesh, pinocchio, pybullet…) are imported inside commands, never at start-up.
@@ -13,7 +13,7 @@ import typer
 
 from .. import __version__
 # each module registers its commands; import order is the order `modc --help` lists them in
-from . import compile, lint, analysis, motion, view, info  # noqa: F401, I001
+from . import compile, lint, analysis, motion, view, info, design_cmd  # noqa: F401, I001
 from .app import app
 
 def _version(value: bool):

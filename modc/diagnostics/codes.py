@@ -214,6 +214,17 @@ NONPOSITIVE_SIZE = _register("nonpositive-size", E, "an obstacle size, radius or
 UNKNOWN_ALLOW = _register("unknown-allow", E, "`allow` naming a code that cannot be silenced",
     "'{name}' cannot be allowed", "allowable codes: {allowable}")
 
+# --- design problems (`design NAME { … }`, modc design) -----------------------------------------
+DESIGN_BOUND = _register("design-bound", E, "a search bound of a design block that cannot be searched",
+    "{what}", "{hint}")
+UNKNOWN_OBJECTIVE = _register("unknown-objective", E, "`rank` naming an objective modc does not know",
+    "unknown objective '{name}'", "objectives are {known}, written in order of importance")
+DESIGN_NO_TARGETS = _register("design-no-targets", E, "a design block without any target",
+    "design '{name}' has no targets: nothing to design the arm for", "add `target NAME at (x, y, z) m` to the block")
+NO_DESIGN = _register("no-design", E, "`modc design` found no chain that does every task of the cell",
+    "no design of {units} units does every task of '{name}': {closest}",
+    "widen the search (more units, more module types, other link lengths) or move the targets")
+
 # --- command line / IO (rendered like the others, exit code 2) ---------------------------------
 FILE_NOT_FOUND = _register("file-not-found", E, "an input file that cannot be read",
     "cannot read '{path}': {detail}", "check the path")

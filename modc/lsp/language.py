@@ -74,7 +74,8 @@ KEYWORDS = {
     "sphere": "`sphere NAME radius R m at (x, y, z) m` — a sphere obstacle in base_link.",
     "cylinder": "`cylinder NAME radius R m length L m at (x, y, z) m [rpy (…) deg]` — a cylinder obstacle in "
     "base_link, axis along z before rpy.",
-    "target": "`target NAME at (x, y, z) m` — a position for tool0, in base_link.",
+    "target": "`target NAME at (x, y, z) m [rpy (r, p, y) deg] [within 5 mm, 2 deg]` — a position (and orientation) "
+    "for tool0, in base_link, with its tolerances.",
     "allow": "`allow first-variant, …` — silence one of the paper's assembly rules for this robot on purpose (e.g. "
     "for a wrist).",
     "at": "`at (x, y, z) m` — a position (in base_link for obstacles and targets, in tool0 for a payload).",
@@ -82,6 +83,15 @@ KEYWORDS = {
     "size": "`size (x, y, z) m` — a box's full edge lengths.",
     "radius": "`radius R m` — the radius of a sphere or cylinder.",
     "length": "`length L m` — a cylinder's length along its axis.",
+    "design": "`design NAME { … }` — a design problem for `modc design`: the cell and its targets, search bounds "
+              "and objectives, no chain.",
+    "units": "`units 1 to 3` — (design) how many units a chain may have.",
+    "modules": "`modules H1, H3, L4` — (design) the unit types a chain may use.",
+    "links": "`links 150 mm to 300 mm step 50 mm` — (design) the link-module lengths to try.",
+    "rank": "`rank modules, mass, margin` — (design) the objectives in order of importance.",
+    "to": "`… to …` — the upper end of a range (`units 1 to 3`, `links 150 mm to 300 mm`).",
+    "step": "`step 50 mm` — the spacing of the link lengths a design search tries.",
+    "within": "`within 5 mm, 2 deg` — a target's position (and orientation) tolerance (default 5 mm, 2°).",
 }
 
 # What each parameter does, in words; their names and kinds are the lowering's (model/lower.py).

@@ -10,7 +10,7 @@ from .. import names
 from ..diagnostics import REGISTRY, Diagnostic, codes
 from ..syntax import ast
 from . import quantities as Q
-from .robot import Design, DHRow, JointLimit, Obstacle, Payload, Pose, Robot, Target, Transform, UnitSpec
+from .robot import Design, DHRow, JointLimit, Obstacle, Payload, Pose, Problem, Robot, Target, Transform, UnitSpec
 
 UNIT_PARAMS = {"pivot": "an angle", "port": "an angle", "link": "a length"}
 DH_PARAMS = {"a": "a length", "alpha": "an angle", "d": "a length", "theta": "an angle"}
@@ -123,76 +123,129 @@ class _Lowerer:
         rpy = self.vector(p.rpy, "an angle", f"{p.keyword} orientation") if p.rpy else None
         return Transform(xyz=xyz or (0.0, 0.0, 0.0), rpy=rpy or (0.0, 0.0, 0.0))
 
+    def target(self, st: ast.Target) -> Target | None:
+        what = f"target '{_say(st.name)}'"
+        xyz = self.vector(st.at, "a length", what)
+        rpy = self.vector(st.rpy, "an angle", f"orientation of {what}") if st.rpy else None
+        tol: dict[str, float] = {}
+        if st.within is not None:
+            w = st.within
+            pos = self.quantity(w.position, "a length", f"position tolerance of {what}")
+            ang = self.quantity(w.orientation, "an angle", f"orientation tolerance of {what}") if w.orientation else None
+            for key, value, q in (("position_tolerance", pos, w.position), ("orientation_tolerance", ang, w.orientation)):
+                if value is not None and value <= 0:
+                    self.error(codes.NONPOSITIVE_SIZE.at(q.span, what=f"the {key.replace('_', ' ')} of {what}",
+                                                         value=f"{q.value:g} {q.unit}"))
+                elif value is not None:
+                    tol[key] = value
+        if not self.name(st.name, "target") or xyz is None or (st.rpy is not None and rpy is None):
+            return None
+        return Target(name=st.name.text, xyz=xyz, rpy=rpy, span=st.span, **tol)
+
+    def cell_statement(self, st, block: str, fields: dict, seen: dict, acc: dict) -> None:
+        """Statements robots and design blocks share (library, placements, payload, poses,
+        limits, obstacles, targets, allow), into fields and the acc lists."""
+        kind = {ast.Chain: "chain", ast.DH: "dh", ast.Library: "library", ast.Payload: "payload"}.get(type(st))
+        if isinstance(st, ast.Placement):
+            kind = st.keyword
+        if kind in ONCE:
+            if kind in seen:
+                self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=block))
+                return
+            seen[kind] = st
+        match st:
+            case ast.Chain():
+                units = [self.unit(u) for u in st.units]
+                # a chain with a bad unit name is not checked further: the rest would only mislead
+                acc["named"] = acc["named"] and None not in units
+                fields["units"] = tuple(u for u in units if u is not None)
+            case ast.DH():
+                fields["dh"] = self.dh(st)
+                fields["dh_fit_links"] = st.fit_links
+            case ast.Library():
+                fields["library_ref"] = st.ref
+                fields["library_dir"] = acc["source_dir"] if st.is_path else None
+                fields["library_span"] = st.span
+            case ast.Placement():
+                fields[st.keyword] = self.placement(st)
+            case ast.Payload():
+                mass = self.quantity(st.mass, "a mass", "payload mass")
+                com = self.vector(st.at, "a length", "payload centre of mass") if st.at else (0.0, 0.0, 0.0)
+                if mass is not None and com is not None:
+                    fields["payload"] = Payload(mass=mass, com=com, span=st.span)
+            case ast.Pose():
+                q = self.vector(st.values, "an angle", f"pose '{_say(st.name)}'", n=None)
+                if self.name(st.name, "pose") and q is not None:
+                    acc["poses"].append(Pose(name=st.name.text, q=q, span=st.span))
+            case ast.Limit():
+                v = self.vector(st.values, "an angle", f"limit of '{_say(st.joint)}'", n=2)
+                if self.name(st.joint, "joint") and v is not None:
+                    acc["limits"].append(JointLimit(joint=st.joint.text, lower=v[0], upper=v[1], span=st.span))
+            case ast.Box() | ast.Sphere() | ast.Cylinder():
+                o = self.obstacle(st)
+                if o is not None:
+                    acc["obstacles"].append(o)
+            case ast.Target():
+                t = self.target(st)
+                if t is not None:
+                    acc["targets"].append(t)
+            case ast.Allow():
+                for c in st.codes:
+                    if c.text in REGISTRY and REGISTRY[c.text].allowable:
+                        acc["allow"].add(c.text)
+                    else:
+                        allowable = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
+                        self.error(codes.UNKNOWN_ALLOW.at(c.span, name=_say(c), allowable=allowable))
+
+    @staticmethod
+    def _acc(source_dir: str | None) -> dict:
+        return {"poses": [], "limits": [], "obstacles": [], "targets": [], "allow": set(), "source_dir": source_dir,
+                "named": True}
+
+    @staticmethod
+    def _lists(acc: dict) -> dict:
+        return {"poses": tuple(acc["poses"]), "limits": tuple(acc["limits"]), "obstacles": tuple(acc["obstacles"]),
+                "targets": tuple(acc["targets"]), "allow": frozenset(acc["allow"])}
+
     def robot(self, r: ast.Robot, source_dir: str | None) -> Robot | None:
         """The robot, or None when its name or a unit's is invalid (its statements are still checked)."""
         named = self.name(r.name, "robot")
         rname = _say(r.name)
         fields: dict = {}
         seen: dict[str, object] = {}
-        poses, limits, obstacles, targets, allow = [], [], [], [], set()
+        acc = self._acc(source_dir)
         for st in r.body:
-            kind = {ast.Chain: "chain", ast.DH: "dh", ast.Library: "library", ast.Payload: "payload"}.get(type(st))
-            if isinstance(st, ast.Placement):
-                kind = st.keyword
-            if kind in ONCE:
-                if kind in seen:
-                    self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=rname))
-                    continue
-                seen[kind] = st
-            match st:
-                case ast.Chain():
-                    units = [self.unit(u) for u in st.units]
-                    # a chain with a bad unit name is not checked further: the rest would only mislead
-                    named = named and None not in units
-                    fields["units"] = tuple(u for u in units if u is not None)
-                case ast.DH():
-                    fields["dh"] = self.dh(st)
-                    fields["dh_fit_links"] = st.fit_links
-                case ast.Library():
-                    fields["library_ref"] = st.ref
-                    fields["library_dir"] = source_dir if st.is_path else None
-                    fields["library_span"] = st.span
-                case ast.Placement():
-                    fields[st.keyword] = self.placement(st)
-                case ast.Payload():
-                    mass = self.quantity(st.mass, "a mass", "payload mass")
-                    com = self.vector(st.at, "a length", "payload centre of mass") if st.at else (0.0, 0.0, 0.0)
-                    if mass is not None and com is not None:
-                        fields["payload"] = Payload(mass=mass, com=com, span=st.span)
-                case ast.Pose():
-                    q = self.vector(st.values, "an angle", f"pose '{_say(st.name)}'", n=None)
-                    if self.name(st.name, "pose") and q is not None:
-                        poses.append(Pose(name=st.name.text, q=q, span=st.span))
-                case ast.Limit():
-                    v = self.vector(st.values, "an angle", f"limit of '{_say(st.joint)}'", n=2)
-                    if self.name(st.joint, "joint") and v is not None:
-                        limits.append(JointLimit(joint=st.joint.text, lower=v[0], upper=v[1], span=st.span))
-                case ast.Box() | ast.Sphere() | ast.Cylinder():
-                    o = self.obstacle(st)
-                    if o is not None:
-                        obstacles.append(o)
-                case ast.Target():
-                    xyz = self.vector(st.at, "a length", f"target '{_say(st.name)}'")
-                    if self.name(st.name, "target") and xyz is not None:
-                        targets.append(Target(name=st.name.text, xyz=xyz, span=st.span))
-                case ast.Allow():
-                    for c in st.codes:
-                        if c.text in REGISTRY and REGISTRY[c.text].allowable:
-                            allow.add(c.text)
-                        else:
-                            allowable = ", ".join(sorted(k for k, v in REGISTRY.items() if v.allowable))
-                            self.error(codes.UNKNOWN_ALLOW.at(c.span, name=_say(c), allowable=allowable))
+            self.cell_statement(st, rname, fields, seen, acc)
         if "chain" in seen and "dh" in seen:
             self.error(codes.CHAIN_AND_DH.at(seen["dh"].span, robot=rname))
             fields.pop("dh")
         elif "chain" not in seen and "dh" not in seen:
             self.error(codes.MISSING_CHAIN.at(r.name.span, robot=rname))
-        if not named:
+        if not (named and acc["named"]):
             return None
-        return Robot(
-            name=r.name.text, poses=tuple(poses), limits=tuple(limits), obstacles=tuple(obstacles),
-            targets=tuple(targets), allow=frozenset(allow), span=r.span, name_span=r.name.span, **fields,
-        )
+        return Robot(name=r.name.text, span=r.span, name_span=r.name.span, **self._lists(acc), **fields)
+
+    def problem(self, d: ast.DesignBlock, source_dir: str | None) -> Problem | None:
+        """The design problem, or None when its name is invalid (its statements are still checked)."""
+        from .problem_bounds import lower_bounds
+
+        named = self.name(d.name, "design")
+        fields: dict = {}
+        seen: dict[str, object] = {}
+        acc = self._acc(source_dir)
+        search: list = []
+        for st in d.body:
+            if isinstance(st, ast.Units | ast.Modules | ast.Links | ast.Rank):
+                search.append(st)
+            else:
+                self.cell_statement(st, _say(d.name), fields, seen, acc)
+        if not acc["targets"] and not any(isinstance(st, ast.Target) for st in d.body):
+            self.error(codes.DESIGN_NO_TARGETS.at(d.name.span, name=_say(d.name)))
+        bounds = lower_bounds(self, search, _say(d.name))
+        if not (named and acc["named"]):
+            return None
+        cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)
+        return Problem(name=d.name.text, cell=cell, span=d.span, name_span=d.name.span, **bounds)
 
     def obstacle(self, st) -> Obstacle | None:
         name = _say(st.name)
@@ -223,4 +276,6 @@ def lower(file: ast.File, diags: list[Diagnostic]) -> Design:
     source_dir = str(Path(file.path).parent) if not file.path.startswith("<") else None
     low = _Lowerer(diags)
     robots = (low.robot(r, source_dir) for r in file.robots)
-    return Design(path=file.path, robots=tuple(r for r in robots if r is not None))
+    problems = (low.problem(d, source_dir) for d in file.designs)
+    return Design(path=file.path, robots=tuple(r for r in robots if r is not None),
+                  problems=tuple(p for p in problems if p is not None))

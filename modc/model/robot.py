@@ -88,9 +88,16 @@ class Obstacle(_M):
     span: SpanField
 
 
+POSITION_TOLERANCE = 0.005  # m: default distance of tool0 from a target that counts as on it
+ORIENTATION_TOLERANCE = 0.034906585039886591  # rad (2°): default for a target with an orientation
+
+
 class Target(_M):
     name: Name
     xyz: Vec3  # m, in base_link
+    rpy: Vec3 | None = None  # rad, tool0's orientation in base_link (URDF fixed axes); None: position only
+    position_tolerance: float = POSITION_TOLERANCE
+    orientation_tolerance: float = ORIENTATION_TOLERANCE
     span: SpanField
 
 
@@ -172,8 +179,29 @@ class Robot(_M):
         return (lo, hi) if lo < hi else hw
 
 
+RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest torque margin
+
+
+class Problem(_M):
+    """A `design` block: the cell (a robot without units: library, base, tool, payload,
+    obstacles, targets) and the bounds and objectives of the search for its chains."""
+
+    name: Name
+    cell: Robot
+    min_units: int = 1
+    max_units: int = 3
+    modules: tuple[str, ...] | None = None  # allowed unit names; None: every unit of the library
+    links: tuple[float, ...] | None = None  # m, link-module lengths to try; None: the library's default
+    rank: tuple[str, ...] = RANK_KEYS
+    span: SpanField
+    name_span: SpanField
+    # where each bound was written ("units", "links", "module:H9"), for the library checks
+    bound_spans: Annotated[SkipValidation[dict[str, Span]], Field(default_factory=dict, exclude=True, repr=False)]
+
+
 class Design(_M):
     """Everything one input file defines."""
 
     path: str
     robots: tuple[Robot, ...] = ()
+    problems: tuple[Problem, ...] = ()  # `design` blocks

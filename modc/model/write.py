@@ -52,3 +52,65 @@ def robot_text(robot: Robot, comments: list[str] = ()) -> str:
         lines.append(" ".join(parts))
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def _placement(keyword: str, t) -> str | None:
+    if t.xyz == (0.0, 0.0, 0.0) and t.rpy == (0.0, 0.0, 0.0):
+        return None
+    parts = [f"    {keyword}"]
+    if t.xyz != (0.0, 0.0, 0.0):
+        parts.append("at " + vec([_num(v) for v in t.xyz], "m"))
+    if t.rpy != (0.0, 0.0, 0.0):
+        parts.append("rpy " + vec([_num(math.degrees(v)) for v in t.rpy], "deg"))
+    return " ".join(parts)
+
+
+def _obstacle(o) -> str:
+    at = "at " + vec([_num(v) for v in o.origin.xyz], "m")
+    rpy = " rpy " + vec([_num(math.degrees(v)) for v in o.origin.rpy], "deg") if o.origin.rpy != (0.0, 0.0, 0.0) else ""
+    if o.shape == "box":
+        return f"    box {o.name} size {vec([_num(v) for v in o.size], 'm')} {at}{rpy}"
+    if o.shape == "sphere":
+        return f"    sphere {o.name} radius {_num(o.size[0])} m {at}"
+    return f"    cylinder {o.name} radius {_num(o.size[0])} m length {_num(o.size[1])} m {at}{rpy}"
+
+
+def target_text(t) -> str:
+    from .robot import ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+
+    s = f"    target {t.name} at {vec([_num(v) for v in t.xyz], 'm')}"
+    if t.rpy is not None:
+        s += " rpy " + vec([_num(math.degrees(v)) for v in t.rpy], "deg")
+    if t.position_tolerance != POSITION_TOLERANCE or t.orientation_tolerance != ORIENTATION_TOLERANCE:
+        s += f" within {_num(t.position_tolerance * 1000, 6)} mm"
+        if t.rpy is not None:
+            s += f", {_num(math.degrees(t.orientation_tolerance))} deg"
+    return s
+
+
+def robot_file_text(robot: Robot, comments: list[str] = ()) -> str:
+    """A complete robot block: chain, library, placements, payload, limits, poses, the cell and its targets."""
+    lines = robot_text(robot, comments).rstrip("\n").split("\n")[:-1]  # without the closing brace
+    if robot.library_ref != "mark2" and robot.library_dir is not None:
+        from pathlib import Path
+
+        # a library file named relative to the source: name it absolutely (the text came from a
+        # quoted string, so it holds no quote or newline)
+        path = (Path(robot.library_dir) / robot.library_ref).resolve()
+        lines = [f'    library "{path}"' if ln.startswith("    library ") else ln for ln in lines]
+    base = _placement("base", robot.base)
+    if base:
+        lines.append(base)
+    if robot.payload is not None:
+        at = "" if robot.payload.com == (0.0, 0.0, 0.0) else " at " + vec([_num(v) for v in robot.payload.com], "m")
+        lines.append(f"    payload {_num(robot.payload.mass * 1000, 6)} g{at}")
+    for lim in robot.limits:
+        lines.append(f"    limit {lim.joint} " + vec([_num(math.degrees(lim.lower)), _num(math.degrees(lim.upper))], "deg"))
+    for p in robot.poses:
+        lines.append(f"    pose {p.name} " + vec([_num(math.degrees(x), 6) for x in p.q], "deg"))
+    lines += [_obstacle(o) for o in robot.obstacles]
+    lines += [target_text(t) for t in robot.targets]
+    if robot.allow:
+        lines.append("    allow " + ", ".join(sorted(robot.allow)))
+    lines.append("}")
+    return "\n".join(lines) + "\n"

@@ -8,6 +8,7 @@ from . import (
     check_modules,
     check_names,
     check_poses,
+    check_problems,
     check_torque,
     check_twists,
     convert_dh,
@@ -25,6 +26,7 @@ PASSES = (
     check_poses,
     check_environment,
     check_torque,
+    check_problems,
 )
 
 

@@ -9,7 +9,7 @@ target (SPEC section 6).
 Steps (modules of this package):
     collision.py  the compiled URDF's collision meshes + the file's obstacles, pinocchio + coal;
                   self-collision pairs from the SRDF's matrix; certified straight motions
-    ik.py         position IK of tool0 (projected Levenberg-Marquardt, many seeded starts);
+    ik.py         IK of tool0, position or full pose (projected Levenberg-Marquardt, many seeded starts);
                   the collision-free solution closest to the start pose is the goal
     planner.py    OMPL RRT-Connect in joint space, then shortcutting
     timing.py     stop-at-every-vertex trapezoidal timing within the velocity limits
@@ -227,8 +227,11 @@ def _goals(job: _Job, checker, q_start):
 
     from . import ik
 
+    from ..kinematics import rpy_matrix
+
     tgt = job.target
-    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper)
+    rotation = None if tgt.rpy is None else rpy_matrix(tgt.rpy)
+    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper, rotation)
     verdict: dict[bytes, bool] = {}
 
     def free(q) -> bool:
@@ -238,7 +241,8 @@ def _goals(job: _Job, checker, q_start):
         return verdict[key]
 
     solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * job.robot.dof, job.seed,
-                               batches=IK_BATCHES, enough=free)
+                               batches=IK_BATCHES, enough=free,
+                               tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf))
     if not solutions:
         tool = solver.position(best.q)
         raise job.fail(

@@ -14,6 +14,11 @@ more joints than the 3 the position needs, slid along their self-motion towards 
 
 A run that does not reach the target stops at a local minimum of the distance: the smallest
 of those over all seeds is what "how far out of reach" reports.
+
+Targets with an orientation (`target … rpy …`): the residual gains the rotation vector of
+R_target R(q)^T, weighted by ROTATION_WEIGHT m/rad, and J the angular rows (6-D IK). A target's
+tolerances (default 5 mm, 2°) decide what counts as reached for arms that cannot get closer
+(fewer joints than the target has constraints); runs still polish towards TOLERANCE.
 """
 from __future__ import annotations
 
@@ -28,6 +33,7 @@ LAMBDA0 = 1e-3
 LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e8
 STALL = 1e-6  # a step that lowers the error by less than this fraction ends the run
 NULL_STEPS = 60  # redundant arms: steps towards the start pose along the self-motion
+ROTATION_WEIGHT = 0.2  # m/rad: weight of the orientation error against the position error (6-D IK)
 
 
 @dataclass(frozen=True)
@@ -37,29 +43,70 @@ class Solution:
     seed_index: int
 
 
+def rotation_vector(R: np.ndarray) -> np.ndarray:
+    """The axis times the angle of a rotation matrix (log map), accurate up to 180°."""
+    cos = np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)
+    angle = float(np.arccos(cos))
+    v = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    s = float(np.linalg.norm(v))
+    if s > 1e-9:
+        return v * (angle / s)
+    if cos > 0:
+        return v  # near identity: the skew part is the rotation vector
+    B = (R + np.eye(3)) / 2.0  # near 180°: the axis from the symmetric part
+    k = int(np.argmax(np.diag(B)))
+    axis = B[:, k] / np.linalg.norm(B[:, k])
+    return axis * angle
+
+
 class PositionIK:
-    def __init__(self, model, data, frame: int, lower, upper):
+    """IK of tool0 to a position, or (rotation given: a 3x3 matrix in base_link) to a full pose."""
+
+    def __init__(self, model, data, frame: int, lower, upper, rotation=None):
         import pinocchio as pin
 
         self.pin = pin
         self.model, self.data, self.frame = model, data, frame
         self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
+        self.rotation = None if rotation is None else np.asarray(rotation, float)
 
-    def position(self, q) -> np.ndarray:
+    def placement(self, q):
         pin = self.pin
         pin.forwardKinematics(self.model, self.data, q)
-        return np.array(pin.updateFramePlacement(self.model, self.data, self.frame).translation)
+        return pin.updateFramePlacement(self.model, self.data, self.frame)
+
+    def position(self, q) -> np.ndarray:
+        return np.array(self.placement(q).translation)
+
+    def residual(self, q, target) -> np.ndarray:
+        """target - p(q), with the weighted rotation error appended for a full pose."""
+        M = self.placement(q)
+        e = target - np.array(M.translation)
+        if self.rotation is None:
+            return e
+        return np.concatenate([e, ROTATION_WEIGHT * rotation_vector(self.rotation @ np.array(M.rotation).T)])
+
+    def errors(self, q, target) -> tuple[float, float]:
+        """(position error m, orientation error rad; 0 without an orientation)."""
+        M = self.placement(q)
+        pe = float(np.linalg.norm(target - np.array(M.translation)))
+        if self.rotation is None:
+            return pe, 0.0
+        return pe, float(np.linalg.norm(rotation_vector(self.rotation @ np.array(M.rotation).T)))
 
     def jacobian(self, q) -> np.ndarray:
         pin = self.pin
         J = pin.computeFrameJacobian(self.model, self.data, q, self.frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-        return np.array(J[:3])
+        if self.rotation is None:
+            return np.array(J[:3])
+        return np.vstack([np.array(J[:3]), ROTATION_WEIGHT * np.array(J[3:])])
 
     def run(self, q0, target) -> tuple[np.ndarray, float]:
         """One projected LM descent from q0: (q, final error)."""
         q = np.clip(np.asarray(q0, float), self.lower, self.upper)
-        e = target - self.position(q)
+        e = self.residual(q, target)
         err = float(np.linalg.norm(e))
+        m = e.size
         lam = LAMBDA0
         for _ in range(MAX_ITERATIONS):
             if err <= TOLERANCE:
@@ -68,9 +115,9 @@ class PositionIK:
             JJt = J @ J.T
             improved = False
             while lam <= LAMBDA_MAX:
-                y = np.linalg.solve(JJt + lam * np.eye(3), e)
+                y = np.linalg.solve(JJt + lam * np.eye(m), e)
                 qn = np.clip(q + J.T @ y, self.lower, self.upper)
-                en = target - self.position(qn)
+                en = self.residual(qn, target)
                 errn = float(np.linalg.norm(en))
                 if errn < err:
                     stalled = err - errn < STALL * err
@@ -88,7 +135,7 @@ class PositionIK:
         gradient steps in the Jacobian's null space, each re-converged; a step that leaves the
         limits or the target is dropped)."""
         n = q.size
-        if n <= 3:
+        if n <= (3 if self.rotation is None else 6):
             return q
         for _ in range(NULL_STEPS):
             J = self.jacobian(q)
@@ -115,12 +162,14 @@ def seeds(start, lower, upper, count: int, seed: int) -> list[np.ndarray]:
 
 
 def solve(ik: PositionIK, target, start, count: int, seed: int, batches: int = 1,
-          enough: Callable[[np.ndarray], bool] | None = None) -> tuple[list[Solution], Solution]:
+          enough: Callable[[np.ndarray], bool] | None = None,
+          tolerance: tuple[float, float] = (TOLERANCE, np.inf)) -> tuple[list[Solution], Solution]:
     """Converged solutions (duplicates within 1e-6 rad dropped), in order of joint-space
     distance to start, and the best run overall (the closest approach, for error messages).
     Up to `batches` batches of `count` seeds; after a batch, stop if some solution is
     `enough` (e.g. collision-free: redundant arms have a continuum of solutions, and a few
-    more seeds find a free one where the first batch's all collide)."""
+    more seeds find a free one where the first batch's all collide). A run counts as a solution
+    when it ends within `tolerance` (m, rad) of the target: the target's own tolerances."""
     target = np.asarray(target, float)
     start = np.asarray(start, float)
     found: list[Solution] = []
@@ -128,15 +177,17 @@ def solve(ik: PositionIK, target, start, count: int, seed: int, batches: int = 1
     all_seeds = seeds(start, ik.lower, ik.upper, count * batches, seed)
     for b in range(batches):
         for k in range(b * count, (b + 1) * count):
-            q, err = ik.run(all_seeds[k], target)
-            if best is None or err < best.error:
-                best = Solution(q, err, k)
-            if err > TOLERANCE:
+            q, _ = ik.run(all_seeds[k], target)
+            pe, oe = ik.errors(q, target)
+            if best is None or pe < best.error:
+                best = Solution(q, pe, k)
+            if pe > max(tolerance[0], TOLERANCE) or oe > tolerance[1]:
                 continue
-            q = ik.towards(q, start, target)
+            if pe <= TOLERANCE:
+                q = ik.towards(q, start, target)
             if any(np.max(np.abs(s.q - q)) < 1e-6 for s in found):
                 continue
-            found.append(Solution(q, float(np.linalg.norm(target - ik.position(q))), k))
+            found.append(Solution(q, ik.errors(q, target)[0], k))
         if not found and b == 0:
             break  # nothing converged from count seeds: out of reach, more seeds will not help
         if enough is None or any(enough(s.q) for s in found):
@@ -146,4 +197,4 @@ def solve(ik: PositionIK, target, start, count: int, seed: int, batches: int = 1
     return found, best
 
 
-__all__ = ["MAX_ITERATIONS", "TOLERANCE", "PositionIK", "Solution", "seeds", "solve"]
+__all__ = ["MAX_ITERATIONS", "ROTATION_WEIGHT", "TOLERANCE", "PositionIK", "Solution", "rotation_vector", "seeds", "solve"]

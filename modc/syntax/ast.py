@@ -131,15 +131,61 @@ class Cylinder:
 
 
 @dataclass(frozen=True, slots=True)
+class Within:
+    """`within 5 mm, 2 deg`: a target's position (and orientation) tolerance."""
+
+    position: Quantity
+    orientation: Quantity | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
 class Target:
     name: Name
     at: Vector
     span: Span
+    rpy: Vector | None = None  # tool0's orientation in base_link (URDF fixed axes)
+    within: Within | None = None
 
 
 @dataclass(frozen=True, slots=True)
 class Allow:
     codes: tuple[Name, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Units:
+    """`units 1 to 3` (design blocks): bounds on the number of units."""
+
+    low: Quantity
+    high: Quantity | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Modules:
+    """`modules H1, H3, L4` (design blocks): the unit types a chain may use."""
+
+    names: tuple[Name, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Links:
+    """`links 150 mm to 300 mm step 50 mm` (design blocks): link-module lengths to try."""
+
+    low: Quantity
+    high: Quantity | None
+    step: Quantity | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Rank:
+    """`rank modules, mass, margin` (design blocks): the order of objectives."""
+
+    keys: tuple[Name, ...]
     span: Span
 
 
@@ -153,7 +199,20 @@ class Robot:
     span: Span
 
 
+DesignStatement = Library | Placement | Payload | Box | Sphere | Cylinder | Target | Allow | Units | Modules | Links | Rank
+
+
+@dataclass(frozen=True, slots=True)
+class DesignBlock:
+    """`design NAME { … }`: a cell and its targets, for `modc design` to find chains for."""
+
+    name: Name
+    body: tuple[DesignStatement, ...]
+    span: Span
+
+
 @dataclass(frozen=True, slots=True)
 class File:
     path: str
     robots: tuple[Robot, ...]
+    designs: tuple[DesignBlock, ...] = ()

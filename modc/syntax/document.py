@@ -62,6 +62,15 @@ class CylinderDoc(_Doc):
     rpy: Vector | None = None
 
 
+class TargetDoc(_Doc):
+    at: Vector
+    rpy: Vector | None = Field(None, description="tool0's orientation in base_link (URDF fixed axes), e.g. \"(0, 90, 0) deg\"")
+    within: str | None = Field(None, description='tolerances: "5 mm" or "5 mm, 2 deg"')
+
+
+TargetValue = Union[Vector, TargetDoc]
+
+
 class RobotDoc(_Doc):
     name: Name
     library: str | None = Field(None, description="built-in library name, or a path to a library YAML file")
@@ -74,13 +83,31 @@ class RobotDoc(_Doc):
     limits: dict[str, Vector] = Field(default_factory=dict, description='joint name -> "(lower, upper) deg"',
                                       json_schema_extra=_KEYS)
     obstacles: list[Union[BoxDoc, SphereDoc, CylinderDoc]] = Field(default_factory=list)
-    targets: dict[str, Vector] = Field(default_factory=dict, description='name -> position of tool0 in base_link',
-                                       json_schema_extra=_KEYS)
+    targets: dict[str, TargetValue] = Field(default_factory=dict, description='name -> position of tool0 in base_link (or {at, rpy, within})',
+                                            json_schema_extra=_KEYS)
     allow: list[str] = Field(default_factory=list, description="assembly-rule codes to silence, e.g. first-variant")
 
 
+class DesignDoc(_Doc):
+    """A design problem (`modc design`): the cell and its targets, search bounds, objectives."""
+
+    name: str = Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    library: str | None = None
+    base: PlacementDoc | None = None
+    tool: PlacementDoc | None = None
+    payload: PayloadDoc | None = None
+    obstacles: list[Union[BoxDoc, SphereDoc, CylinderDoc]] = Field(default_factory=list)
+    targets: dict[str, TargetValue] = Field(default_factory=dict)
+    allow: list[str] = Field(default_factory=list)
+    units: Union[int, str, None] = Field(None, description='number of units: 3 or "2 to 4"')
+    modules: list[str] | None = Field(None, description="unit types a chain may use, e.g. [H1, H3, L3, L4]")
+    links: str | None = Field(None, description='link lengths to try: "220 mm" or "150 mm to 300 mm step 50 mm"')
+    rank: list[str] | None = Field(None, description="objectives in order: modules, mass, margin")
+
+
 class Document(_Doc):
-    robots: list[RobotDoc]
+    robots: list[RobotDoc] = Field(default_factory=list)
+    designs: list[DesignDoc] = Field(default_factory=list)
 
 
 def json_schema() -> dict:

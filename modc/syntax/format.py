@@ -153,7 +153,7 @@ def _tokens(tree) -> list[_Tok]:
                 _statement(c, 1, out)
                 continue
             t = _tok(c)
-            if t.type == "ROBOT":
+            if t.type in ("ROBOT", "DESIGN"):
                 t.level = 0
             elif t.type == "LBRACE":
                 t.opens = True

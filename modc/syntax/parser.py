@@ -42,11 +42,13 @@ def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]
         tree = lark.parse(text, start="start")
     except UnexpectedInput as e:
         return ast.File(file, ()), [_diagnose(e, text, file)]
-    robots = ToAst(file).transform(tree)
+    blocks = ToAst(file).transform(tree)
+    robots = tuple(b for b in blocks if isinstance(b, ast.Robot))
+    designs = tuple(b for b in blocks if isinstance(b, ast.DesignBlock))
     diags = []
-    if not robots:
+    if not blocks:
         diags.append(codes.EMPTY_FILE.at(Span.point(file)))
-    return ast.File(file, tuple(robots)), diags
+    return ast.File(file, robots, designs), diags
 
 
 def _describe(name: str) -> str:
@@ -137,7 +139,7 @@ def _open_robot(text: str) -> str | None:
     import re
 
     depth, name = 0, None
-    for m in re.finditer(r"#[^\n]*|\"[^\"\n]*\"|\brobot\s+([A-Za-z_]\w*)|[{}]", text):
+    for m in re.finditer(r"#[^\n]*|\"[^\"\n]*\"|\b(?:robot|design)\s+([A-Za-z_]\w*)|[{}]", text):
         s = m.group(0)
         if s.startswith(("#", '"')):
             continue

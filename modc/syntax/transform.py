@@ -37,8 +37,30 @@ class ToAst:
     def _name(self, t: Token) -> ast.Name:
         return ast.Name(str(t), token_span(self.file, t))
 
-    def start(self, meta, robots):
-        return list(robots)
+    def start(self, meta, blocks):
+        return list(blocks)
+
+    def design(self, meta, items):
+        name, *body = items
+        return ast.DesignBlock(self._name(name), tuple(body), self._span(meta))
+
+    def units(self, meta, items):
+        return ast.Units(self._count(items[0]), self._count(items[1]) if items[1] is not None else None, self._span(meta))
+
+    def _count(self, t: Token) -> ast.Quantity:
+        return ast.Quantity(_num(t), None, token_span(self.file, t))
+
+    def modules(self, meta, items):
+        return ast.Modules(tuple(self._name(t) for t in items), self._span(meta))
+
+    def links(self, meta, items):
+        return ast.Links(items[0], items[1], items[2], self._span(meta))
+
+    def rank(self, meta, items):
+        return ast.Rank(tuple(self._name(t) for t in items), self._span(meta))
+
+    def within(self, meta, items):
+        return ("within", ast.Within(items[0], items[1], self._span(meta)))
 
     def robot(self, meta, items):
         name, *body = items
@@ -119,7 +141,8 @@ class ToAst:
         return ast.Cylinder(self._name(items[0]), items[1], items[2], rest["at"], rest.get("rpy"), self._span(meta))
 
     def target(self, meta, items):
-        return ast.Target(self._name(items[0]), items[1][1], self._span(meta))
+        rest = dict(items[2:])
+        return ast.Target(self._name(items[0]), items[1][1], self._span(meta), rest.get("rpy"), rest.get("within"))
 
     def allow(self, meta, items):
         return ast.Allow(tuple(self._name(t) for t in items), self._span(meta))

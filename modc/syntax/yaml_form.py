@@ -82,7 +82,68 @@ class _Reader:
         return _respan(node, span)
 
     def robot(self, r, path: tuple) -> ast.Robot:
-        body: list = []
+        body: list = [self._chain(r, path)]
+        body += self._cell(r, path)
+        for name, text in r.poses.items():
+            v = self._vec(text, path + ("poses", name))
+            if v is not None:
+                body.append(ast.Pose(ast.Name(name, self.span(path + ("poses", name, "__key__"))), v, self.span(path + ("poses", name))))
+        for name, text in r.limits.items():
+            v = self._vec(text, path + ("limits", name))
+            if v is not None:
+                body.append(ast.Limit(ast.Name(name, self.span(path + ("limits", name, "__key__"))), v, self.span(path + ("limits", name))))
+        return ast.Robot(ast.Name(r.name, self.span(path + ("name",))), tuple(body), self.span(path))
+
+    def design(self, d, path: tuple) -> ast.DesignBlock:
+        body = self._cell(d, path)
+        if d.units is not None:
+            p = path + ("units",)
+            parts = [x.strip() for x in str(d.units).split(" to ")] if isinstance(d.units, str) else [str(d.units)]
+            nums = [self._count(x, p) for x in parts[:2]]
+            if all(n is not None for n in nums):
+                body.append(ast.Units(nums[0], nums[1] if len(nums) > 1 else None, self.span(p)))
+        if d.modules is not None:
+            p = path + ("modules",)
+            body.append(ast.Modules(tuple(ast.Name(m, self.span(p + (i,))) for i, m in enumerate(d.modules)), self.span(p)))
+        if d.links is not None:
+            p = path + ("links",)
+            import re
+
+            parts = re.split(r"\s+(?:to|step)\s+", d.links)
+            qs = [self._sub("quantity_text", x, p) for x in parts[:3]]
+            if all(q is not None for q in qs):
+                qs += [None] * (3 - len(qs))
+                body.append(ast.Links(qs[0], qs[1], qs[2], self.span(p)))
+        if d.rank is not None:
+            p = path + ("rank",)
+            body.append(ast.Rank(tuple(ast.Name(k, self.span(p + (i,))) for i, k in enumerate(d.rank)), self.span(p)))
+        return ast.DesignBlock(ast.Name(d.name, self.span(path + ("name",))), tuple(body), self.span(path))
+
+    def _count(self, text: str, path: tuple):
+        try:
+            return ast.Quantity(float(text), None, self.span(path))
+        except ValueError:
+            self.diags.append(codes.YAML_SCHEMA.at(self.span(path), detail=f"{_dotted(path)}: expected a number of units such as 3 or \"2 to 4\", got {text!r}"))
+            return None
+
+    def _target(self, name: str, value, p: tuple):
+        from .document import TargetDoc
+
+        key = ast.Name(name, self.span(p + ("__key__",)))
+        if not isinstance(value, TargetDoc):
+            v = self._vec(value, p)
+            return None if v is None else ast.Target(key, v, self.span(p))
+        at, rpy = self._vec(value.at, p + ("at",)), self._vec(value.rpy, p + ("rpy",))
+        within = None
+        if value.within is not None:
+            qs = [self._sub("quantity_text", x.strip(), p + ("within",)) for x in value.within.split(",")[:2]]
+            if all(q is not None for q in qs):
+                within = ast.Within(qs[0], qs[1] if len(qs) > 1 else None, self.span(p + ("within",)))
+        if at is None or (value.rpy is not None and rpy is None):
+            return None
+        return ast.Target(key, at, self.span(p), rpy, within)
+
+    def _chain(self, r, path: tuple) -> ast.Chain:
         units = []
         for i, item in enumerate(r.chain):
             p = path + ("chain", i)
@@ -99,7 +160,11 @@ class _Reader:
                 u = ast.Unit(ast.Name(item.unit, self.span(p + ("unit",))), tuple(params), self.span(p))
             if u is not None:
                 units.append(u)
-        body.append(ast.Chain(tuple(units), self.span(path + ("chain",))))
+        return ast.Chain(tuple(units), self.span(path + ("chain",)))
+
+    def _cell(self, r, path: tuple) -> list:
+        """Statements robots and designs share: library, placements, payload, obstacles, targets, allow."""
+        body: list = []
         if r.library is not None:
             is_path = r.library.endswith((".yaml", ".yml")) or "/" in r.library
             body.append(ast.Library(r.library, is_path, self.span(path + ("library",))))
@@ -113,24 +178,16 @@ class _Reader:
             m = self._sub("quantity_text", r.payload.mass, path + ("payload", "mass"))
             if m is not None:
                 body.append(ast.Payload(m, self._vec(r.payload.at, path + ("payload", "at")), self.span(path + ("payload",))))
-        for name, text in r.poses.items():
-            v = self._vec(text, path + ("poses", name))
-            if v is not None:
-                body.append(ast.Pose(ast.Name(name, self.span(path + ("poses", name, "__key__"))), v, self.span(path + ("poses", name))))
-        for name, text in r.limits.items():
-            v = self._vec(text, path + ("limits", name))
-            if v is not None:
-                body.append(ast.Limit(ast.Name(name, self.span(path + ("limits", name, "__key__"))), v, self.span(path + ("limits", name))))
         for i, o in enumerate(r.obstacles):
             body.extend(self._obstacle(o, path + ("obstacles", i)))
-        for name, text in r.targets.items():
-            v = self._vec(text, path + ("targets", name))
-            if v is not None:
-                body.append(ast.Target(ast.Name(name, self.span(path + ("targets", name, "__key__"))), v, self.span(path + ("targets", name))))
+        for name, value in r.targets.items():
+            t = self._target(name, value, path + ("targets", name))
+            if t is not None:
+                body.append(t)
         if r.allow:
             names = tuple(ast.Name(c, self.span(path + ("allow", i))) for i, c in enumerate(r.allow))
             body.append(ast.Allow(names, self.span(path + ("allow",))))
-        return ast.Robot(ast.Name(r.name, self.span(path + ("name",))), tuple(body), self.span(path))
+        return body
 
     def _vec(self, text, path):
         return None if text is None else self._sub("vector_text", text, path)
@@ -236,6 +293,7 @@ def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
         return ast.File(file, ()), diags
     reader = _Reader(file, spans, diags)
     robots = tuple(reader.robot(r, ("robots", i)) for i, r in enumerate(doc.robots))
-    if not robots:
+    designs = tuple(reader.design(d, ("designs", i)) for i, d in enumerate(doc.designs))
+    if not robots and not designs:
         diags.append(codes.EMPTY_FILE.at(Span.point(file)))
-    return ast.File(file, robots), diags
+    return ast.File(file, robots, designs), diags

@@ -1,0 +1,137 @@
+"""`modc design FILE -o DIR`: ranked module chains for the `design` blocks of FILE."""
+from __future__ import annotations
+
+import sys
+from contextlib import contextmanager, nullcontext
+from typing import Annotated
+
+import typer
+
+from .app import EXIT_ERRORS, EXIT_USAGE, LibraryOpt, _err, _print_diagnostics, app, usage_errors
+
+RENDERED = 3  # pictures of the top designs in report.html
+
+
+@contextmanager
+def _executor(workers: int, scheduler: str | None):
+    """None (this process), a local process pool, or a Dask cluster's executor: one interface."""
+    if scheduler:
+        from distributed import Client
+
+        with Client(scheduler) as client:
+            yield client.get_executor()
+    elif workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            yield pool
+    else:
+        yield None
+
+
+@contextmanager
+def _progress(enabled: bool, name: str):
+    """A rich progress line on stderr (a TTY only): twist settings screened per second, the best design so far."""
+    if not enabled:
+        yield None
+        return
+    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+    with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), transient=True,
+                  console=__import__("rich.console", fromlist=["Console"]).Console(stderr=True)) as bar:
+        import time
+
+        task = bar.add_task(f"design {name}", total=None)
+        start = time.perf_counter()
+
+        def update(evaluated: int, shapes: int, best: str) -> None:
+            rate = evaluated / max(time.perf_counter() - start, 1e-9)
+            bar.update(task, description=f"{name}: {evaluated:,} screened ({rate:,.0f}/s), {shapes} shapes; "
+                                         f"best {best or '—'}")
+        yield update
+
+
+def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
+    """PNG pictures of the given design files, each at its first target's pose."""
+    import tempfile
+    from pathlib import Path
+
+    from ..sim.render import render
+
+    out: dict[str, bytes] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in names:
+            src = Path(tmp) / name
+            src.write_text(files[name], encoding="utf-8")
+            text = files[name]
+            pose = next((ln.split()[1] for ln in text.splitlines() if ln.strip().startswith("pose ")), None)
+            png = Path(tmp) / (name + ".png")
+            ok, _, _ = render(str(src), str(png), pose=pose, width=400, height=300)
+            if ok:
+                out[name] = png.read_bytes()
+    return out
+
+
+@app.command("design")
+def design_cmd(
+    file: Annotated[str, typer.Argument(help=".mod file with `design NAME { … }` blocks")],
+    out: Annotated[str, typer.Option("-o", "--out", help="output directory: ranking.json, .mod files, report.html")],
+    max_units: Annotated[int | None, typer.Option("--max-units", min=1, help="largest chain, over `units`")] = None,
+    top: Annotated[int, typer.Option("--top", min=1, help="designs to keep")] = 5,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="same file and seed, same ranking")] = 0,
+    workers: Annotated[int, typer.Option("--workers", min=1, help="local worker processes")] = 1,
+    scheduler: Annotated[str | None, typer.Option("--scheduler", help="run on a Dask cluster: tcp://host:8786")] = None,
+    json_out: Annotated[bool, typer.Option("--json", help="print ranking.json on stdout")] = False,
+    render: Annotated[bool, typer.Option("--render/--no-render", help="pictures of the top designs")] = True,
+    library: LibraryOpt = None,
+    force: Annotated[bool, typer.Option(help="replace DIR even if modc did not create it")] = False,
+):
+    """Find the best module chains for the cells and targets of FILE's design blocks."""
+    import json
+
+    from ..compiler import InputError, check_file, write_tree
+    from ..design import run as search
+    from ..design.write import files as design_files
+    from ..design.write import ranking, summary_line
+    from ..diagnostics import codes
+
+    try:
+        checked = check_file(file, library)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise typer.Exit(EXIT_USAGE) from None
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    if not checked.ok:
+        raise typer.Exit(EXIT_ERRORS)
+    problems = checked.design.problems
+    if not problems:
+        _err(f"modc design: {file} has no `design NAME {{ … }}` block")
+        raise typer.Exit(EXIT_USAGE)
+    outcomes, failed = [], []
+    tty = sys.stderr.isatty()
+    with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor:
+        for p in problems:
+            with _progress(tty, p.name) if tty else nullcontext() as bar:
+                o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar)
+            if not o.designs:
+                assert p.cell.library is not None
+                hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
+                units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
+                failed.append(codes.NO_DESIGN.at(p.name_span, units=units, name=p.name, closest=o.why_none()))
+            outcomes.append(o)
+    if failed:
+        _print_diagnostics(failed, checked.sources)
+        _err(f"modc design: no design found; nothing written to {out}")
+        raise typer.Exit(EXIT_ERRORS)
+    tree = design_files(outcomes)
+    if render:
+        names = [f for f in tree if f.endswith(".mod")]
+        picks = [n for o in outcomes for n in names if n.startswith(f"{o.problem.name}_")][:RENDERED * len(outcomes)]
+        tree = design_files(outcomes, _renders(tree, picks))
+    with usage_errors("design", writing=out):
+        write_tree(tree, out, force=force)
+    if json_out:
+        print(json.dumps(ranking(outcomes), indent=2))
+    for o in outcomes:
+        _err(f"modc design: {summary_line(o)}")
+    _err(f"modc design: {len(tree)} files written to {out}")

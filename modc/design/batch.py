@@ -1,0 +1,152 @@
+"""SPEC section 2's kinematics for many candidate chains and many joint vectors at once (numpy).
+
+Per unit, A_t1(pivot) . A_J(theta) . A_t2(port) = PRE . Rz(theta) . POST with PRE = A_t1 . Tz(z12)
+and POST = A_t2 (identity for units 1/2), so one forward pass is two fixed 4x4 products and a
+rotation about z per unit. Arrays carry a leading batch shape (candidates, targets, seeds); the
+fixed parts broadcast over the last two. This is what the search evaluates by the thousand;
+modc.kinematics.Chain stays the reference (tests compare the two).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics import A_t1, A_t2, homogeneous, transform
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Fixed transforms of C candidates of one skeleton."""
+
+    pre: np.ndarray  # (C, n, 4, 4): A_t1(pivot) . Tz(z12)
+    post: np.ndarray  # (C, n, 4, 4): A_t2(port, link) or identity
+    t1: np.ndarray  # (n, 3): the twist1 origin in the unit's base frame, (x01, 0, z01)
+    flange_tool: np.ndarray  # (4, 4)
+
+    @property
+    def dof(self) -> int:
+        return self.pre.shape[1]
+
+
+def geometry(units, pivots: np.ndarray, ports: np.ndarray, links, tool_xyz, tool_rpy) -> Geometry:
+    """units: the library's UnitType per position; pivots, ports: (C, n) rad; links: m per position."""
+    C, n = pivots.shape
+    pre = np.empty((C, n, 4, 4))
+    post = np.empty((C, n, 4, 4))
+    for i, t in enumerate(units):
+        Tz = homogeneous(np.eye(3), (0.0, 0.0, t.z12))
+        for c in range(C):
+            pre[c, i] = A_t1(pivots[c, i], t.x01, t.z01) @ Tz
+            post[c, i] = A_t2(ports[c, i], links[i]) if t.link else np.eye(4)
+    t1 = np.array([(t.x01, 0.0, t.z01) for t in units], dtype=float).reshape(n, 3)
+    return Geometry(pre, post, t1, transform(tool_xyz, tool_rpy))
+
+
+def forward(g: Geometry, q: np.ndarray, points: bool = False):
+    """q (C, T, S, n) -> joint origins p and axes z (C, T, S, n, 3), T_base_tool (C, T, S, 4, 4) and,
+    with points, each unit's frame origins (base, twist1, joint, end) as (C, T, S, n, 4, 3)."""
+    C, T, S, n = q.shape
+    M = np.broadcast_to(np.eye(4), (C, T, S, 4, 4)).copy()
+    p = np.empty((C, T, S, n, 3))
+    z = np.empty((C, T, S, n, 3))
+    pts = np.empty((C, T, S, n, 4, 3)) if points else None
+    c, s = np.cos(q), np.sin(q)
+    for i in range(n):
+        if pts is not None:
+            pts[..., i, 0, :] = M[..., :3, 3]
+            pts[..., i, 1, :] = M[..., :3, 3] + M[..., :3, :3] @ g.t1[i]
+        M = M @ g.pre[:, i][:, None, None]
+        ci, si = c[..., i, None], s[..., i, None]
+        x, y = M[..., :3, 0].copy(), M[..., :3, 1].copy()
+        M[..., :3, 0] = ci * x + si * y
+        M[..., :3, 1] = ci * y - si * x
+        p[..., i, :] = M[..., :3, 3]
+        z[..., i, :] = M[..., :3, 2]
+        M = M @ g.post[:, i][:, None, None]
+        if pts is not None:
+            pts[..., i, 2, :] = p[..., i, :]
+            pts[..., i, 3, :] = M[..., :3, 3]
+    return p, z, M @ g.flange_tool, pts
+
+
+@dataclass
+class Flat:
+    """Fixed transforms per run, structure of arrays (run index last, so every product is a few
+    long vector operations): rotations (n, 3, 3, B), translations (n, 3, B)."""
+
+    pre_R: np.ndarray
+    pre_t: np.ndarray
+    post_R: np.ndarray
+    post_t: np.ndarray
+    tool_R: np.ndarray  # (3, 3)
+    tool_t: np.ndarray  # (3,)
+
+    @classmethod
+    def of(cls, g: Geometry, c_idx: np.ndarray) -> Flat:
+        def soa(M, rows, cols):
+            return np.ascontiguousarray(np.moveaxis(M[c_idx][:, :, rows, cols], 0, -1))
+
+        rot, col = (slice(0, 3), slice(0, 3)), (slice(0, 3), 3)
+        return cls(soa(g.pre, *rot), soa(g.pre, *col), soa(g.post, *rot), soa(g.post, *col),
+                   g.flange_tool[:3, :3], g.flange_tool[:3, 3])
+
+    def take(self, keep: np.ndarray) -> Flat:
+        return Flat(self.pre_R[..., keep], self.pre_t[..., keep], self.post_R[..., keep], self.post_t[..., keep],
+                    self.tool_R, self.tool_t)
+
+
+def _rot(R, P):
+    """R . P for stacks (3, 3, B) of rotations."""
+    return np.stack([np.stack([R[i, 0] * P[0, k] + R[i, 1] * P[1, k] + R[i, 2] * P[2, k] for k in range(3)])
+                     for i in range(3)])
+
+
+def _apply(R, v):
+    """R . v for (3, 3, B) and (3, B)."""
+    return np.stack([R[i, 0] * v[0] + R[i, 1] * v[1] + R[i, 2] * v[2] for i in range(3)])
+
+
+def forward_flat(f: Flat, q: np.ndarray):
+    """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
+    and position (3, B)."""
+    n, B = q.shape
+    R = np.zeros((3, 3, B))
+    R[0, 0] = R[1, 1] = R[2, 2] = 1.0
+    t = np.zeros((3, B))
+    p = np.empty((n, 3, B))
+    z = np.empty((n, 3, B))
+    c, s = np.cos(q), np.sin(q)
+    for i in range(n):
+        t = t + _apply(R, f.pre_t[i])
+        R = _rot(R, f.pre_R[i])
+        x, y = R[:, 0].copy(), R[:, 1]
+        R[:, 0] = c[i] * x + s[i] * y
+        R[:, 1] = c[i] * y - s[i] * x
+        p[i] = t
+        z[i] = R[:, 2]
+        t = t + _apply(R, f.post_t[i])
+        R = _rot(R, f.post_R[i])
+    t_tool = t + np.tensordot(np.moveaxis(R, -1, 0), f.tool_t, axes=1).T
+    R_tool = np.moveaxis(np.moveaxis(R, -1, 0) @ f.tool_R, 0, -1)
+    return p, z, R_tool, t_tool
+
+
+def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Rotation vector (..., 3) of R_target . R^T: the turn (in base_link axes) that brings R onto R_target."""
+    E = R_target @ np.swapaxes(R, -1, -2)
+    v = 0.5 * np.stack([E[..., 2, 1] - E[..., 1, 2], E[..., 0, 2] - E[..., 2, 0], E[..., 1, 0] - E[..., 0, 1]], -1)
+    cos = np.clip((np.trace(E, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos)
+    sin = np.linalg.norm(v, axis=-1)
+    scale = np.where(sin > 1e-9, angle / np.maximum(sin, 1e-12), 1.0)
+    out = v * scale[..., None]
+    # at 180° the skew part vanishes: take the axis from the symmetric part
+    near_pi = (cos < -0.999) & (sin < 1e-3)
+    if np.any(near_pi):
+        B = (E[near_pi] + np.eye(3)) / 2.0
+        k = np.argmax(np.diagonal(B, axis1=-2, axis2=-1), axis=-1)
+        axis = B[np.arange(len(k)), :, k]
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        out[near_pi] = axis * angle[near_pi][:, None]
+    return out

@@ -1,0 +1,195 @@
+"""Evaluating candidate chains: the fast screen over many twist settings at once (screen_batch),
+and the exact check of one design with modc's own analyses (verify).
+
+screen_batch: batched IK per target within the joint limits (position, or 6-D with an
+orientation), then the sphere-swept obstacle screen on the solutions found. Fast and
+approximate: it decides what is worth checking.
+
+verify: the one place a design is accepted. It writes the design as a robot, checks it with the
+compiler's passes and analyses (check_text: assembly rules, twists, poses within limits, the
+torque check with the payload), re-measures every target with modc.kinematics.Chain, and tests
+the chosen joint vectors with modc.plan.collision.CollisionChecker (the emitted meshes against
+the cell and against themselves beyond the SRDF's disabled pairs). A faster physical model
+(pinocchio/coal built in memory) drops in behind these same calls.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import Pose, Problem, Robot, UnitSpec
+from . import reach
+from .batch import Geometry, forward, geometry
+from .screen import Obstacles, collides, segment_radii
+from .space import Shape
+
+SEEDS = 4  # IK starts per target (the zero pose first)
+VERIFY_MARGIN = 0.001  # m kept from the cell and between links in the chosen poses
+
+
+@dataclass(frozen=True)
+class Spec:
+    """What a worker needs to screen shapes of one problem (picklable)."""
+
+    problem: Problem
+    targets: reach.Targets
+    obstacles: Obstacles
+    radii: np.ndarray
+    lower: float
+    upper: float
+
+    @classmethod
+    def of(cls, problem: Problem) -> Spec:
+        lib = problem.cell.library
+        assert lib is not None
+        lower = max(np.radians(v.lower_deg) for v in lib.variants.values())
+        upper = min(np.radians(v.upper_deg) for v in lib.variants.values())
+        return cls(problem, reach.Targets.of(problem.cell.targets), Obstacles.of(problem.cell.obstacles),
+                   segment_radii(lib), float(lower), float(upper))
+
+
+@dataclass
+class Screened:
+    """Per candidate (C): feasible, a score (0 when feasible; else how far from it), per target the
+    closest position error (C, T) and the joint vectors that pass the screen, best first."""
+
+    feasible: np.ndarray
+    score: np.ndarray
+    closest: np.ndarray
+    solutions: list[list[list[np.ndarray]]] = field(default_factory=list)
+
+
+def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
+    k = slice(t, t + 1)
+    return reach.Targets(tg.xyz[k], tg.R[k], tg.oriented[k], tg.tol_p[k], tg.tol_r[k], tg.names[k])
+
+
+def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray, seed: int) -> Screened:
+    """Targets one at a time, farthest from the base first: a candidate leaves the batch at the
+    first target it cannot reach (most random twist settings miss the hardest one), so the rest
+    of the work is spent on candidates that may pass."""
+    lib = spec.problem.cell.library
+    assert lib is not None
+    types = [lib.units[k] for k in shape.kinds]
+    links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
+    tool = spec.problem.cell.tool
+    g = geometry(types, pivots, ports, links, tool.xyz, tool.rpy)
+    n, C = shape.n, len(pivots)
+    tg = spec.targets
+    T = len(tg.names)
+    lo, hi = np.full(n, spec.lower), np.full(n, spec.upper)
+    q0 = reach.seeds(n, SEEDS, lo, hi, seed)
+    q = np.zeros((C, T, SEEDS, n))
+    ep = np.full((C, T, SEEDS), np.inf)
+    hit = np.zeros((C, T, SEEDS), bool)
+    live = np.arange(C)
+    for t in np.argsort(-np.linalg.norm(tg.xyz, axis=1), kind="stable"):
+        if live.size == 0:
+            break
+        sub = Geometry(g.pre[live], g.post[live], g.t1, g.flange_tool)
+        qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0, lo, hi)
+        h = (ept <= tg.tol_p[t]) & (ert <= (tg.tol_r[t] if tg.oriented[t] else np.inf))
+        if h.any() and len(spec.obstacles.shape):
+            # only the runs that reached their target are worth a collision test
+            c, s_ = np.nonzero(h[:, 0])
+            one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+            _, _, _, pts = forward(one, qt[c, 0, s_][:, None, None, :], points=True)
+            h[c, 0, s_] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+        q[live, t], ep[live, t], hit[live, t] = qt[:, 0], ept[:, 0], h[:, 0]
+        live = live[h[:, 0].any(-1)]
+    reached = hit.any(-1)  # (C, T)
+    feasible = reached.all(-1)
+    closest = ep.min(-1)
+    # how far from feasible: metres missed on the targets tried, plus a metre per target not reached
+    excess = np.where(np.isfinite(closest), np.maximum(closest - tg.tol_p[None], 0.0), 0.0)
+    score = np.where(feasible, 0.0, excess.sum(-1) + (~reached).sum(-1) * 1.0)
+    sols = []
+    for cand in np.flatnonzero(feasible):
+        per_target = []
+        for t in range(T):
+            order = np.argsort(ep[cand, t] + 1e3 * ~hit[cand, t], kind="stable")
+            per_target.append([q[cand, t, s] for s in order if hit[cand, t, s]])
+        sols.append(per_target)
+    return Screened(np.asarray(feasible), np.asarray(score), closest, sols)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A chain the screen passed, with its joint vectors per target (best first)."""
+
+    shape: Shape
+    variants: tuple[str, ...]
+    pivots: tuple[float, ...]
+    ports: tuple[float, ...]
+    solutions: tuple[tuple[tuple[float, ...], ...], ...]  # per target, per solution
+
+    def units(self) -> tuple[UnitSpec, ...]:
+        parts = zip(self.variants, self.shape.kinds, self.pivots, self.ports, self.shape.links, strict=True)
+        return tuple(UnitSpec(name=f"{v}{k}", variant=v, kind=k, pivot=p, port=o, link=x) for v, k, p, o, x in parts)
+
+
+@dataclass(frozen=True)
+class Verified:
+    robot: Robot  # checked, with one pose per target
+    mass: float  # kg, the arm without payload
+    margin: float  # smallest share of peak torque left over the joints
+    targets: dict[str, dict]  # name -> {"q", "position_error_m", "orientation_error_deg"}
+
+
+def pose_name(target: str) -> str:
+    return f"at_{target}"
+
+
+def robot_for(problem: Problem, cand: Candidate, poses: dict[str, tuple[float, ...]], name: str) -> Robot:
+    cell = problem.cell
+    return cell.model_copy(update={
+        "name": name, "units": cand.units(),
+        "poses": tuple(Pose(name=pose_name(t), q=tuple(q)) for t, q in poses.items())})
+
+
+def verify(problem: Problem, cand: Candidate) -> Verified | str:
+    """The exact check of one design; a string says why it fails."""
+    from ..compiler import check_text
+    from ..kinematics import Chain, rpy_matrix
+    from ..model.write import robot_file_text
+    from ..physical.assembly import library_mass
+    from ..plan.collision import CollisionChecker
+
+    names = [t.name for t in problem.cell.targets]
+    first = {t: sols[0] for t, sols in zip(names, cand.solutions, strict=True)}
+    text = robot_file_text(robot_for(problem, cand, first, problem.name))
+    checked = check_text(text, f"{problem.name}.mod", analyses=frozenset({"torque"}))
+    if not checked.ok:
+        d = next(d for d in checked.diagnostics if d.is_error)
+        return f"{d.code}: {d.message}"
+    robot = checked.design.robots[0]
+    checker = CollisionChecker(robot, margin=VERIFY_MARGIN)
+    if checker.static_contacts():
+        return "base_link touches the cell"
+    chain = Chain(robot)
+    chosen: dict[str, tuple[float, ...]] = {}
+    report: dict[str, dict] = {}
+    for target, sols in zip(problem.cell.targets, cand.solutions, strict=True):
+        q = next((q for q in sols if checker.valid(np.asarray(q))), None)
+        if q is None:
+            contacts = checker.contacts(np.asarray(sols[0]))
+            what = contacts[0].describe() if contacts else "a collision"
+            return f"target '{target.name}' is reached only in collision ({what})"
+        T = chain.T_base_tool(np.asarray(q))
+        perr = float(np.linalg.norm(T[:3, 3] - np.asarray(target.xyz)))
+        oerr = None
+        if target.rpy is not None:
+            E = rpy_matrix(target.rpy) @ T[:3, :3].T
+            oerr = float(np.degrees(np.arccos(np.clip((np.trace(E) - 1) / 2, -1.0, 1.0))))
+            if oerr > np.degrees(target.orientation_tolerance) + 1e-9:
+                return f"target '{target.name}' orientation off by {oerr:.2g}°"
+        if perr > target.position_tolerance + 1e-12:
+            return f"target '{target.name}' missed by {perr * 1000:.2g} mm"
+        chosen[target.name] = tuple(float(x) for x in q)
+        report[target.name] = {"q": [round(float(x), 9) for x in q], "position_error_m": round(perr, 9),
+                               "orientation_error_deg": None if oerr is None else round(oerr, 6)}
+    robot = robot.model_copy(update={"poses": tuple(Pose(name=pose_name(t), q=q) for t, q in chosen.items())})
+    payload = robot.payload.mass if robot.payload else 0.0
+    margin = min(j.margin for j in robot.torque) if robot.torque else 1.0
+    return Verified(robot, library_mass(robot) - payload, float(margin), report)

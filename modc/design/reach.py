@@ -1,0 +1,138 @@
+"""Inverse kinematics of many candidate chains at once: damped least squares (Levenberg-Marquardt,
+a damping per run that shrinks on success and grows on failure), projected onto the joint limits,
+from the same few seeds for every candidate. Position only, or 6-D for targets with an
+orientation (the rotation error is weighted by ROTATION_WEIGHT metres per radian).
+
+This is the search's screen: a run counts when it ends within the target's tolerances. The
+chosen joint vectors are then checked exactly by modc.design.evaluate.verify.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .batch import Flat, Geometry, forward_flat, rotation_error
+
+ROTATION_WEIGHT = 0.2  # m/rad: 1° of orientation error costs as much as 3.5 mm
+ITERATIONS = 40
+LAMBDA0 = 1e-2
+
+
+@dataclass(frozen=True)
+class Targets:
+    xyz: np.ndarray  # (T, 3) m
+    R: np.ndarray  # (T, 3, 3)
+    oriented: np.ndarray  # (T,) bool
+    tol_p: np.ndarray  # (T,) m
+    tol_r: np.ndarray  # (T,) rad
+    names: tuple[str, ...]
+
+    @classmethod
+    def of(cls, targets) -> Targets:
+        from ..kinematics import rpy_matrix
+
+        return cls(np.array([t.xyz for t in targets], float).reshape(-1, 3),
+                   np.array([rpy_matrix(t.rpy or (0.0, 0.0, 0.0)) for t in targets]).reshape(-1, 3, 3),
+                   np.array([t.rpy is not None for t in targets], bool),
+                   np.array([t.position_tolerance for t in targets], float),
+                   np.array([t.orientation_tolerance for t in targets], float),
+                   tuple(t.name for t in targets))
+
+
+def seeds(n: int, count: int, lower, upper, seed: int) -> np.ndarray:
+    """(count, n): the zero pose (clipped to the limits), then uniform samples from default_rng(seed)."""
+    rng = np.random.default_rng(seed)
+    lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+    out = [np.clip(np.zeros(n), lower, upper)]
+    out += list(lower + (upper - lower) * rng.random((count - 1, n)))
+    return np.array(out)
+
+
+def _rotation_error(Rt, R):
+    """Rotation vectors (3, B) of Rt . R^T for stacks (3, 3, B): the turn that brings R onto Rt."""
+    E = np.stack([np.stack([Rt[i, 0] * R[j, 0] + Rt[i, 1] * R[j, 1] + Rt[i, 2] * R[j, 2] for j in range(3)])
+                  for i in range(3)])
+    return np.moveaxis(rotation_error(np.eye(3), np.moveaxis(E, -1, 0).transpose(0, 2, 1)), -1, 0)
+
+
+class _Runs:
+    """The residuals of the live runs: position (3, B), weighted rotation (3, B), cost (B,)."""
+
+    def __init__(self, tg: Targets, ti: np.ndarray):
+        self.xyz = np.ascontiguousarray(tg.xyz[ti].T)
+        self.R = np.ascontiguousarray(np.moveaxis(tg.R[ti], 0, -1))
+        self.oriented = tg.oriented[ti].astype(float)
+        self.any_oriented = bool(tg.oriented[ti].any())
+
+    def take(self, keep):
+        out = object.__new__(_Runs)
+        out.xyz, out.R, out.oriented = self.xyz[:, keep], self.R[..., keep], self.oriented[keep]
+        out.any_oriented = self.any_oriented
+        return out
+
+    def residual(self, R_tool, t_tool):
+        e_p = self.xyz - t_tool
+        if self.any_oriented:
+            e_r = _rotation_error(self.R, R_tool) * self.oriented
+        else:
+            e_r = np.zeros_like(e_p)
+        return e_p, e_r
+
+
+def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
+    """Runs from every seed q0 (S, n) towards every target, for every candidate of g.
+    Returns q (C, T, S, n), position error (C, T, S) m, orientation error (C, T, S) rad.
+
+    The runs are one flat batch; a run leaves it when it is within 1e-7 m (and 1e-6 rad) of its target or
+    stalls (its damping saturates), so late iterations cost only what is still moving."""
+    C, n, T, S = g.pre.shape[0], g.dof, len(tg.names), q0.shape[0]
+    lo, hi = np.asarray(lower, float)[:, None], np.asarray(upper, float)[:, None]
+    B = C * T * S
+    c_idx = np.repeat(np.arange(C), T * S)
+    t_idx = np.tile(np.repeat(np.arange(T), S), C)
+    q_all = np.ascontiguousarray(np.tile(q0, (C * T, 1)).T)  # (n, B)
+    ep_all, er_all = np.empty(B), np.empty(B)
+    w = ROTATION_WEIGHT
+    live = np.arange(B)
+    q = q_all.copy()
+    f = Flat.of(g, c_idx)
+    runs = _Runs(tg, t_idx)
+    # runs go on well inside the tolerances (LM converges quadratically there): reported errors are ~0
+    tol_p, tol_r = np.full(B, 1e-7), np.full(B, 1e-6)
+    p, z, R_tool, t_tool = forward_flat(f, q)
+    e_p, e_r = runs.residual(R_tool, t_tool)
+    cost = (e_p ** 2).sum(0) + w * w * (e_r ** 2).sum(0)
+    lam = np.full(B, LAMBDA0)
+    for it in range(iterations + 1):
+        ep, er = np.sqrt((e_p ** 2).sum(0)), np.sqrt((e_r ** 2).sum(0))
+        active = ((ep > tol_p) | (er > tol_r)) & (lam < 1e4) & (it < iterations)
+        if active.sum() < 0.8 * active.size or not active.any():  # compaction costs: do it in steps
+            gone = ~active
+            q_all[:, live[gone]], ep_all[live[gone]], er_all[live[gone]] = q[:, gone], ep[gone], er[gone]
+            live, q, f, runs = live[active], q[:, active], f.take(active), runs.take(active)
+            tol_p, tol_r = tol_p[active], tol_r[active]
+            p, z, t_tool, e_p, e_r = p[..., active], z[..., active], t_tool[:, active], e_p[:, active], e_r[:, active]
+            cost, lam = cost[active], lam[active]
+            active = active[active]
+            if live.size == 0:
+                break
+        if not active.any():
+            break
+        # J columns: position z_i x (p_tool - p_i), rotation z_i (weighted, oriented targets only)
+        Jp = np.cross(z, t_tool[None] - p, axis=1)  # (n, 3, b)
+        J = np.concatenate([Jp, z * (w * runs.oriented)], axis=1)  # (n, 6, b)
+        e = np.concatenate([e_p, w * e_r], axis=0)  # (6, b)
+        A = np.einsum("ikb,jkb->bij", J, J)
+        A[:, np.arange(n), np.arange(n)] += lam[:, None]
+        rhs = np.einsum("ikb,kb->bi", J, e)
+        dq = np.linalg.solve(A, rhs[..., None])[..., 0].T
+        qn = np.clip(q + dq, lo, hi)
+        pn, zn, Rn, tn = forward_flat(f, qn)
+        e_pn, e_rn = runs.residual(Rn, tn)
+        cost_n = (e_pn ** 2).sum(0) + w * w * (e_rn ** 2).sum(0)
+        ok = (cost_n < cost) & active
+        q[:, ok], p[..., ok], z[..., ok], t_tool[:, ok] = qn[:, ok], pn[..., ok], zn[..., ok], tn[:, ok]
+        e_p[:, ok], e_r[:, ok], cost[ok] = e_pn[:, ok], e_rn[:, ok], cost_n[ok]
+        lam = np.where(ok, np.maximum(lam / 3.0, 1e-9), lam * 4.0)
+    return q_all.T.reshape(C, T, S, n), ep_all.reshape(C, T, S), er_all.reshape(C, T, S)

@@ -1,0 +1,129 @@
+"""Cheap necessary conditions, in numpy, before anything expensive.
+
+reach_bound   the farthest tool0 can get from base_link's origin: every fixed offset of the chain
+              laid end to end. A target beyond it rules the skeleton out without any IK.
+Obstacles     the arm as spheres along the segments between its frames (unit base -> twist1: the
+              twist unit and input casing; twist1 -> joint: the actuator; joint -> end: the link
+              bar), tested against each obstacle's signed distance. The radii are the light
+              variant's (the thinner arm): the screen rejects only what surely collides, and the
+              exact check (coal on the emitted meshes, modc.design.evaluate.verify) decides.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kinematics import rpy_matrix
+
+
+def reach_bound(unit_types, links, tool_xyz) -> float:
+    r = 0.0
+    for t, length in zip(unit_types, links, strict=True):
+        r += float(np.hypot(t.x01, t.z01)) + t.z12 + (length if t.link else 0.0)
+    return r + float(np.linalg.norm(tool_xyz))
+
+
+@dataclass(frozen=True)
+class Obstacles:
+    """The cell's obstacles as arrays: shape code (0 box, 1 sphere, 2 cylinder), centre, rotation, size."""
+
+    shape: np.ndarray  # (K,)
+    centre: np.ndarray  # (K, 3)
+    R: np.ndarray  # (K, 3, 3) obstacle frame -> base_link
+    size: np.ndarray  # (K, 3): box half extents; sphere (r, 0, 0); cylinder (r, half length, 0)
+
+    @classmethod
+    def of(cls, obstacles) -> Obstacles:
+        shapes, centres, Rs, sizes = [], [], [], []
+        for o in obstacles:
+            shapes.append({"box": 0, "sphere": 1, "cylinder": 2}[o.shape])
+            centres.append(o.origin.xyz)
+            Rs.append(rpy_matrix(o.origin.rpy))
+            s = o.size
+            sizes.append((s[0] / 2, s[1] / 2, s[2] / 2) if o.shape == "box" else (s[0], 0.0, 0.0) if o.shape == "sphere"
+                         else (s[0], s[1] / 2, 0.0))
+        return cls(np.array(shapes, int), np.array(centres, float).reshape(-1, 3), np.array(Rs).reshape(-1, 3, 3),
+                   np.array(sizes, float).reshape(-1, 3))
+
+    def distance(self, pts: np.ndarray) -> np.ndarray:
+        """Signed distance (P, K) of points (P, 3) to every obstacle (negative inside)."""
+        out = np.empty((pts.shape[0], len(self.shape)))
+        for k, shape in enumerate(self.shape):
+            x = (pts - self.centre[k]) @ self.R[k]  # R^T (p - c), row-wise
+            s = self.size[k]
+            if shape == 1:
+                out[:, k] = np.sqrt((x * x).sum(1)) - s[0]
+                continue
+            if shape == 0:
+                d = np.abs(x) - s
+            else:
+                d = np.stack([np.sqrt(x[:, 0] ** 2 + x[:, 1] ** 2) - s[0], np.abs(x[:, 2]) - s[1]], -1)
+            m = np.maximum(d, 0.0)
+            out[:, k] = np.sqrt((m * m).sum(1)) + np.minimum(d.max(1), 0.0)
+        return out
+
+
+def segment_radii(library) -> np.ndarray:
+    """Radii of the three segments of a unit (twist unit, actuator, link bar): the thinnest variant's."""
+    v = min(library.variants.values(), key=lambda v: v.actuator.diameter)
+    r = v.actuator.diameter / 2
+    bar = float(np.hypot(v.link_module.width, v.link_module.height)) / 2
+    return np.array([r, r, bar])
+
+
+def collides(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: float = 0.02) -> np.ndarray:
+    """frames (R, n, 4, 3): each unit's frame origins (base, twist1, joint, end) in R poses. True
+    where the sphere-swept segments between them (except the first unit's twist unit, part of
+    base_link, which never moves) go into an obstacle by more than 1 mm."""
+    R, n = frames.shape[:2]
+    if len(obstacles.shape) == 0 or R == 0:
+        return np.zeros(R, bool)
+    a, b = frames[:, :, :3, :], frames[:, :, 1:, :]  # (R, n, 3 segments, 3)
+    m = int(np.ceil(0.25 / step)) + 1  # points per segment: enough for a 0.25 m link bar
+    ts = np.linspace(0.0, 1.0, m)
+    pts = a[..., None, :] + (b - a)[..., None, :] * ts[:, None]  # (R, n, 3, m, 3)
+    d = obstacles.distance(pts.reshape(-1, 3)).min(-1).reshape(R, n, 3, m) - radii[:, None]
+    d[:, 0, 0, :] = np.inf
+    return (d < -1e-3).reshape(R, -1).any(-1)
+
+
+G = 9.81  # m/s²
+
+
+def _part_com(part) -> np.ndarray:
+    """A part's centre of mass in its frame: its primitives' centroids weighted by volume (uniform
+    density, as the URDF's inertials are derived)."""
+    vols = np.array([p.volume for p in part.primitives])
+    centres = np.array([p.center for p in part.primitives], float)
+    return (vols[:, None] * centres).sum(0) / vols.sum()
+
+
+def static_torques(robot, qs) -> np.ndarray:
+    """|gravity torque| (N·m) per pose and joint, (len(qs), n), from the library's parts and the
+    payload: exact static torques at these poses. Poses inside the joint limits bound the worst
+    case from below, so a pose over an actuator's peak rules the chain out before any exact check."""
+    from ..kinematics import Chain, rpy_matrix
+    from ..physical.parts import unit_parts
+
+    lib = robot.library
+    chain = Chain(robot)
+    g = rpy_matrix(robot.base.rpy).T @ np.array([0.0, 0.0, -G])
+    per_unit = [unit_parts(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units]
+    out = np.zeros((len(qs), robot.dof))
+    for k, q in enumerate(qs):
+        frames = chain.frames(np.asarray(q, float))
+        bodies = []  # (first joint that carries it, mass, centre in base_link)
+        for i, (f, parts) in enumerate(zip(frames, per_unit, strict=True)):
+            for part in parts:
+                T = f[{"unit": "T_base_unit", "twist1": "T_base_twist1", "joint": "T_base_joint"}[part.frame]]
+                carried_from = i if part.frame == "joint" else i - 1
+                bodies.append((carried_from, part.mass, T[:3, :3] @ _part_com(part) + T[:3, 3]))
+        if robot.payload is not None:
+            T = chain.T_base_tool(np.asarray(q, float))
+            bodies.append((robot.dof - 1, robot.payload.mass, T[:3, :3] @ np.asarray(robot.payload.com) + T[:3, 3]))
+        for i, f in enumerate(frames):
+            p, z = f["T_base_joint"][:3, 3], f["T_base_joint"][:3, 2]
+            moment = sum((np.cross(c - p, m * g) for j, m, c in bodies if j >= i), np.zeros(3))
+            out[k, i] = abs(float(z @ moment))
+    return out

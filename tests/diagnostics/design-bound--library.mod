@@ -1,0 +1,4 @@
+design cell {
+    target a at (0.3, 0, 0.2) m
+    units 2 to 7   # expect: error[design-bound]
+}
