@@ -34,22 +34,8 @@ __all__ = ["ModLexer"]
 #: Keyword that opens a robot block.
 DECLARATIONS = ("design", "robot")
 #: Keywords that start a statement inside a robot block (`row` starts a row of a `dh` block).
-STATEMENTS = (
-    "allow",
-    "base",
-    "box",
-    "chain",
-    "cylinder",
-    "dh",
-    "library",
-    "limit",
-    "payload",
-    "pose",
-    "row",
-    "sphere",
-    "target",
-    "tool",
-)
+STATEMENTS = ("allow", "base", "box", "chain", "cylinder", "dh", "library", "limit", "links", "modules",
+              "payload", "pose", "rank", "row", "sphere", "target", "tool", "units")
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
 CLAUSES = ("at", "fit-links", "length", "radius", "rpy", "size", "step", "to", "within")
 #: Every keyword of the language.

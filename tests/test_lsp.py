@@ -318,7 +318,7 @@ def test_completion_of_statements_and_clauses(server):
     got = labels(complete_at_end(server, "robot a {\n    chain H1 - L1\n    "))
     assert got == list(statements())
     assert "chain" in labels(complete_at_end(server, "robot a {\n    cha"))
-    assert labels(complete_at_end(server, "")) == ["robot"]
+    assert labels(complete_at_end(server, "")) == ["design", "robot"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf ")) == ["size"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    box shelf size (1, 1, 1) m ")) == ["at"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1\n    library ")) == ["mark2", "mark2-strict"]
@@ -328,6 +328,11 @@ def test_completion_of_statements_and_clauses(server):
         "joint_3",
     ]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ")) == ["home"]
+    assert labels(complete_at_end(server, "design d {\n    target t at (0.3, 0, 0.2) m\n    rank ")) == [
+        "modules",
+        "mass",
+        "margin",
+    ]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose home (0,0,0) deg\n    pose ")) == []
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ready ")) == ["(0, 0, 0) deg"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1 # a comment ")) == []
@@ -680,7 +685,7 @@ def test_each_version_is_parsed_once(monkeypatch, path, text):
 def test_keyword_classes_are_read_from_the_grammar():
     from modc.lsp import language
 
-    assert language.declaration_keywords() == {"robot"}
+    assert language.declaration_keywords() == {"robot", "design"}
     assert language.statements() == (
         "chain",
         "dh",
@@ -697,8 +702,12 @@ def test_keyword_classes_are_read_from_the_grammar():
         "allow",
     )
     assert language.statements("dh") == ("row",)
-    assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links"}
-    assert language.name_takers() == {"robot", "pose", "limit", "box", "sphere", "cylinder", "target"}
+    assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links", "within", "to", "step"}
+    assert language.statements("design") == (
+        "library", "base", "tool", "payload", "box", "sphere", "cylinder", "target", "allow", "units", "modules",
+        "links", "rank",
+    )
+    assert language.name_takers() == {"robot", "design", "pose", "limit", "box", "sphere", "cylinder", "target", "rank"}
     assert language.syntax_of("cylinder") == "cylinder NAME radius QUANTITY length QUANTITY at (…) rpy (…)"
 
 
@@ -717,14 +726,14 @@ GRAMMAR_PLUS = {
     "     | allow\n": "     | allow\n     | gripper\n",
     'allow: "allow"': 'gripper: "gripper" NAME at\nallow: "allow"',
     # a new top-level block with its own statement
-    "start: robot*": 'start: (robot | design)*\ndesign: "design" NAME "{" use* "}"\nuse: "use" NAME',
+    "start: (robot | design)*": 'start: (robot | design | fixture)*\nfixture: "fixture" NAME "{" use* "}"\nuse: "use" NAME',
 }
 
 
 @pytest.fixture
 def grammar_plus(monkeypatch, tmp_path):
     """The real grammar with a new statement (`gripper NAME at (…)`) and a new top-level block
-    (`design NAME { use NAME }`): nothing else changed."""
+    (`fixture NAME { use NAME }`): nothing else changed."""
     from lark import Lark
 
     import modc.syntax.parser as parser
@@ -757,15 +766,15 @@ def test_a_new_statement_needs_no_language_server_change(grammar_plus):
     from modc.lsp import language
 
     assert "gripper" in language.statements() and "gripper" in language.name_takers()
-    assert language.declaration_keywords() == {"robot", "design"} and language.statements("design") == ("use",)
+    assert language.declaration_keywords() == {"robot", "design", "fixture"} and language.statements("fixture") == ("use",)
     got = _labels(complete(Analysis("robot a {\n    chain H1 - L1\n    ", "/x/a.mod"), 33))
     assert got[-1] == "gripper" and got[:-1] == list(language.statements())[:-1]
     text = "robot a {\n    chain H1 - L1\n    gripper g "
     assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["at"]
     text += "at (0, 0, 0.1) "
     assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["m", "cm", "mm"]
-    assert set(_labels(complete(Analysis("", "/x/a.mod"), 0))) == {"robot", "design"}
-    text = "design d {\n    "
+    assert set(_labels(complete(Analysis("", "/x/a.mod"), 0))) == {"robot", "design", "fixture"}
+    text = "fixture d {\n    "
     assert _labels(complete(Analysis(text, "/x/a.mod"), len(text))) == ["use"]
     # the half-typed outline declares the new statement's name
     an = Analysis("robot a {\n    chain H1 - L1\n    gripper g at (0, 0", "/x/a.mod")

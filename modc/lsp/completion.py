@@ -193,7 +193,11 @@ def _names(an: Analysis, robot: str | None, stmt: str | None, body: list[Any], l
         return _params(DH_PARAMS, _assigned(body), lib)
     if body:
         return []
-    if stmt in language.REFERS:
+    if stmt == "rank":
+        from ..model.robot import RANK_KEYS
+
+        return [Completion(k, types.CompletionItemKind.EnumMember, "objective") for k in RANK_KEYS]
+    if stmt == "limit":
         return [
             Completion(f"joint_{i}", types.CompletionItemKind.Variable, f"unit {i}: {u}")
             for i, u in enumerate(_block_units(an, robot), 1)

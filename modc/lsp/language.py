@@ -50,9 +50,13 @@ QUANTITY_KINDS = {
     "pose": "an angle",
     "limit": "an angle",
     "payload": "a mass",
+    "within": "a length",  # then an angle: `within 5 mm, 2 deg`
+    "links": "a length",
+    "to": "a length",  # `links 150 mm to 300 mm` (`units 1 to 3` takes plain numbers)
+    "step": "a length",
 }
 # Name-taking statements whose name refers to something (a joint) rather than declaring one.
-REFERS = frozenset({"limit"})
+REFERS = frozenset({"limit", "rank"})  # rank names objectives, not things it declares
 
 KEYWORDS = {
     "robot": "`robot NAME { … }` — one arm; a file holds one or more robot blocks.",
