@@ -26,16 +26,16 @@ import pinocchio as pin
 import pybullet
 import pytest
 import yourdfpy
+from conftest import EXAMPLES, ROOT, checked_ok
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pybullet_utils.bullet_client import BulletClient
+from strategies import RobotSpec, robot_specs
 
-from conftest import EXAMPLES, ROOT, checked_ok
 from modc.compiler import build, check_file, write_tree
 from modc.kinematics import Chain
 from modc.model import Robot
 from modc.physical.assembly import FRAME_MASS, library_mass
-from strategies import RobotSpec, robot_specs
 
 FK_TOL = 1e-9  # SPEC section 7: FK from the URDF equals section 2 to 1e-9
 # The pip wheel of PyBullet is built in single precision (btScalar = float): getLinkState returns

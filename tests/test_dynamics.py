@@ -8,8 +8,8 @@ import sys
 
 import numpy as np
 import pytest
-
 from conftest import ROOT, checked_ok, compile_text
+
 from modc.compiler import COMPILE_ANALYSES, check_text
 from modc.dynamics.model import Dynamics
 from modc.dynamics.worst import worst_case

@@ -8,15 +8,14 @@ from functools import cache
 from pathlib import Path
 
 import pytest
+from conftest import EXAMPLES
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from strategies import valid_chains
 
 from modc.compiler import build, check_text
 from modc.resources import data_dir
 from modc.syntax.format import WIDTH, format_text, rewrite_file
-
-from conftest import EXAMPLES
-from strategies import valid_chains
 
 POSITION_KEYS = ("line", "col", "end_line", "end_col", "start", "end")
 

@@ -5,8 +5,8 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import ROOT, checked_ok
+
 from modc.compiler import check_file
 from modc.kinematics import A_J, A_t1, A_t2, Chain, matrix_rpy, rpy_matrix
 

@@ -6,8 +6,8 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import ROOT, checked_ok
+
 from modc.compiler import check_text
 from modc.model import library
 

@@ -21,12 +21,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from modc.compiler import build, check_file, write_tree
 from modc.kinematics import Chain
 from modc.plan import PlanError, plan, timing
-
-from conftest import ROOT
 
 FARM = ROOT / "examples" / "farm.mod"
 JOINT_STEP = math.radians(0.25)  # rad per joint between independently checked samples

@@ -5,12 +5,11 @@ from __future__ import annotations
 import json
 
 import pytest
+from conftest import checked_ok
+from test_diagnostics_corpus import run_cli
 
 from modc.api import ModcError, load
 from modc.model.select import RobotChoiceError, choose_robot
-
-from conftest import checked_ok
-from test_diagnostics_corpus import run_cli
 
 TWO = "robot a { chain H3 - L4 target t at (0.2, 0, 0.3) m }\nrobot b { chain H3 - L4 target t at (0.2, 0, 0.3) m }\n"
 

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import EXAMPLES, ROOT
+
 from modc.compiler import COMPILE_ANALYSES, build, check_file, check_text
 from modc.kinematics import Chain
 from modc.model.select import RobotChoiceError

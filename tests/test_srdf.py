@@ -15,14 +15,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import EXAMPLES, ROOT, checked_ok
 
-from modc.backends import Build
-from modc.backends import srdf
+from modc.backends import Build, srdf
 from modc.compiler import check_file
 from modc.model import Robot
 from modc.physical import collisions
-
-from conftest import EXAMPLES, ROOT, checked_ok
 
 RESAMPLES = 2000
 RESEED = 20240917  # not the backend's seed

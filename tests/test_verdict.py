@@ -6,13 +6,12 @@ import math
 
 import numpy as np
 import pytest
+from conftest import checked_ok
 
 from modc.dynamics.model import Dynamics
 from modc.kinematics import Chain
 from modc.sim.contacts import Contact
 from modc.sim.verdict import TRACK_TOL, Hold, Measured, RobotResult, describe, judge_pose
-
-from conftest import checked_ok
 
 pytest.importorskip("pinocchio")
 

@@ -24,14 +24,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import xacro
-from hypothesis import HealthCheck, given, settings
-
 from conftest import EXAMPLES, ROOT, checked_ok
+from hypothesis import HealthCheck, given, settings
+from strategies import robot_specs
+
 from modc.backends import BACKENDS, Build, load_all
 from modc.compiler import build, check_file, write_tree
 from modc.kinematics import Chain, transform
 from modc.model import Robot
-from strategies import robot_specs
 
 # The backend registers itself on import. Until load_all() imports it, keep it out of the
 # registry so that other tests' outputs (golden files, report.json) do not change under them.

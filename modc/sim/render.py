@@ -128,7 +128,7 @@ class Stage:
     _backdrop: dict = field(default_factory=dict)
 
     @classmethod
-    def build(cls, client, robots, urdfs: dict[str, Path], qs: dict | None = None) -> "Stage":
+    def build(cls, client, robots, urdfs: dict[str, Path], qs: dict | None = None) -> Stage:
         placements = scene.world_placements(robots, qs)
         scenes = {r.name: scene.load_robot(client, r, urdfs[r.name], placements[r.name]) for r in robots}
         return cls(client, scenes)

@@ -261,7 +261,7 @@ def extent_points(robot: Robot, q=None, T_world_base=None):
 LAYOUT_GAP = 0.15  # m between robots laid out side by side
 
 
-def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, "object"]:
+def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, object]:
     """robot name -> T_world_base. Each robot sits at its `base`; when two robots of one file
     share a placement (both at the default origin, say), they are laid out along the world's y
     axis instead, LAYOUT_GAP apart at the pose shown (qs: name -> q, default home), so that a

@@ -32,7 +32,7 @@ class Trajectory:
     def duration(self) -> float:
         return self.t[-1] - self.t[0]
 
-    def in_order(self, names) -> "Trajectory":
+    def in_order(self, names) -> Trajectory:
         """The same motion with columns in the order of `names` (e.g. joint_1 … joint_n)."""
         idx = [self.joint_names.index(n) for n in names]
         return Trajectory(tuple(names), self.t, tuple(tuple(row[i] for i in idx) for row in self.q), self.robot)
