@@ -221,9 +221,13 @@ def check_fk_yourdfpy(arm: Arm, qs, tol: float = FK_TOL) -> None:
     for q in qs:
         urdf.update_cfg(dict(zip(arm.joint_names, q)))
         # get_transform(frame_to, frame_from): pose of frame_to expressed in frame_from
-        assert_close(urdf.get_transform("tool0", "base_link"), chain.T_base_tool(q), tol, f"yourdfpy T_base_tool at q={q}")
+        assert_close(
+            urdf.get_transform("tool0", "base_link"), chain.T_base_tool(q), tol, f"yourdfpy T_base_tool at q={q}"
+        )
         for i, f in enumerate(chain.frames(q), start=1):
-            assert_close(urdf.get_transform(f"link_{i}", "base_link"), f["T_base_joint"], tol, f"yourdfpy link_{i} at q={q}")
+            assert_close(
+                urdf.get_transform(f"link_{i}", "base_link"), f["T_base_joint"], tol, f"yourdfpy link_{i} at q={q}"
+            )
 
 
 def test_fk_pinocchio_matches_spec(arms):
@@ -272,7 +276,9 @@ def test_fk_pybullet_matches_spec(arms, bullet):
                 assert bullet.getJointInfo(body, joints[name])[2] == pybullet.JOINT_REVOLUTE
             # base_link's URDF frame = its inertial frame composed with the inverse inertial offset
             _, _, _, local_pos, local_orn, *_ = bullet.getDynamicsInfo(body, -1)
-            T_world_base = bullet_pose(*bullet.getBasePositionAndOrientation(body)) @ np.linalg.inv(bullet_pose(local_pos, local_orn))
+            T_world_base = bullet_pose(*bullet.getBasePositionAndOrientation(body)) @ np.linalg.inv(
+                bullet_pose(local_pos, local_orn)
+            )
             chain = Chain(arm.robot)
             for q in random_qs(arm.robot, N_RANDOM_Q, seed=k):
                 for name, qi in zip(arm.joint_names, q):
@@ -282,9 +288,21 @@ def test_fk_pybullet_matches_spec(arms, bullet):
                     s = bullet.getLinkState(body, links[link], computeForwardKinematics=True)
                     return np.linalg.inv(T_world_base) @ bullet_pose(s[4], s[5])  # 4/5: URDF link frame
 
-                assert_pose_close(pose("tool0"), chain.T_base_tool(q), BULLET_POS_TOL, BULLET_ROT_TOL, f"PyBullet T_base_tool at q={q}")
+                assert_pose_close(
+                    pose("tool0"),
+                    chain.T_base_tool(q),
+                    BULLET_POS_TOL,
+                    BULLET_ROT_TOL,
+                    f"PyBullet T_base_tool at q={q}",
+                )
                 for i, f in enumerate(chain.frames(q), start=1):
-                    assert_pose_close(pose(f"link_{i}"), f["T_base_joint"], BULLET_POS_TOL, BULLET_ROT_TOL, f"PyBullet link_{i} at q={q}")
+                    assert_pose_close(
+                        pose(f"link_{i}"),
+                        f["T_base_joint"],
+                        BULLET_POS_TOL,
+                        BULLET_ROT_TOL,
+                        f"PyBullet link_{i} at q={q}",
+                    )
         finally:
             bullet.removeBody(body)
 
@@ -313,7 +331,9 @@ def test_pinocchio_loads_every_mesh(arms, kind):
     tag = kind.lower()
     for arm in arms:
         model = pin.buildModelFromUrdf(str(arm.urdf))
-        geom = pin.buildGeomFromUrdf(model, str(arm.urdf), getattr(pin.GeometryType, kind), package_dirs=[str(arm.urdf.parent)])
+        geom = pin.buildGeomFromUrdf(
+            model, str(arm.urdf), getattr(pin.GeometryType, kind), package_dirs=[str(arm.urdf.parent)]
+        )
         expected = {link: len(elems) for link, elems in urdf_elements(arm.urdf, tag).items() if elems}
         got: dict[str, int] = {}
         for obj in geom.geometryObjects:
@@ -386,7 +406,9 @@ def assert_physical(mass: float, com, I: np.ndarray, what: str) -> None:
     assert eig.min() > 0, f"{what}: principal moments {eig} not positive"
     slack = 1e-12 * eig.max()
     for k in range(3):
-        assert eig[k] <= eig[(k + 1) % 3] + eig[(k + 2) % 3] + slack, f"{what}: principal moments {eig} break the triangle inequality"
+        assert eig[k] <= eig[(k + 1) % 3] + eig[(k + 2) % 3] + slack, (
+            f"{what}: principal moments {eig} break the triangle inequality"
+        )
     pseudo = pin.Inertia(mass, np.asarray(com, dtype=float), I).toPseudoInertia().toMatrix()
     assert np.linalg.eigvalsh(pseudo).min() > 0, f"{what}: pseudo-inertia not positive definite"
 

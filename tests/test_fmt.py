@@ -207,7 +207,10 @@ def test_long_chain_wraps_after_a_dash():
 
 
 def test_blank_lines_collapse_to_one_and_not_at_block_edges():
-    text = "\n\n# a\n\n\n\n# b\nrobot a {\n\n\n chain H1 - L1\n\n\n\n pose p (0, 0) deg\n\n\n}\n\n\n\nrobot b { chain H1 - L1 }\n\n\n"
+    text = (
+        "\n\n# a\n\n\n\n# b\nrobot a {\n\n\n chain H1 - L1\n\n\n\n pose p (0, 0) deg\n\n\n}\n\n\n\n"
+        "robot b { chain H1 - L1 }\n\n\n"
+    )
     assert fmt(text) == ("# a\n\n# b\nrobot a {\n    chain H1 - L1\n\n    pose p (0, 0) deg\n}\n\n"
                          "robot b {\n    chain H1 - L1\n}\n")
 

@@ -347,7 +347,9 @@ def test_out_of_reach(tmp_path, farm):
     rng = np.random.default_rng(99)
     chain = Chain(robot)
     lo, hi = np.array([-2.967] * 3), np.array([2.967] * 3)
-    d = min(np.linalg.norm(chain.T_base_tool(lo + (hi - lo) * rng.random(3))[:3, 3] - [1.2, 0, 0.3]) for _ in range(3000))
+    d = min(
+        np.linalg.norm(chain.T_base_tool(lo + (hi - lo) * rng.random(3))[:3, 3] - [1.2, 0, 0.3]) for _ in range(3000)
+    )
     assert reported <= d + 1e-3
     assert reported >= d - 0.03
     assert err.diagnostics[0].span.line == 6  # points at the target's line in the file

@@ -35,13 +35,21 @@ def test_every_command_says_robot_unknown(tmp_path, capsys):
     two = tmp_path / "two.mod"
     two.write_text(TWO, encoding="utf-8")
     traj = tmp_path / "t.json"
-    traj.write_text(json.dumps({"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]}), encoding="utf-8")
+    traj.write_text(
+        json.dumps({"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]}), encoding="utf-8"
+    )
     named = tmp_path / "named.json"
-    named.write_text(json.dumps({"joint_names": ["joint_1", "joint_2"], "robot": "zz", "points": [{"t": 0, "q": [0, 0]}]}),
-                     encoding="utf-8")
+    named.write_text(
+        json.dumps({"joint_names": ["joint_1", "joint_2"], "robot": "zz", "points": [{"t": 0, "q": [0, 0]}]}),
+        encoding="utf-8",
+    )
     cases = [
         (["sim", str(two), "--robot", "nope"], "<command line>:1:1", "has no robot 'nope'"),
-        (["render", str(two), "--robot", "nope", "-o", str(tmp_path / "x.png")], "<command line>:1:1", "has no robot 'nope'"),
+        (
+            ["render", str(two), "--robot", "nope", "-o", str(tmp_path / "x.png")],
+            "<command line>:1:1",
+            "has no robot 'nope'",
+        ),
         (["play", str(two), "--traj", str(traj), "--headless"], "<command line>:1:1", "defines 2 robots (a, b)"),
         (["plan", str(two), "--to", "t", "--robot", "nope"], "<command line>:1:1", "has no robot 'nope'"),
         (["plan", str(two), "--to", "t"], "<command line>:1:1", "robots a, b all have a target 't'"),

@@ -102,7 +102,12 @@ def test_virtual_joint_and_arm_chain(example_srdfs):
         for r in _robots(b):
             root = ET.fromstring(files[f"config/{r.file_stem}.srdf"])
             (vj,) = root.findall("virtual_joint")
-            assert vj.attrib == {"name": "virtual_joint", "type": "fixed", "parent_frame": "world", "child_link": "base_link"}
+            assert vj.attrib == {
+                "name": "virtual_joint",
+                "type": "fixed",
+                "parent_frame": "world",
+                "child_link": "base_link",
+            }
             arm = [g for g in root.findall("group") if g.get("name") == "arm"]
             assert len(arm) == 1
             (chain,) = arm[0].findall("chain")
@@ -212,7 +217,9 @@ def test_never_pairs_do_not_collide_when_resampled_with_another_seed(example_srd
             for q in rng.uniform(lo, hi, size=(RESAMPLES, model.nq)):
                 if pin.computeCollisions(model, data, never, never_data, q, True):
                     cp = never.collisionPairs[never_data.collisionPairIndex]
-                    pytest.fail(f"{stem}: {owner[cp.first]} / {owner[cp.second]} marked Never collide at q = {q.tolist()}")
+                    pytest.fail(
+                        f"{stem}: {owner[cp.first]} / {owner[cp.second]} marked Never collide at q = {q.tolist()}"
+                    )
             default, default_data = geometry_model("Default")
             q0 = np.where((lo <= 0) & (hi >= 0), 0.0, (lo + hi) / 2)
             pin.computeCollisions(model, data, default, default_data, q0, False)

@@ -240,7 +240,9 @@ def test_expansion_passes_check_urdf(pairs):
     assert exe.is_file(), f"check_urdf is expected next to {sys.executable}"
     for p in pairs:
         res = subprocess.run([str(exe), str(p.xacro_urdf)], capture_output=True, text=True, timeout=60)
-        assert res.returncode == 0, f"check_urdf rejects the expansion of {p.robot.file_stem}:\n{res.stdout}\n{res.stderr}"
+        assert res.returncode == 0, (
+            f"check_urdf rejects the expansion of {p.robot.file_stem}:\n{res.stdout}\n{res.stderr}"
+        )
         assert "Successfully Parsed XML" in res.stdout and "root Link: base_link" in res.stdout
 
 
@@ -342,9 +344,15 @@ def test_xacro_cli(farm, tmp_path):
 def test_files_and_library_layout():
     c = checked_ok(CHAINS["two_libraries"], "two.mod")
     files = xacro_backend.emit(Build(c.design))
-    assert sorted(files) == ["config/mod2_planar_macro.srdf.xacro", "config/mod3_strict_macro.srdf.xacro",
-                             "urdf/mod2_planar.urdf.xacro", "urdf/mod2_planar_macro.xacro", "urdf/mod3_strict.urdf.xacro",
-                             "urdf/mod3_strict_macro.xacro", "urdf/modc_modules.xacro"]
+    assert sorted(files) == [
+        "config/mod2_planar_macro.srdf.xacro",
+        "config/mod3_strict_macro.srdf.xacro",
+        "urdf/mod2_planar.urdf.xacro",
+        "urdf/mod2_planar_macro.xacro",
+        "urdf/mod3_strict.urdf.xacro",
+        "urdf/mod3_strict_macro.xacro",
+        "urdf/modc_modules.xacro",
+    ]
     lib = files["urdf/modc_modules.xacro"]
     for ident in ("mark2", "mark2_strict"):
         for k in (1, 2, 3, 4):
@@ -440,7 +448,10 @@ def two_arm_case(tmp_path: Path, left: Pair, right: Pair, name: str) -> None:
     mounts = {"left": transform((0, 0.4, 0), (0, 0, 0.5)), "right": transform((0.1, -0.4, 0.2), (0.3, 0, -1))}
     rng = np.random.default_rng(11)
     for _ in range(3):
-        qs = {side: random_qs(p.robot, 1, int(rng.integers(1 << 30)))[-1] for side, p in (("left", left), ("right", right))}
+        qs = {
+            side: random_qs(p.robot, 1, int(rng.integers(1 << 30)))[-1]
+            for side, p in (("left", left), ("right", right))
+        }
         qp = pin.neutral(model)
         for side, p in (("left", left), ("right", right)):
             for n, qi in zip(joint_names(p.robot, side + "_"), qs[side]):

@@ -58,7 +58,7 @@ def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
 
 def robot_warnings(robot: Robot, matrix: collisions.CollisionMatrix) -> list[str]:
     out = []
-    bare = [l for l in matrix.links_without_geometry if l not in FRAME_LINKS]
+    bare = [link for link in matrix.links_without_geometry if link not in FRAME_LINKS]
     if bare:
         out.append(f"robot {robot.name}: link(s) {', '.join(bare)} have no collision geometry; "
                    "MoveIt cannot check them for collisions")

@@ -135,9 +135,9 @@ def _trusted(value):
 
 
 def _inertial(i: Inertial) -> dict:
-    I = i.inertia
-    return {"mass": i.mass, "xyz": vec(i.com), "ixx": I[0, 0], "ixy": I[0, 1], "ixz": I[0, 2],
-            "iyy": I[1, 1], "iyz": I[1, 2], "izz": I[2, 2]}
+    inertia = i.inertia
+    return {"mass": i.mass, "xyz": vec(i.com), "ixx": inertia[0, 0], "ixy": inertia[0, 1], "ixz": inertia[0, 2],
+            "iyy": inertia[1, 1], "iyz": inertia[1, 2], "izz": inertia[2, 2]}
 
 
 def _inertial_strings(i: Inertial) -> dict:
@@ -171,7 +171,9 @@ def _check_link_module(lib: Library, variant: str, part: Part, length: float) ->
     ok = (part.frame == "joint" and part.primitives == want and part.scale_x == length
           and math.isclose(part.mass, lm.mass_per_length * length, rel_tol=1e-12))
     if not ok:
-        raise AssertionError(f"link module {part.mesh} is no longer the box LINK_MODULE assumes; update modc/backends/xacro.py")
+        raise AssertionError(
+            f"link module {part.mesh} is no longer the box LINK_MODULE assumes; update modc/backends/xacro.py"
+        )
 
 
 def unit_data(lib: Library, variant: str, kind: int) -> dict:
@@ -315,11 +317,14 @@ def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) 
         units.append({"n": n, "name": u.name, "macro": f"{entry.ident}_unit{u.kind}", "variant": _key(u.variant),
                       "parent": parent, "params": params})
         parent = last_frame(n, t.link)
-    links = {l.name: l for l in desc.links}
+    links = {link.name: link for link in desc.links}
     joints = {j.name: j for j in desc.joints}
     payload = None
     if "payload" in links:
-        payload = {"inertial": _inertial_strings(links["payload"].inertial), **_pose(joints["payload_joint"].T_parent_child)}
+        payload = {
+            "inertial": _inertial_strings(links["payload"].inertial),
+            **_pose(joints["payload_joint"].T_parent_child),
+        }
     tool = robot.tool
     return {
         "version": __version__, "source": comment(source), "robot": robot.name, "sequence": robot.sequence,

@@ -31,7 +31,9 @@ def run(design: Design, ctx: Context) -> Design:
         if conv.tool.rpy != (0.0, 0.0, 0.0):
             tool = tool.model_copy(update={"rpy": conv.tool.rpy})
         r = r.model_copy(update={"units": conv.units, "tool": tool})
-        if len(r.units) <= r.library.rules.max_dof and all(u.link is None or r.library.link_length_min <= u.link <= r.library.link_length_max for u in r.units):
+        if len(r.units) <= r.library.rules.max_dof and all(
+            u.link is None or r.library.link_length_min <= u.link <= r.library.link_length_max for u in r.units
+        ):
             rows = compare(r)
             da = max(abs(x["realised"]["a"] - x["requested"]["a"]) for x in rows)
             dal = max(abs(x["realised"]["alpha"] - x["requested"]["alpha"]) for x in rows)
@@ -39,7 +41,16 @@ def run(design: Design, ctx: Context) -> Design:
             hint = "`modc dh FILE` lists every row"
             if da > 1e-3 and not r.dh_fit_links:
                 hint = "write `dh fit-links { … }` to print links that realise a exactly; " + hint
-            ctx.report(codes.DH_APPROXIMATION.at(r.name_span, robot=r.name, da=f"{da * 1000:.1f} mm",
-                                                 dalpha=f"{math.degrees(dal):.2f}deg", dd=f"{dd * 1000:.1f} mm", hint=hint), r)
+            ctx.report(
+                codes.DH_APPROXIMATION.at(
+                    r.name_span,
+                    robot=r.name,
+                    da=f"{da * 1000:.1f} mm",
+                    dalpha=f"{math.degrees(dal):.2f}deg",
+                    dd=f"{dd * 1000:.1f} mm",
+                    hint=hint,
+                ),
+                r,
+            )
         robots.append(r)
     return design.model_copy(update={"robots": tuple(robots)})

@@ -171,7 +171,7 @@ def _run(client, stage, r, traj, recording: bool, fps: float, size: tuple[int, i
             break
         q_cmd = traj.at(t0 + t)
         q_next = traj.at(t0 + t + TIME_STEP)
-        s.hold(q_cmd, [(b - a) / TIME_STEP for a, b in zip(q_cmd, q_next)])
+        s.hold(q_cmd, [(b - a) / TIME_STEP for a, b in zip(q_cmd, q_next, strict=True)])
         client.stepSimulation()
         if k % 10 == 0:
             run.worst = np.maximum(run.worst, np.abs(s.q() - np.array(traj.at(t0 + t + TIME_STEP))))
@@ -195,7 +195,9 @@ def _report(r, traj, run: _Run) -> list[str]:
     if run.contacts:
         for (a, b), (t_first, depth) in sorted(run.contacts.items(), key=lambda kv: kv[1][0]):
             what = f"obstacle {b}" if b in run.obstacles else b
-            lines.append(f"  warning: {a} collides with {what} from t = {t_first:.2f} s ({depth * 1000:.1f} mm deep at most)")
+            lines.append(
+                f"  warning: {a} collides with {what} from t = {t_first:.2f} s ({depth * 1000:.1f} mm deep at most)"
+            )
     else:
         lines.append("  no collisions (between links, or with the environment)")
     return lines

@@ -147,14 +147,31 @@ class Stage:
                                              ((0, 0, 0), AXIS_RGBA[2]))):
                 pos = [length / 2 if k == j else 0.0 for j in range(3)]
                 orn = self.client.getQuaternionFromEuler(rpy)
-                shapes.append(self.client.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=length, rgbaColor=rgba,
-                                                            visualFramePosition=pos, visualFrameOrientation=orn))
-            body = self.client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=shapes[0],
-                                               linkMasses=[0.0, 0.0], linkCollisionShapeIndices=[-1, -1],
-                                               linkVisualShapeIndices=shapes[1:], linkPositions=[[0, 0, 0]] * 2,
-                                               linkOrientations=[[0, 0, 0, 1]] * 2, linkInertialFramePositions=[[0, 0, 0]] * 2,
-                                               linkInertialFrameOrientations=[[0, 0, 0, 1]] * 2, linkParentIndices=[0, 0],
-                                               linkJointTypes=[p.JOINT_FIXED] * 2, linkJointAxis=[[0, 0, 1]] * 2)
+                shapes.append(
+                    self.client.createVisualShape(
+                        p.GEOM_CYLINDER,
+                        radius=radius,
+                        length=length,
+                        rgbaColor=rgba,
+                        visualFramePosition=pos,
+                        visualFrameOrientation=orn,
+                    )
+                )
+            body = self.client.createMultiBody(
+                baseMass=0.0,
+                baseCollisionShapeIndex=-1,
+                baseVisualShapeIndex=shapes[0],
+                linkMasses=[0.0, 0.0],
+                linkCollisionShapeIndices=[-1, -1],
+                linkVisualShapeIndices=shapes[1:],
+                linkPositions=[[0, 0, 0]] * 2,
+                linkOrientations=[[0, 0, 0, 1]] * 2,
+                linkInertialFramePositions=[[0, 0, 0]] * 2,
+                linkInertialFrameOrientations=[[0, 0, 0, 1]] * 2,
+                linkParentIndices=[0, 0],
+                linkJointTypes=[p.JOINT_FIXED] * 2,
+                linkJointAxis=[[0, 0, 1]] * 2,
+            )
             self.axes[name] = body
         self.place_axes()
 
@@ -386,7 +403,14 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
         img, cam = picture(client, robots, urdfs, qs, width, height, azimuth, elevation)
     save_png(img, out_png, colors)
     who = ", ".join(f"{r.name} ({r.sequence}) at {pose or 'home'}" for r in robots)
-    return True, [f"render: wrote {out_png} ({width}x{height}): {who}; camera azimuth {cam.azimuth:g}°, elevation {cam.elevation:g}°"], checked
+    return (
+        True,
+        [
+            f"render: wrote {out_png} ({width}x{height}): {who}; "
+            f"camera azimuth {cam.azimuth:g}°, elevation {cam.elevation:g}°"
+        ],
+        checked,
+    )
 
 
 def picture(client, robots, urdfs, qs, width: int = WIDTH, height: int = HEIGHT,

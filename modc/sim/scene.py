@@ -252,7 +252,7 @@ def extent_points(robot: Robot, q=None, T_world_base=None):
         pts.append(np.array(t.xyz))
         radii.append(TARGET_RADIUS)
     out = []
-    for p, r in zip(pts, radii):
+    for p, r in zip(pts, radii, strict=True):
         w = (T @ np.array([*p, 1.0]))[:3]
         out += [w - r, w + r]
     return np.array(out)
@@ -312,17 +312,23 @@ class Scene(CollisionQueries):
     def q(self):
         import numpy as np
 
-        return np.array([s[0] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+        return np.array(
+            [s[0] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])]
+        )
 
     def qd(self):
         import numpy as np
 
-        return np.array([s[1] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+        return np.array(
+            [s[1] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])]
+        )
 
     def applied_torques(self):
         import numpy as np
 
-        return np.array([s[3] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+        return np.array(
+            [s[3] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])]
+        )
 
     def release_motors(self) -> None:
         """PyBullet starts every joint with a velocity motor (a brake); switch them off."""
@@ -378,7 +384,9 @@ def load_robot(client, robot: Robot, urdf: Path, T_world_base=None, *, environme
     import numpy as np
 
     p = pybullet()
-    T_world_base = transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else np.asarray(T_world_base, dtype=float)
+    T_world_base = (
+        transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else np.asarray(T_world_base, dtype=float)
+    )
     pos, orn = matrix_pose(T_world_base)
     with captured_output() as log:
         body = client.loadURDF(str(urdf), basePosition=pos, baseOrientation=orn, useFixedBase=True,

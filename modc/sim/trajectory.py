@@ -48,7 +48,7 @@ class Trajectory:
         k = bisect.bisect_right(self.t, time)
         t0, t1 = self.t[k - 1], self.t[k]
         a = (time - t0) / (t1 - t0)
-        return tuple(x0 + a * (x1 - x0) for x0, x1 in zip(self.q[k - 1], self.q[k]))
+        return tuple(x0 + a * (x1 - x0) for x0, x1 in zip(self.q[k - 1], self.q[k], strict=True))
 
     def to_json(self) -> dict:
         doc: dict = {"joint_names": list(self.joint_names)}
@@ -64,7 +64,10 @@ class Trajectory:
         if self.robot is not None:
             lines.append(f'  "robot": {json.dumps(self.robot)},')
         lines.append('  "points": [')
-        pts = [f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}' for t, q in zip(self.t, self.q, strict=True)]
+        pts = [
+            f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}'
+            for t, q in zip(self.t, self.q, strict=True)
+        ]
         lines.append(",\n".join(pts))
         lines += ["  ]", "}"]
         return "\n".join(lines) + "\n"
@@ -112,7 +115,9 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
         elif t < 0:
             errors.append(f"{where}.t: {t:g} s is negative")
         elif ts and ts[-1] is not None and t <= ts[-1]:
-            errors.append(f"{where}.t: {t:g} s does not come after points[{k - 1}].t = {ts[-1]:g} s (times must increase)")
+            errors.append(
+                f"{where}.t: {t:g} s does not come after points[{k - 1}].t = {ts[-1]:g} s (times must increase)"
+            )
         ts.append(t if _number(t) else None)
         if not isinstance(q, list) or not all(_number(x) for x in q):
             errors.append(f"{where}.q: expected a list of finite numbers (radians)")
@@ -133,7 +138,9 @@ def validate_for(traj: Trajectory, robot) -> list[str]:
     unknown = [n for n in traj.joint_names if n not in want]
     missing = [n for n in want if n not in traj.joint_names]
     if unknown:
-        errors.append(f"joint_names: robot {robot.name} has no joint(s) {', '.join(unknown)} (its joints: {', '.join(want)})")
+        errors.append(
+            f"joint_names: robot {robot.name} has no joint(s) {', '.join(unknown)} (its joints: {', '.join(want)})"
+        )
     if missing:
         errors.append(f"joint_names: joint(s) {', '.join(missing)} of robot {robot.name} missing")
     if errors:
