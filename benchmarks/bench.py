@@ -376,7 +376,7 @@ def bench_corpus(
         check_file(p)
     # classification check: does each file land where the generator meant it to?
     outcome = {}
-    for p, cat in files:
+    for p, _cat in files:
         c = check_file(p)
         codes = {d.code for d in c.diagnostics if d.is_error}
         syntax = codes & {"syntax-error", "unexpected-character", "unclosed-block", "missing-dash",
@@ -580,7 +580,7 @@ def _fmt(rows: list[tuple]) -> list[str]:
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     out = []
     for j, r in enumerate(rows):
-        cells = [r[0].ljust(widths[0])] + [c.rjust(w) for c, w in zip(r[1:], widths[1:])]
+        cells = [r[0].ljust(widths[0])] + [c.rjust(w) for c, w in zip(r[1:], widths[1:], strict=True)]
         out.append("   " + "  ".join(cells).rstrip())
         if j == 0:
             out.append("   " + "  ".join("-" * w for w in widths))

@@ -33,7 +33,7 @@ import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # benchmarks/_common.py
+from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -96,9 +96,9 @@ def main(argv: list[str] | None = None) -> int:
         file=out,
     )
     for stem, b, r in _robots(args.all):
-        load, geo = _time(lambda: collisions.geometry(b.description(r)), fast_runs)
-        fast, mf = _time(lambda: collisions.compute(geo, args.samples, args.seed), fast_runs)
-        naive, mn = _time(lambda: collisions.compute_naive(geo, args.samples, args.seed), naive_runs)
+        load, geo = _time(lambda b=b, r=r: collisions.geometry(b.description(r)), fast_runs)
+        fast, mf = _time(lambda geo=geo: collisions.compute(geo, args.samples, args.seed), fast_runs)
+        naive, mn = _time(lambda geo=geo: collisions.compute_naive(geo, args.samples, args.seed), naive_runs)
         same = mf.disabled == mn.disabled and mf.enabled == mn.enabled
         ratio = naive["cpu_median"] / fast["cpu_median"]
         rows.append({"example": stem, "robot": r.name, "dof": r.dof, "samples": args.samples, "seed": args.seed,

@@ -34,7 +34,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # benchmarks/_common.py
+from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:

@@ -29,7 +29,7 @@ def newton_euler(robot, q, qd, qdd, g_base):
     inertials (mass, COM, inertia in each joint frame): the textbook algorithm, in base_link."""
     ch = Chain(robot)
     frames = ch.frames(q)
-    links = {l.name: l for l in describe(robot).links}
+    links = {link.name: link for link in describe(robot).links}
     n = robot.dof
     # inertial of body i = link_i plus what is rigidly fixed to the last link (tool0, payload)
     bodies = []
@@ -69,12 +69,12 @@ def newton_euler(robot, q, qd, qdd, g_base):
         for inert, T_part in bodies[i]:
             R = T[:3, :3] @ T_part[:3, :3]
             c = T[:3, :3] @ (T_part[:3, :3] @ inert.com + T_part[:3, 3]) + p
-            I = R @ inert.inertia @ R.T
+            inertia = R @ inert.inertia @ R.T
             rc = c - p
             a_c = a_i + np.cross(wd_i, rc) + np.cross(w_i, np.cross(w_i, rc))
             Fi = inert.mass * a_c
             F += Fi
-            N += I @ wd_i + np.cross(w_i, I @ w_i) + np.cross(rc, Fi)
+            N += inertia @ wd_i + np.cross(w_i, inertia @ w_i) + np.cross(rc, Fi)
         if p_next is not None:
             F += f_next
             N += n_next + np.cross(p_next - p, f_next)
@@ -157,7 +157,7 @@ def test_worst_case_is_not_beaten_by_a_dense_grid():
         for b in grid[:, 1]:
             for c in grid[:, 2]:
                 best = np.maximum(best, np.abs(dyn.gravity(np.array([a, b, c]))))
-    assert all(f.tau >= b - 1e-9 for f, b in zip(found, best)), ([f.tau for f in found], best)
+    assert all(f.tau >= b - 1e-9 for f, b in zip(found, best, strict=True)), ([f.tau for f in found], best)
 
 
 def _modc(*args):

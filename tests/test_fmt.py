@@ -199,9 +199,9 @@ def test_long_chain_wraps_after_a_dash():
     out = assert_fmt_properties(f"robot a {{ chain {units} }}")
     lines = out.splitlines()[1:-1]
     assert len(lines) > 1
-    assert lines[0].startswith("    chain ") and all(l.startswith(" " * 12) and l[12] != " " for l in lines[1:])
-    assert all(l.endswith(" -") for l in lines[:-1])
-    assert all(len(l) <= WIDTH for l in lines)
+    assert lines[0].startswith("    chain ") and all(ln.startswith(" " * 12) and ln[12] != " " for ln in lines[1:])
+    assert all(ln.endswith(" -") for ln in lines[:-1])
+    assert all(len(ln) <= WIDTH for ln in lines)
     # a chain that fits is never wrapped, however it was written
     assert fmt("robot a { chain H1 -\n\n   H4 -\n L4 }") == "robot a {\n    chain H1 - H4 - L4\n}\n"
 

@@ -78,7 +78,10 @@ def test_raven_example_has_a_remote_centre_of_motion():
         return abs((s - p) @ n) / np.linalg.norm(n)
 
     assert max(gap(0, 1), gap(1, 2), gap(0, 2)) < 1e-6
-    angle = lambda i, j: math.degrees(math.acos(abs(axes[i][1] @ axes[j][1])))
+
+    def angle(i, j):
+        return math.degrees(math.acos(abs(axes[i][1] @ axes[j][1])))
+
     assert angle(0, 1) == pytest.approx(75) and angle(1, 2) == pytest.approx(45)
 
 
