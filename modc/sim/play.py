@@ -40,6 +40,12 @@ def pick_robot(checked, traj: trajectory.Trajectory, robot: str | None):
     return choose_robot(checked.design, robot or traj.robot, say='--robot NAME, or "robot" in the trajectory file')
 
 
+def _palette(img) -> list[int]:
+    pal = img.getpalette()
+    assert pal is not None  # a quantised image is a palette image
+    return pal
+
+
 def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
     """A looping GIF, every frame on one adaptive palette (deterministic)."""
     from PIL import Image
@@ -53,8 +59,8 @@ def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
     sheet = Image.new("RGB", (picks[0].width, picks[0].height * len(picks)))
     for k, f in enumerate(picks):
         sheet.paste(f, (0, k * f.height))
-    smooth = sheet.quantize(colors=200, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).getpalette()[:600]
-    vivid = sheet.quantize(colors=55, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE).getpalette()[:165]
+    smooth = _palette(sheet.quantize(colors=200, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE))[:600]
+    vivid = _palette(sheet.quantize(colors=55, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE))[:165]
     palette = Image.new("P", (1, 1))
     palette.putpalette(smooth + vivid + [0, 0, 0] * (256 - (len(smooth) + len(vivid)) // 3))
     pal = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
@@ -120,11 +126,11 @@ def _frame(client, stage, r, traj, size: tuple[int, int], azimuth: float | None)
 
     stage.add_tool_axes()
     samples = [traj.at(traj.t[0] + traj.duration * k / (CAMERA_SAMPLES - 1)) for k in range(CAMERA_SAMPLES)]
-    pts = []
+    per_sample = []
     for q in samples:
         stage.set({r.name: q})
-        pts.append(stage.points())
-    pts = np.concatenate(pts)
+        per_sample.append(stage.points())
+    pts = np.concatenate(per_sample)
     stage.add_ground(pts)
     cam = stage.choose_camera(pts, size[0], size[1], azimuth, poses=[{r.name: q} for q in samples])
     if client.gui:

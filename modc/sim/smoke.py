@@ -78,11 +78,12 @@ def check_urdf_inertials(urdf: Path) -> list[str]:
     for link in ET.parse(urdf).getroot().iter("link"):
         name = link.get("name")
         inertial = link.find("inertial")
-        if inertial is None or inertial.find("mass") is None or inertial.find("inertia") is None:
+        mass_el = None if inertial is None else inertial.find("mass")
+        inertia = None if inertial is None else inertial.find("inertia")
+        if mass_el is None or inertia is None:
             bad.append(f"link {name} has no <inertial> with mass and inertia")
             continue
-        mass = float(inertial.find("mass").get("value", "0"))
-        inertia = inertial.find("inertia")
+        mass = float(mass_el.get("value", "0"))
         diag = [float(inertia.get(k, "0")) for k in ("ixx", "iyy", "izz")]
         if not mass > 0 or not all(d > 0 for d in diag):
             bad.append(f"link {name} has mass {mass:g} kg and principal inertia {diag}")

@@ -17,6 +17,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeGuard
 
 RANGE_TOL = 1e-9  # rad: q on a joint limit, written with rounding, is still inside
 
@@ -78,7 +79,7 @@ def _num(x: float) -> str:
     return "0.0" if v == 0 else repr(v)
 
 
-def _number(x) -> bool:
+def _number(x: object) -> TypeGuard[float]:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
@@ -103,7 +104,8 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
     if not isinstance(points, list) or not points:
         errors.append("points: expected a non-empty list of {\"t\": seconds, \"q\": [radians…]}")
         return None, errors
-    ts, qs = [], []
+    ts: list[float | None] = []  # None: not a valid time (an error says why)
+    qs: list[tuple[float, ...] | None] = []
     for k, pt in enumerate(points):
         where = f"points[{k}]"
         if not isinstance(pt, dict):
@@ -128,7 +130,9 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
         qs.append(tuple(float(x) for x in q))
     if errors or names is None:
         return None, errors
-    return Trajectory(tuple(names), tuple(float(t) for t in ts), tuple(qs), robot), []
+    # no errors: every time and every q is valid
+    times = tuple(float(t) for t in ts if t is not None)
+    return Trajectory(tuple(names), times, tuple(q for q in qs if q is not None), robot), []
 
 
 def validate_for(traj: Trajectory, robot) -> list[str]:
