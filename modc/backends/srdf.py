@@ -87,6 +87,7 @@ def context(build: Build, robot: Robot) -> dict:
         parent = next(j.parent for j in desc.joints if j.child == TIP_LINK)
         links = [TIP_LINK] + [j.child for j in desc.joints if j.parent == TIP_LINK]
         tool = {"group": TOOL_GROUP, "links": links, "parent_link": parent}
+    assert robot.library is not None  # resolved before any backend runs
     return {
         "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
         "library": comment(robot.library.name), "version": __version__,

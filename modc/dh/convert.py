@@ -112,7 +112,7 @@ def choose_variants(robot: Robot, lib: Library, units: tuple[UnitSpec, ...], too
     if not feasible:  # the chain cannot obey the rules; the checks will say so
         k = max(1, min(eps_h, n - 1 if n > 1 else 1))
         return [heavy] * k + [light] * (n - k)
-    best = None
+    best: tuple[float, list[str]] | None = None
     for k in feasible:
         variants = [heavy] * k + [light] * (n - k)
         trial = robot.model_copy(update={"units": with_variants(units, variants), "tool": tool, "library": lib})
@@ -121,6 +121,7 @@ def choose_variants(robot: Robot, lib: Library, units: tuple[UnitSpec, ...], too
         margin = min((t_nom - t) / t_nom for t_nom, t in zip(nominal, worst, strict=True))
         if best is None or margin > best[0] + 1e-9:
             best = (margin, variants)
+    assert best is not None  # feasible is not empty
     return best[1]
 
 
