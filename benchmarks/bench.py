@@ -248,13 +248,17 @@ class Gen:
         "unknown-parameter": lambda g, t: g.robot("up", ["H1(pviot=45deg)", "L1"]),
         "link-length-range": lambda g, t: g.robot("ll", ["H3(link=900mm)", "L1"]),
         "pose-arity": lambda g, t: t.replace("chain", "pose bad (1, 2, 3, 4, 5, 6, 7) deg\n    chain", 1),
-        "pose-out-of-limits": lambda g, t: g.robot("po", ["H1", "L1"]).replace("chain", "pose far (200, 0) deg\n    chain", 1),
+        "pose-out-of-limits": lambda g, t: g.robot("po", ["H1", "L1"]).replace(
+            "chain", "pose far (200, 0) deg\n    chain", 1
+        ),
         "duplicate-robot": lambda g, t: t + g.robot(t.split()[1]),
         "nonpositive-size": lambda g, t: t.replace("chain", "sphere s0 radius 0 m at (0, 0, 0) m\n    chain", 1),
         "unknown-joint": lambda g, t: t.replace("chain", "limit joint_9 (-10, 10) deg\n    chain", 1),
     }
     SYNTAX = {
-        "missing-dash": lambda g, t: g.robot("md", ["H1", "H4", "L1"]).replace(" - H4", " H4", 1).replace("-\n        H4", " H4", 1),
+        "missing-dash": lambda g, t: (
+            g.robot("md", ["H1", "H4", "L1"]).replace(" - H4", " H4", 1).replace("-\n        H4", " H4", 1)
+        ),
         "missing-equals": lambda g, t: g.robot("me", ["H1(pivot=45deg)", "L1"]).replace("pivot=", "pivot ", 1),
         "unclosed-block": lambda g, t: t.rstrip().rstrip("}") + "\n",
         "unexpected-character": lambda g, t: t.replace("chain", "chain @", 1),
@@ -363,14 +367,16 @@ def bench_compile(iterations: int, text: str) -> dict:
     return res
 
 
-def bench_corpus(files: list[tuple[Path, str]], passes: int, cli_runs: int, directory: Path, env: dict, cwd: str) -> dict:
+def bench_corpus(
+    files: list[tuple[Path, str]], passes: int, cli_runs: int, directory: Path, env: dict, cwd: str
+) -> dict:
     from modc.compiler import check_file
 
     for p, _ in files[:5]:  # warm-up
         check_file(p)
     # classification check: does each file land where the generator meant it to?
     outcome = {}
-    for p, cat in files:
+    for p, _cat in files:
         c = check_file(p)
         codes = {d.code for d in c.diagnostics if d.is_error}
         syntax = codes & {"syntax-error", "unexpected-character", "unclosed-block", "missing-dash",
@@ -416,8 +422,14 @@ def bench_corpus(files: list[tuple[Path, str]], passes: int, cli_runs: int, dire
         walls.append(w)
         cpus.append(c)
     wall = statistics.median(walls)
-    res["cli"] = {"runs": cli_runs, "seconds": wall, "files_per_s": n / wall, "exit_code": rc, "seconds_all_runs": walls,
-                  "cpu_seconds": statistics.median(cpus)}
+    res["cli"] = {
+        "runs": cli_runs,
+        "seconds": wall,
+        "files_per_s": n / wall,
+        "exit_code": rc,
+        "seconds_all_runs": walls,
+        "cpu_seconds": statistics.median(cpus),
+    }
     return res
 
 
@@ -449,34 +461,66 @@ def render_table(doc: dict) -> str:
         lines.append(f"WARNING: the machine is busy (cold lint wall/cpu = {stretch:.2f}); wall times are inflated "
                      "and noisy: compare the cpu and min columns, or rerun")
     if m.get("PYTHONDONTWRITEBYTECODE"):
-        lines.append("note: PYTHONDONTWRITEBYTECODE is set here; subprocesses get a private PYTHONPYCACHEPREFIX instead")
+        lines.append(
+            "note: PYTHONDONTWRITEBYTECODE is set here; subprocesses get a private PYTHONPYCACHEPREFIX instead"
+        )
     lines.append("")
     rows = [("benchmark", "median", "min", "p90", "cpu", "n", "ratio", "target", "")]
 
     cold = doc["cold"]
-    lines.append(f"1. cold start: fresh subprocess wall time, {cold['runs']} runs after 1 warm-up, .pyc cached; file: {cold['file']}")
+    lines.append(
+        f"1. cold start: fresh subprocess wall time, {cold['runs']} runs after 1 warm-up, .pyc cached; "
+        f"file: {cold['file']}"
+    )
     for name, s in cold["results"].items():
         is_lint = "lint" in name and name != AS_IS
         target = f"<= {TARGET_COLD_S:.3f} s" if is_lint else ""
         ok = s["median"] <= TARGET_COLD_S if is_lint else None
         cpu_ok = s["cpu"]["median"] <= TARGET_COLD_S
         ratio = "" if name.startswith("anchor") else f"x{s['ratio_to_anchor']:.1f}"
-        rows.append((name, f"{s['median']:.3f} s", f"{s['min']:.3f} s", f"{s['p90']:.3f} s", f"{s['cpu']['median']:.3f} s",
-                     str(s["n"]), ratio, target, _status(ok, cpu_ok)))
+        rows.append(
+            (
+                name,
+                f"{s['median']:.3f} s",
+                f"{s['min']:.3f} s",
+                f"{s['p90']:.3f} s",
+                f"{s['cpu']['median']:.3f} s",
+                str(s["n"]),
+                ratio,
+                target,
+                _status(ok, cpu_ok),
+            )
+        )
     lines += _fmt(rows)
     lines.append("")
 
     comp = doc["compile"]
     rows = [("benchmark", "median", "min", "p90", "cpu", "n", "", "target", "")]
-    lines.append(f"2. in-process compile, {comp['dof']}-DoF arm ({comp['source']}), no meshes; {comp['iterations']} iterations, ms")
+    lines.append(
+        f"2. in-process compile, {comp['dof']}-DoF arm ({comp['source']}), no meshes; "
+        f"{comp['iterations']} iterations, ms"
+    )
     for name, s in comp["results"].items():
         full = name.startswith("check_text +")
         ok = s["median"] <= TARGET_COMPILE_MS if full else None
         cpu_ok = s["cpu"]["median"] <= TARGET_COMPILE_MS
-        rows.append((name, f"{s['median']:.2f} ms", f"{s['min']:.2f} ms", f"{s['p90']:.2f} ms", f"{s['cpu']['median']:.2f} ms",
-                     str(s["n"]), "", f"<= {TARGET_COMPILE_MS:g} ms" if full else "", _status(ok, cpu_ok)))
+        rows.append(
+            (
+                name,
+                f"{s['median']:.2f} ms",
+                f"{s['min']:.2f} ms",
+                f"{s['p90']:.2f} ms",
+                f"{s['cpu']['median']:.2f} ms",
+                str(s["n"]),
+                "",
+                f"<= {TARGET_COMPILE_MS:g} ms" if full else "",
+                _status(ok, cpu_ok),
+            )
+        )
     lines += _fmt(rows)
-    lines.append(f"   outputs: urdf -> {', '.join(comp['outputs_urdf'])}; urdf,report -> {', '.join(comp['outputs_full'])}")
+    lines.append(
+        f"   outputs: urdf -> {', '.join(comp['outputs_urdf'])}; urdf,report -> {', '.join(comp['outputs_full'])}"
+    )
     lines.append("")
 
     cor = doc["corpus"]
@@ -485,15 +529,47 @@ def render_table(doc: dict) -> str:
                  f"{cor['mismatched']} misclassified")
     rows = [("benchmark", "files/s", "ms/file", "total", "cpu", "n", "", "target", "")]
     ip = cor["in_process"]
-    rows.append(("check_file, in-process, all files", f"{ip['files_per_s']:.0f}", f"{ip['ms_per_file']:.3f}",
-                 f"{ip['seconds']:.3f} s", f"{ip['cpu_seconds']:.3f} s", str(ip["passes"]), "", f">= {TARGET_FILES_PER_S:.0f}/s",
-                 _status(ip["files_per_s"] >= TARGET_FILES_PER_S, ip["cpu_files_per_s"] >= TARGET_FILES_PER_S)))
+    rows.append(
+        (
+            "check_file, in-process, all files",
+            f"{ip['files_per_s']:.0f}",
+            f"{ip['ms_per_file']:.3f}",
+            f"{ip['seconds']:.3f} s",
+            f"{ip['cpu_seconds']:.3f} s",
+            str(ip["passes"]),
+            "",
+            f">= {TARGET_FILES_PER_S:.0f}/s",
+            _status(ip["files_per_s"] >= TARGET_FILES_PER_S, ip["cpu_files_per_s"] >= TARGET_FILES_PER_S),
+        )
+    )
     for cat, s in cor["by_category"].items():
-        rows.append((f"  {cat} files only", f"{s['files_per_s']:.0f}", f"{s['ms_per_file']:.3f}", f"{s['seconds']:.3f} s", "",
-                     str(s["files"]), "", "", ""))
+        rows.append(
+            (
+                f"  {cat} files only",
+                f"{s['files_per_s']:.0f}",
+                f"{s['ms_per_file']:.3f}",
+                f"{s['seconds']:.3f} s",
+                "",
+                str(s["files"]),
+                "",
+                "",
+                "",
+            )
+        )
     cli = cor["cli"]
-    rows.append(("python -m modc lint DIR (with start-up)", f"{cli['files_per_s']:.0f}", f"{cli['seconds'] * 1e3 / cor['files']:.3f}",
-                 f"{cli['seconds']:.3f} s", f"{cli['cpu_seconds']:.3f} s", str(cli["runs"]), f"rc={cli['exit_code']}", "", ""))
+    rows.append(
+        (
+            "python -m modc lint DIR (with start-up)",
+            f"{cli['files_per_s']:.0f}",
+            f"{cli['seconds'] * 1e3 / cor['files']:.3f}",
+            f"{cli['seconds']:.3f} s",
+            f"{cli['cpu_seconds']:.3f} s",
+            str(cli["runs"]),
+            f"rc={cli['exit_code']}",
+            "",
+            "",
+        )
+    )
     lines += _fmt(rows)
     lines.append("")
     lines.append(f"total benchmark time: {doc['elapsed_s']:.1f} s")
@@ -504,7 +580,7 @@ def _fmt(rows: list[tuple]) -> list[str]:
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     out = []
     for j, r in enumerate(rows):
-        cells = [r[0].ljust(widths[0])] + [c.rjust(w) for c, w in zip(r[1:], widths[1:])]
+        cells = [r[0].ljust(widths[0])] + [c.rjust(w) for c, w in zip(r[1:], widths[1:], strict=True)]
         out.append("   " + "  ".join(cells).rstrip())
         if j == 0:
             out.append("   " + "  ".join("-" * w for w in widths))
@@ -558,10 +634,20 @@ def main(argv: list[str] | None = None) -> int:
         "mode": "quick" if args.quick else "full",
         "seed": SEED,
         "machine": machine,
-        "targets": {"cold_lint_s": TARGET_COLD_S, "compile_ms": TARGET_COMPILE_MS, "lint_files_per_s": TARGET_FILES_PER_S},
+        "targets": {
+            "cold_lint_s": TARGET_COLD_S,
+            "compile_ms": TARGET_COMPILE_MS,
+            "lint_files_per_s": TARGET_FILES_PER_S,
+        },
         "cold": {"runs": runs, "file": f"{origin} (copied to a temp dir)", "results": cold},
-        "compile": {"iterations": iterations, "source": origin, "dof": info["dof"],
-                    "outputs_urdf": info["outputs_urdf"], "outputs_full": info["outputs_full"], "results": comp},
+        "compile": {
+            "iterations": iterations,
+            "source": origin,
+            "dof": info["dof"],
+            "outputs_urdf": info["outputs_urdf"],
+            "outputs_full": info["outputs_full"],
+            "results": comp,
+        },
         "corpus": cor,
     }
     lint = cold["python -m modc lint FILE"]["median"]

@@ -33,7 +33,7 @@ import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # benchmarks/_common.py
+from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -89,12 +89,16 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     print(f"self-collision matrix, {args.samples} samples, seed {args.seed}, one core (cpu {cpu}); "
           f"times in s: median wall / median CPU", file=out)
-    print(f"{'example/robot':<26}{'dof':>4}{'load':>8}{'fast wall':>11}{'fast cpu':>10}{'naive wall':>12}{'naive cpu':>11}"
-          f"{'ratio':>8}{'exact':>8}{'same':>6}", file=out)
+    print(
+        f"{'example/robot':<26}{'dof':>4}{'load':>8}{'fast wall':>11}{'fast cpu':>10}"
+        f"{'naive wall':>12}{'naive cpu':>11}"
+        f"{'ratio':>8}{'exact':>8}{'same':>6}",
+        file=out,
+    )
     for stem, b, r in _robots(args.all):
-        load, geo = _time(lambda: collisions.geometry(b.description(r)), fast_runs)
-        fast, mf = _time(lambda: collisions.compute(geo, args.samples, args.seed), fast_runs)
-        naive, mn = _time(lambda: collisions.compute_naive(geo, args.samples, args.seed), naive_runs)
+        load, geo = _time(lambda b=b, r=r: collisions.geometry(b.description(r)), fast_runs)
+        fast, mf = _time(lambda geo=geo: collisions.compute(geo, args.samples, args.seed), fast_runs)
+        naive, mn = _time(lambda geo=geo: collisions.compute_naive(geo, args.samples, args.seed), naive_runs)
         same = mf.disabled == mn.disabled and mf.enabled == mn.enabled
         ratio = naive["cpu_median"] / fast["cpu_median"]
         rows.append({"example": stem, "robot": r.name, "dof": r.dof, "samples": args.samples, "seed": args.seed,
@@ -103,9 +107,13 @@ def main(argv: list[str] | None = None) -> int:
                      "stats": mf.stats, "naive_mesh_pairs": mn.stats.get("mesh_pairs"),
                      "reasons": {k: sum(p.reason == k for p in mf.disabled) for k in collisions.REASONS},
                      "enabled": len(mf.enabled)})
-        print(f"{stem + '/' + r.name:<26}{r.dof:>4}{load['wall_median']:>8.3f}{fast['wall_median']:>11.3f}{fast['cpu_median']:>10.3f}"
-              f"{naive['wall_median']:>12.3f}{naive['cpu_median']:>11.3f}{ratio:>7.1f}x{mf.stats['exact_tests']:>8}"
-              f"{'yes' if same else 'NO':>6}", file=out)
+        print(
+            f"{stem + '/' + r.name:<26}{r.dof:>4}{load['wall_median']:>8.3f}"
+            f"{fast['wall_median']:>11.3f}{fast['cpu_median']:>10.3f}"
+            f"{naive['wall_median']:>12.3f}{naive['cpu_median']:>11.3f}{ratio:>7.1f}x{mf.stats['exact_tests']:>8}"
+            f"{'yes' if same else 'NO':>6}",
+            file=out,
+        )
     six = [x for x in rows if x["dof"] == 6]
     if six:
         worst = max(x["fast"]["cpu_median"] for x in six)

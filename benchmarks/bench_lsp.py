@@ -82,7 +82,9 @@ def run(edits: int, warmup: int) -> dict:
         client.initialize()
         t_ready = time.perf_counter() - t_start
         t0 = client.open(uri, SIX_DOF)
-        t1, first = client.wait_notification("textDocument/publishDiagnostics", lambda p: p["uri"] == uri and p.get("version") == 1)
+        t1, first = client.wait_notification(
+            "textDocument/publishDiagnostics", lambda p: p["uri"] == uri and p.get("version") == 1
+        )
         assert first["diagnostics"] == [], first  # the arm is valid
         open_ms = (t1 - t0) * 1e3
 

@@ -34,7 +34,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # benchmarks/_common.py
+from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -138,10 +138,13 @@ def main(argv: list[str] | None = None) -> int:
             ratio = anchor["wall_median"] / fast["wall_median"] if anchor else None
             rows.append({"case": name, "fast": fast, "anchor": anchor, "ratio_wall": ratio,
                          "phases": _phases(path, target, 0)})
-            print(f"{name:<20}{fast['wall_median']:>8.3f}{'[' + format(fast['wall_min'], '.2f') + '-' + format(fast['wall_max'], '.2f') + ']':>16}"
-                  f"{fast['checks_median']:>9.0f}{statistics.median(fast['motion_s']):>10.2f}"
-                  + (f"{anchor['wall_median']:>9.3f}{anchor['checks_median']:>9.0f}{ratio:>7.1f}x" if anchor else ""),
-                  file=out)
+            print(
+                f"{name:<20}{fast['wall_median']:>8.3f}"
+                f"{'[' + format(fast['wall_min'], '.2f') + '-' + format(fast['wall_max'], '.2f') + ']':>16}"
+                f"{fast['checks_median']:>9.0f}{statistics.median(fast['motion_s']):>10.2f}"
+                + (f"{anchor['wall_median']:>9.3f}{anchor['checks_median']:>9.0f}{ratio:>7.1f}x" if anchor else ""),
+                file=out,
+            )
         print("phases of the seed-0 fast run (s):", file=out)
         for r in rows:
             ph = ", ".join(f"{k} {v:.3f}" for k, v in r["phases"].items())

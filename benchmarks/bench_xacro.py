@@ -175,9 +175,12 @@ def render(doc: dict) -> str:
     w = max(len(k) for k in ip) + 2
     for k, s in ip.items():
         lines.append(f"   {k:<{w}} {s['median']:8.2f}   min {s['min']:7.2f}   p90 {s['p90']:7.2f}")
-    lines.append(f"   ratio modc whole compile / xacro expansion: {r['in_process']:.3f}  (target <= {TARGET_RATIO:g}: "
-                 f"{'ok' if r['in_process'] <= TARGET_RATIO else 'MISS'}); without torque analysis: {r['in_process_no_torque']:.3f}; "
-                 f"cold (first compile of this arm, nothing cached): {r['in_process_cold']:.3f}")
+    lines.append(
+        f"   ratio modc whole compile / xacro expansion: {r['in_process']:.3f}  (target <= {TARGET_RATIO:g}: "
+        f"{'ok' if r['in_process'] <= TARGET_RATIO else 'MISS'}); "
+        f"without torque analysis: {r['in_process_no_torque']:.3f}; "
+        f"cold (first compile of this arm, nothing cached): {r['in_process_cold']:.3f}"
+    )
     bd = doc["breakdown"]
     lines.append(f"   breakdown of the whole compile, median of {doc['runs_breakdown']} runs (ms; the first build of a"
                  " process also renders the library data once):")
@@ -188,7 +191,9 @@ def render(doc: dict) -> str:
     lines.append(f"2. subprocesses, start-up included, median of {doc['runs_subprocess']} interleaved runs (s)")
     w = max(len(k) for k in sp) + 2
     for k, s in sp.items():
-        lines.append(f"   {k:<{w}} {s['median']:8.3f}   min {s['min']:7.3f}   p90 {s['p90']:7.3f}   rc={s['exit_code']}")
+        lines.append(
+            f"   {k:<{w}} {s['median']:8.3f}   min {s['min']:7.3f}   p90 {s['p90']:7.3f}   rc={s['exit_code']}"
+        )
     lines.append(f"   ratio modc / xacro: {r['subprocess']:.3f}")
     return "\n".join(lines)
 

@@ -139,7 +139,7 @@ class Chain:
             raise ValueError(f"expected {self.dof} joint values, got {q.shape}")
         T = np.eye(4)
         out = []
-        for u, qi in zip(self.units, q):
+        for u, qi in zip(self.units, q, strict=True):
             f = {"T_base_unit": T}
             f["T_base_twist1"] = T @ A_t1(u.pivot, u.x01, u.z01)
             f["T_base_joint"] = f["T_base_twist1"] @ A_J(qi, u.z12)

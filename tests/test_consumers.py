@@ -26,16 +26,16 @@ import pinocchio as pin
 import pybullet
 import pytest
 import yourdfpy
+from conftest import EXAMPLES, ROOT, checked_ok
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pybullet_utils.bullet_client import BulletClient
+from strategies import RobotSpec, robot_specs
 
-from conftest import EXAMPLES, ROOT, checked_ok
 from modc.compiler import build, check_file, write_tree
 from modc.kinematics import Chain
 from modc.model import Robot
 from modc.physical.assembly import FRAME_MASS, library_mass
-from strategies import RobotSpec, robot_specs
 
 FK_TOL = 1e-9  # SPEC section 7: FK from the URDF equals section 2 to 1e-9
 # The pip wheel of PyBullet is built in single precision (btScalar = float): getLinkState returns
@@ -194,7 +194,7 @@ def pin_frames(model: pin.Model, arm: Arm, q: np.ndarray) -> dict[str, np.ndarra
     """Frame name -> 4x4 pose in base_link, as pinocchio computes it from the URDF."""
     data = model.createData()
     qp = pin.neutral(model)
-    for name, qi in zip(arm.joint_names, q):
+    for name, qi in zip(arm.joint_names, q, strict=True):
         qp[model.joints[model.getJointId(name)].idx_q] = qi
     pin.framesForwardKinematics(model, data, qp)
     names = ["tool0"] + arm.joint_names + [f"link_{i}" for i in range(1, arm.dof + 1)]
@@ -219,11 +219,15 @@ def check_fk_yourdfpy(arm: Arm, qs, tol: float = FK_TOL) -> None:
     assert urdf.actuated_joint_names == arm.joint_names
     chain = Chain(arm.robot)
     for q in qs:
-        urdf.update_cfg(dict(zip(arm.joint_names, q)))
+        urdf.update_cfg(dict(zip(arm.joint_names, q, strict=True)))
         # get_transform(frame_to, frame_from): pose of frame_to expressed in frame_from
-        assert_close(urdf.get_transform("tool0", "base_link"), chain.T_base_tool(q), tol, f"yourdfpy T_base_tool at q={q}")
+        assert_close(
+            urdf.get_transform("tool0", "base_link"), chain.T_base_tool(q), tol, f"yourdfpy T_base_tool at q={q}"
+        )
         for i, f in enumerate(chain.frames(q), start=1):
-            assert_close(urdf.get_transform(f"link_{i}", "base_link"), f["T_base_joint"], tol, f"yourdfpy link_{i} at q={q}")
+            assert_close(
+                urdf.get_transform(f"link_{i}", "base_link"), f["T_base_joint"], tol, f"yourdfpy link_{i} at q={q}"
+            )
 
 
 def test_fk_pinocchio_matches_spec(arms):
@@ -261,6 +265,12 @@ def bullet_links(client, body: int) -> dict[str, int]:
     return out
 
 
+def bullet_link_pose(client, body: int, link: int, T_world_base: np.ndarray) -> np.ndarray:
+    """The URDF frame of a link (PyBullet link index) in base_link, from the last FK state."""
+    s = client.getLinkState(body, link, computeForwardKinematics=True)
+    return np.linalg.inv(T_world_base) @ bullet_pose(s[4], s[5])  # 4/5: URDF link frame
+
+
 def test_fk_pybullet_matches_spec(arms, bullet):
     """PyBullet's link frames of tool0 and every link_i match SPEC section 2 (to float32 precision)."""
     for k, arm in enumerate(arms):
@@ -272,19 +282,28 @@ def test_fk_pybullet_matches_spec(arms, bullet):
                 assert bullet.getJointInfo(body, joints[name])[2] == pybullet.JOINT_REVOLUTE
             # base_link's URDF frame = its inertial frame composed with the inverse inertial offset
             _, _, _, local_pos, local_orn, *_ = bullet.getDynamicsInfo(body, -1)
-            T_world_base = bullet_pose(*bullet.getBasePositionAndOrientation(body)) @ np.linalg.inv(bullet_pose(local_pos, local_orn))
+            T_world_base = bullet_pose(*bullet.getBasePositionAndOrientation(body)) @ np.linalg.inv(
+                bullet_pose(local_pos, local_orn)
+            )
             chain = Chain(arm.robot)
             for q in random_qs(arm.robot, N_RANDOM_Q, seed=k):
-                for name, qi in zip(arm.joint_names, q):
+                for name, qi in zip(arm.joint_names, q, strict=True):
                     bullet.resetJointState(body, joints[name], float(qi))
-
-                def pose(link: str) -> np.ndarray:
-                    s = bullet.getLinkState(body, links[link], computeForwardKinematics=True)
-                    return np.linalg.inv(T_world_base) @ bullet_pose(s[4], s[5])  # 4/5: URDF link frame
-
-                assert_pose_close(pose("tool0"), chain.T_base_tool(q), BULLET_POS_TOL, BULLET_ROT_TOL, f"PyBullet T_base_tool at q={q}")
+                assert_pose_close(
+                    bullet_link_pose(bullet, body, links["tool0"], T_world_base),
+                    chain.T_base_tool(q),
+                    BULLET_POS_TOL,
+                    BULLET_ROT_TOL,
+                    f"PyBullet T_base_tool at q={q}",
+                )
                 for i, f in enumerate(chain.frames(q), start=1):
-                    assert_pose_close(pose(f"link_{i}"), f["T_base_joint"], BULLET_POS_TOL, BULLET_ROT_TOL, f"PyBullet link_{i} at q={q}")
+                    assert_pose_close(
+                        bullet_link_pose(bullet, body, links[f"link_{i}"], T_world_base),
+                        f["T_base_joint"],
+                        BULLET_POS_TOL,
+                        BULLET_ROT_TOL,
+                        f"PyBullet link_{i} at q={q}",
+                    )
         finally:
             bullet.removeBody(body)
 
@@ -313,7 +332,9 @@ def test_pinocchio_loads_every_mesh(arms, kind):
     tag = kind.lower()
     for arm in arms:
         model = pin.buildModelFromUrdf(str(arm.urdf))
-        geom = pin.buildGeomFromUrdf(model, str(arm.urdf), getattr(pin.GeometryType, kind), package_dirs=[str(arm.urdf.parent)])
+        geom = pin.buildGeomFromUrdf(
+            model, str(arm.urdf), getattr(pin.GeometryType, kind), package_dirs=[str(arm.urdf.parent)]
+        )
         expected = {link: len(elems) for link, elems in urdf_elements(arm.urdf, tag).items() if elems}
         got: dict[str, int] = {}
         for obj in geom.geometryObjects:
@@ -360,7 +381,7 @@ def test_total_mass_pinocchio(arms):
     for arm in arms:
         model = pin.buildModelFromUrdf(str(arm.urdf))
         # inertias[0] holds base_link (fixed to the universe); fixed tool0/payload merge into the last body
-        total = sum(I.mass for I in model.inertias) - FRAME_MASS
+        total = sum(b.mass for b in model.inertias) - FRAME_MASS
         assert total == pytest.approx(library_mass(arm.robot), abs=MASS_TOL)
 
 
@@ -377,17 +398,19 @@ def test_total_mass_pybullet(arms, bullet):
         assert total == pytest.approx(library_mass(arm.robot), abs=MASS_TOL)
 
 
-def assert_physical(mass: float, com, I: np.ndarray, what: str) -> None:
+def assert_physical(mass: float, com, inertia: np.ndarray, what: str) -> None:
     """Positive mass, symmetric positive-definite inertia about the COM, triangle inequality on
     the principal moments, and a positive-definite pseudo-inertia (a real mass distribution)."""
     assert mass > 0, f"{what}: mass {mass}"
-    assert_close(I, I.T, 0.0, f"{what}: inertia symmetric")
-    eig = np.linalg.eigvalsh(I)
+    assert_close(inertia, inertia.T, 0.0, f"{what}: inertia symmetric")
+    eig = np.linalg.eigvalsh(inertia)
     assert eig.min() > 0, f"{what}: principal moments {eig} not positive"
     slack = 1e-12 * eig.max()
     for k in range(3):
-        assert eig[k] <= eig[(k + 1) % 3] + eig[(k + 2) % 3] + slack, f"{what}: principal moments {eig} break the triangle inequality"
-    pseudo = pin.Inertia(mass, np.asarray(com, dtype=float), I).toPseudoInertia().toMatrix()
+        assert eig[k] <= eig[(k + 1) % 3] + eig[(k + 2) % 3] + slack, (
+            f"{what}: principal moments {eig} break the triangle inequality"
+        )
+    pseudo = pin.Inertia(mass, np.asarray(com, dtype=float), inertia).toPseudoInertia().toMatrix()
     assert np.linalg.eigvalsh(pseudo).min() > 0, f"{what}: pseudo-inertia not positive definite"
 
 
@@ -399,8 +422,8 @@ def test_inertias_are_physical(arms):
         for name, link in urdf.link_map.items():
             assert link.inertial is not None, f"{arm.urdf.name}: {name} has no <inertial>"
             o = link.inertial.origin
-            I = o[:3, :3] @ link.inertial.inertia @ o[:3, :3].T  # in the link frame, about the COM
-            assert_physical(link.inertial.mass, o[:3, 3], I, f"{arm.urdf.name} {name}")
+            inertia = o[:3, :3] @ link.inertial.inertia @ o[:3, :3].T  # in the link frame, about the COM
+            assert_physical(link.inertial.mass, o[:3, 3], inertia, f"{arm.urdf.name} {name}")
         model = pin.buildModelFromUrdf(str(arm.urdf))
         for j, body in enumerate(model.inertias):
             assert_physical(body.mass, body.lever, body.inertia, f"{arm.urdf.name} pinocchio body {model.names[j]}")
@@ -427,7 +450,7 @@ def spec_T_base_tool(spec: RobotSpec, q) -> np.ndarray:
         return R
 
     T = np.eye(4)
-    for u, qi in zip(spec.units, q):
+    for u, qi in zip(spec.units, q, strict=True):
         x01, z01, z12 = table[u.kind]
         T = T @ H(rot(1, math.radians(u.pivot_deg or 0)), (x01, 0, z01)) @ H(rot(2, qi), (0, 0, z12))
         if u.has_link:
@@ -453,4 +476,4 @@ def test_random_valid_chains_load_with_spec_kinematics(spec: RobotSpec, seed: in
         check_fk_yourdfpy(arm, qs)
         assert_check_urdf_accepts(arm)
         model = pin.buildModelFromUrdf(str(arm.urdf))
-        assert sum(I.mass for I in model.inertias) - FRAME_MASS == pytest.approx(library_mass(arm.robot), abs=MASS_TOL)
+        assert sum(b.mass for b in model.inertias) - FRAME_MASS == pytest.approx(library_mass(arm.robot), abs=MASS_TOL)

@@ -8,8 +8,8 @@ import sys
 
 import numpy as np
 import pytest
-
 from conftest import ROOT, checked_ok, compile_text
+
 from modc.compiler import COMPILE_ANALYSES, check_text
 from modc.dynamics.model import Dynamics
 from modc.dynamics.worst import worst_case
@@ -18,7 +18,8 @@ from modc.physical.assembly import describe
 
 G = 9.81
 ARMS = [
-    "robot r { chain H1 - H4(pivot=-90deg, port=45deg) - L3(pivot=30deg, link=150mm) - L2 payload 0.4 kg at (0.01, 0, 0.02) m }",
+    "robot r { chain H1 - H4(pivot=-90deg, port=45deg) - L3(pivot=30deg, link=150mm) - L2 "
+    "payload 0.4 kg at (0.01, 0, 0.02) m }",
     "robot r { chain H3(pivot=60deg) - H4(port=-105deg) - L4 - L1 tool at (0.05, 0, 0.02) m base rpy (20, 0, 0) deg }",
 ]
 
@@ -28,7 +29,7 @@ def newton_euler(robot, q, qd, qdd, g_base):
     inertials (mass, COM, inertia in each joint frame): the textbook algorithm, in base_link."""
     ch = Chain(robot)
     frames = ch.frames(q)
-    links = {l.name: l for l in describe(robot).links}
+    links = {link.name: link for link in describe(robot).links}
     n = robot.dof
     # inertial of body i = link_i plus what is rigidly fixed to the last link (tool0, payload)
     bodies = []
@@ -68,12 +69,12 @@ def newton_euler(robot, q, qd, qdd, g_base):
         for inert, T_part in bodies[i]:
             R = T[:3, :3] @ T_part[:3, :3]
             c = T[:3, :3] @ (T_part[:3, :3] @ inert.com + T_part[:3, 3]) + p
-            I = R @ inert.inertia @ R.T
+            inertia = R @ inert.inertia @ R.T
             rc = c - p
             a_c = a_i + np.cross(wd_i, rc) + np.cross(w_i, np.cross(w_i, rc))
             Fi = inert.mass * a_c
             F += Fi
-            N += I @ wd_i + np.cross(w_i, I @ w_i) + np.cross(rc, Fi)
+            N += inertia @ wd_i + np.cross(w_i, inertia @ w_i) + np.cross(rc, Fi)
         if p_next is not None:
             F += f_next
             N += n_next + np.cross(p_next - p, f_next)
@@ -145,7 +146,9 @@ def test_horizontal_two_module_arm_matches_the_hand_calculation():
 
 
 def test_worst_case_is_not_beaten_by_a_dense_grid():
-    robot = checked_ok("robot r { chain H3(pivot=-90deg) - H4(port=45deg) - L4(link=300mm) payload 0.2 kg }").design.robots[0]
+    robot = checked_ok(
+        "robot r { chain H3(pivot=-90deg) - H4(port=45deg) - L4(link=300mm) payload 0.2 kg }"
+    ).design.robots[0]
     dyn = Dynamics(robot)
     found = worst_case(dyn)
     grid = np.linspace(dyn.lower, dyn.upper, 41)
@@ -154,7 +157,7 @@ def test_worst_case_is_not_beaten_by_a_dense_grid():
         for b in grid[:, 1]:
             for c in grid[:, 2]:
                 best = np.maximum(best, np.abs(dyn.gravity(np.array([a, b, c]))))
-    assert all(f.tau >= b - 1e-9 for f, b in zip(found, best)), ([f.tau for f in found], best)
+    assert all(f.tau >= b - 1e-9 for f, b in zip(found, best, strict=True)), ([f.tau for f in found], best)
 
 
 def _modc(*args):
@@ -194,7 +197,9 @@ def test_compile_refuses_an_overloaded_arm_unless_told(tmp_path):
 
 
 def test_epsilon_and_torque_disagreement_is_told():
-    c = check_text("robot tower { chain H1 - H1 - H1 - H1 - L1 allow epsilon-exceeded }", "t.mod", analyses=COMPILE_ANALYSES)
+    c = check_text(
+        "robot tower { chain H1 - H1 - H1 - H1 - L1 allow epsilon-exceeded }", "t.mod", analyses=COMPILE_ANALYSES
+    )
     assert [d.code for d in c.diagnostics] == ["epsilon-disagrees"]
     c = check_text("robot reach { chain H1 - L4(pivot=-90deg, link=450mm) - L4(link=450mm) payload 1 kg }", "t.mod",
                    analyses=COMPILE_ANALYSES)
@@ -234,7 +239,11 @@ def test_check_along_a_planned_motion(tmp_path):
     r = _modc("check", farm, "--traj", str(fast))
     assert r.returncode == 1
     assert "Traceback" not in r.stderr
-    assert re.search(r"^modc check: joint_\d \([HL]\d\) needs [\d.]+ N·m at t = [\d.]+ s of .*fast.json, above its peak", r.stderr, re.M), r.stderr
+    assert re.search(
+        r"^modc check: joint_\d \([HL]\d\) needs [\d.]+ N·m at t = [\d.]+ s of .*fast.json, above its peak",
+        r.stderr,
+        re.M,
+    ), r.stderr
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"joint_names": ["joint_1"], "points": [{"t": 0, "q": [0]}]}))
     r = _modc("check", farm, "--traj", str(bad))

@@ -8,15 +8,14 @@ from functools import cache
 from pathlib import Path
 
 import pytest
+from conftest import EXAMPLES
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from strategies import valid_chains
 
 from modc.compiler import build, check_text
 from modc.resources import data_dir
 from modc.syntax.format import WIDTH, format_text, rewrite_file
-
-from conftest import EXAMPLES
-from strategies import valid_chains
 
 POSITION_KEYS = ("line", "col", "end_line", "end_col", "start", "end")
 
@@ -200,15 +199,18 @@ def test_long_chain_wraps_after_a_dash():
     out = assert_fmt_properties(f"robot a {{ chain {units} }}")
     lines = out.splitlines()[1:-1]
     assert len(lines) > 1
-    assert lines[0].startswith("    chain ") and all(l.startswith(" " * 12) and l[12] != " " for l in lines[1:])
-    assert all(l.endswith(" -") for l in lines[:-1])
-    assert all(len(l) <= WIDTH for l in lines)
+    assert lines[0].startswith("    chain ") and all(ln.startswith(" " * 12) and ln[12] != " " for ln in lines[1:])
+    assert all(ln.endswith(" -") for ln in lines[:-1])
+    assert all(len(ln) <= WIDTH for ln in lines)
     # a chain that fits is never wrapped, however it was written
     assert fmt("robot a { chain H1 -\n\n   H4 -\n L4 }") == "robot a {\n    chain H1 - H4 - L4\n}\n"
 
 
 def test_blank_lines_collapse_to_one_and_not_at_block_edges():
-    text = "\n\n# a\n\n\n\n# b\nrobot a {\n\n\n chain H1 - L1\n\n\n\n pose p (0, 0) deg\n\n\n}\n\n\n\nrobot b { chain H1 - L1 }\n\n\n"
+    text = (
+        "\n\n# a\n\n\n\n# b\nrobot a {\n\n\n chain H1 - L1\n\n\n\n pose p (0, 0) deg\n\n\n}\n\n\n\n"
+        "robot b { chain H1 - L1 }\n\n\n"
+    )
     assert fmt(text) == ("# a\n\n# b\nrobot a {\n    chain H1 - L1\n\n    pose p (0, 0) deg\n}\n\n"
                          "robot b {\n    chain H1 - L1\n}\n")
 

@@ -11,8 +11,8 @@ import hashlib
 from pathlib import Path
 
 import pytest
-
 from conftest import EXAMPLES, ROOT
+
 from modc.compiler import COMPILE_ANALYSES, build, check_file
 
 GOLDEN = ROOT / "tests" / "golden"

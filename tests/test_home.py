@@ -13,11 +13,10 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 import yaml
+from conftest import checked_ok
 
 from modc.compiler import build, check_text
 from modc.kinematics import Chain
-
-from conftest import checked_ok
 
 LIMITED = """robot farm {
     chain H1 - L4(port=45deg) - L1

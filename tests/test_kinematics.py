@@ -5,14 +5,16 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import ROOT, checked_ok
+
 from modc.compiler import check_file
 from modc.kinematics import A_J, A_t1, A_t2, Chain, matrix_rpy, rpy_matrix
 
 
 def paper_eq4(a, x01, z01):  # eq. (4), entries as printed
-    return np.array([[math.cos(a), 0, math.sin(a), x01], [0, 1, 0, 0], [-math.sin(a), 0, math.cos(a), z01], [0, 0, 0, 1]])
+    return np.array(
+        [[math.cos(a), 0, math.sin(a), x01], [0, 1, 0, 0], [-math.sin(a), 0, math.cos(a), z01], [0, 0, 0, 1]]
+    )
 
 
 def paper_eq5(t, z12):
@@ -32,7 +34,9 @@ def test_frame_matrices_are_the_papers(angle):
 
 def test_product_of_units_is_eq3():
     """T_base_tool = prod_i A_t1 A_J (A_t2 for units 3/4), with Table-free numbers from section 3.1."""
-    r = checked_ok("robot r { chain H1 - H4(pivot=-90deg, port=45deg) - L3(pivot=30deg, link=150mm) - L2 }").design.robots[0]
+    r = checked_ok(
+        "robot r { chain H1 - H4(pivot=-90deg, port=45deg) - L3(pivot=30deg, link=150mm) - L2 }"
+    ).design.robots[0]
     q = np.array([0.1, -0.7, 1.3, 2.0])
     d = math.radians
     expected = (
@@ -74,7 +78,10 @@ def test_raven_example_has_a_remote_centre_of_motion():
         return abs((s - p) @ n) / np.linalg.norm(n)
 
     assert max(gap(0, 1), gap(1, 2), gap(0, 2)) < 1e-6
-    angle = lambda i, j: math.degrees(math.acos(abs(axes[i][1] @ axes[j][1])))
+
+    def angle(i, j):
+        return math.degrees(math.acos(abs(axes[i][1] @ axes[j][1])))
+
     assert angle(0, 1) == pytest.approx(75) and angle(1, 2) == pytest.approx(45)
 
 

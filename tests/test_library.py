@@ -6,8 +6,8 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import ROOT, checked_ok
+
 from modc.compiler import check_text
 from modc.model import library
 
@@ -60,7 +60,9 @@ def test_user_library_file_is_used(tmp_path):
     (tmp_path / "mine.yaml").write_text(text)
     src = tmp_path / "arm.mod"
     src.write_text('robot r {\n  library "mine.yaml"\n  chain H1 - L1\n}\n')
-    r = subprocess.run([sys.executable, "-m", "modc", str(src), "-o", str(tmp_path / "out")], capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", str(src), "-o", str(tmp_path / "out")], capture_output=True, text=True
+    )
     assert r.returncode == 0, r.stderr
     assert 'effort="40"' in (tmp_path / "out" / "urdf" / "mod2_r.urdf").read_text()
     # the command-line override wins over the file

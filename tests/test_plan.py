@@ -11,6 +11,7 @@ The properties that matter are checked independently of the code under test:
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import os
@@ -21,12 +22,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from modc.compiler import build, check_file, write_tree
 from modc.kinematics import Chain
 from modc.plan import PlanError, plan, timing
-
-from conftest import ROOT
 
 FARM = ROOT / "examples" / "farm.mod"
 JOINT_STEP = math.radians(0.25)  # rad per joint between independently checked samples
@@ -85,17 +85,17 @@ class Independent:
             g = {"box": lambda s: coal.Box(*s), "sphere": lambda s: coal.Sphere(s[0]),
                  "cylinder": lambda s: coal.Cylinder(s[0], s[1])}[ob.shape](ob.size)
             self.obstacles.append((ob.name, _T(ob.origin.xyz, ob.origin.rpy), g))
-        with_geom = {l for l, _, _ in self.geoms}
-        nbr = {l.get("name"): set() for l in root.findall("link")}
+        with_geom = {link for link, _, _ in self.geoms}
+        nbr = {link.get("name"): set() for link in root.findall("link")}
         for j in root.findall("joint"):
             a, b = j.find("parent").get("link"), j.find("child").get("link")
             nbr[a].add(b)
             nbr[b].add(a)
-        for l in list(nbr):
-            if l not in with_geom:
-                ns = nbr.pop(l)
+        for link in list(nbr):
+            if link not in with_geom:
+                ns = nbr.pop(link)
                 for n in ns:
-                    nbr[n].discard(l)
+                    nbr[n].discard(link)
                 for a in ns:
                     nbr[a] |= ns - {a}
         links = sorted(with_geom)
@@ -113,7 +113,7 @@ class Independent:
         return c.collide(g1, tf1, g2, tf2, c.CollisionRequest(), c.CollisionResult()) > 0
 
     def collisions(self, q) -> list[tuple[str, str]]:
-        self.urdf.update_cfg(dict(zip(self.joints, (float(v) for v in q))))
+        self.urdf.update_cfg(dict(zip(self.joints, (float(v) for v in q), strict=True)))
         T_link: dict[str, np.ndarray] = {}
         placed = []
         for link, T, g in self.geoms:
@@ -140,7 +140,7 @@ def dense(q_rows, chain: Chain):
     JOINT_STEP per joint and TOOL_STEP of tool0 apart."""
     Q = np.asarray(q_rows, float)
     out = [Q[0]]
-    for a, b in zip(Q[:-1], Q[1:]):
+    for a, b in itertools.pairwise(Q):
         n = max(1, math.ceil(np.max(np.abs(b - a)) / JOINT_STEP))
         while True:
             seg = [a + (b - a) * k / n for k in range(n + 1)]
@@ -348,7 +348,9 @@ def test_out_of_reach(tmp_path, farm):
     rng = np.random.default_rng(99)
     chain = Chain(robot)
     lo, hi = np.array([-2.967] * 3), np.array([2.967] * 3)
-    d = min(np.linalg.norm(chain.T_base_tool(lo + (hi - lo) * rng.random(3))[:3, 3] - [1.2, 0, 0.3]) for _ in range(3000))
+    d = min(
+        np.linalg.norm(chain.T_base_tool(lo + (hi - lo) * rng.random(3))[:3, 3] - [1.2, 0, 0.3]) for _ in range(3000)
+    )
     assert reported <= d + 1e-3
     assert reported >= d - 0.03
     assert err.diagnostics[0].span.line == 6  # points at the target's line in the file

@@ -76,7 +76,11 @@ def packages(tmp_path_factory):
 
 def ros_files(files: dict) -> set[str]:
     per_robot = (".srdf", ".scene", ".urdf.xacro", ".ros2_control.xacro", ".srdf.xacro")
-    return {rel for rel in files if not rel.startswith(("urdf/", "meshes/", "mjcf/", "report")) and not rel.endswith(per_robot)}
+    return {
+        rel
+        for rel in files
+        if not rel.startswith(("urdf/", "meshes/", "mjcf/", "report")) and not rel.endswith(per_robot)
+    }
 
 
 # ------------------------------------------------------------------------------------------------

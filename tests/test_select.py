@@ -5,12 +5,11 @@ from __future__ import annotations
 import json
 
 import pytest
+from conftest import checked_ok
+from test_diagnostics_corpus import run_cli
 
 from modc.api import ModcError, load
 from modc.model.select import RobotChoiceError, choose_robot
-
-from conftest import checked_ok
-from test_diagnostics_corpus import run_cli
 
 TWO = "robot a { chain H3 - L4 target t at (0.2, 0, 0.3) m }\nrobot b { chain H3 - L4 target t at (0.2, 0, 0.3) m }\n"
 
@@ -36,13 +35,21 @@ def test_every_command_says_robot_unknown(tmp_path, capsys):
     two = tmp_path / "two.mod"
     two.write_text(TWO, encoding="utf-8")
     traj = tmp_path / "t.json"
-    traj.write_text(json.dumps({"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]}), encoding="utf-8")
+    traj.write_text(
+        json.dumps({"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]}), encoding="utf-8"
+    )
     named = tmp_path / "named.json"
-    named.write_text(json.dumps({"joint_names": ["joint_1", "joint_2"], "robot": "zz", "points": [{"t": 0, "q": [0, 0]}]}),
-                     encoding="utf-8")
+    named.write_text(
+        json.dumps({"joint_names": ["joint_1", "joint_2"], "robot": "zz", "points": [{"t": 0, "q": [0, 0]}]}),
+        encoding="utf-8",
+    )
     cases = [
         (["sim", str(two), "--robot", "nope"], "<command line>:1:1", "has no robot 'nope'"),
-        (["render", str(two), "--robot", "nope", "-o", str(tmp_path / "x.png")], "<command line>:1:1", "has no robot 'nope'"),
+        (
+            ["render", str(two), "--robot", "nope", "-o", str(tmp_path / "x.png")],
+            "<command line>:1:1",
+            "has no robot 'nope'",
+        ),
         (["play", str(two), "--traj", str(traj), "--headless"], "<command line>:1:1", "defines 2 robots (a, b)"),
         (["plan", str(two), "--to", "t", "--robot", "nope"], "<command line>:1:1", "has no robot 'nope'"),
         (["plan", str(two), "--to", "t"], "<command line>:1:1", "robots a, b all have a target 't'"),

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import EXAMPLES, ROOT
+
 from modc.compiler import COMPILE_ANALYSES, build, check_file, check_text
 from modc.kinematics import Chain
 from modc.model.select import RobotChoiceError
@@ -132,7 +132,9 @@ def test_srdf_disabled_pairs_are_honoured_but_never_pairs_are_not(tmp_path):
     (out / "config").mkdir(parents=True)
     srdf = out / "config" / "mod3_fold.srdf"
     for reason, passes in (("Default", True), ("Always", True), ("Adjacent", True), ("Never", False)):
-        srdf.write_text(f'<robot name="mod3_fold"><disable_collisions link1="base_link" link2="link_2" reason="{reason}"/></robot>')
+        srdf.write_text(
+            f'<robot name="mod3_fold"><disable_collisions link1="base_link" link2="link_2" reason="{reason}"/></robot>'
+        )
         ok, lines, _ = smoke.run_sim(path, out_dir=out)
         assert ok == passes, (reason, lines)
 
@@ -297,8 +299,10 @@ def traj_file(tmp_path: Path, doc, name: str = "traj.json") -> Path:
     return p
 
 
-SWEEP = {"joint_names": ["joint_1", "joint_2", "joint_3"],
-         "points": [{"t": 0.0, "q": [0.0, 0.0, 0.0]}, {"t": 0.6, "q": [0.9, -0.5, 0.8]}, {"t": 1.2, "q": [1.6, -0.9, 1.4]}]}
+SWEEP = {
+    "joint_names": ["joint_1", "joint_2", "joint_3"],
+    "points": [{"t": 0.0, "q": [0.0, 0.0, 0.0]}, {"t": 0.6, "q": [0.9, -0.5, 0.8]}, {"t": 1.2, "q": [1.6, -0.9, 1.4]}],
+}
 
 
 def test_play_records_a_gif_of_many_different_frames(tmp_path):
@@ -343,18 +347,44 @@ def test_play_joint_order_is_free(tmp_path):
 
 
 BAD = [
-    ({"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]}, "joint(s) joint_3 of robot spatial missing"),
+    (
+        {"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}]},
+        "joint(s) joint_3 of robot spatial missing",
+    ),
     ({"joint_names": ["joint_1", "joint_2", "elbow"], "points": [{"t": 0, "q": [0, 0, 0]}]}, "has no joint(s) elbow"),
-    ({"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [0, 0, 0]}, {"t": 0, "q": [0, 0, 0]}]},
-     "points[1].t: 0 s does not come after points[0].t = 0 s"),
-    ({"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [0, 0]}]}, "points[0].q: 2 value(s) for 3 joint name(s)"),
-    ({"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [0, 4, 0]}]}, "joint_2 = 4 rad (229.2°) is outside its range"),
+    (
+        {
+            "joint_names": ["joint_1", "joint_2", "joint_3"],
+            "points": [{"t": 0, "q": [0, 0, 0]}, {"t": 0, "q": [0, 0, 0]}],
+        },
+        "points[1].t: 0 s does not come after points[0].t = 0 s",
+    ),
+    (
+        {"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [0, 0]}]},
+        "points[0].q: 2 value(s) for 3 joint name(s)",
+    ),
+    (
+        {"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [0, 4, 0]}]},
+        "joint_2 = 4 rad (229.2°) is outside its range",
+    ),
     ({"joint_names": ["joint_1", "joint_2", "joint_3"], "points": []}, "points: expected a non-empty list"),
-    ({"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": -1, "q": [0, 0, 0]}]}, "points[0].t: -1 s is negative"),
-    ({"joint_names": ["joint_1", "joint_1", "joint_3"], "points": [{"t": 0, "q": [0, 0, 0]}]}, "joint_1 listed more than once"),
+    (
+        {"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": -1, "q": [0, 0, 0]}]},
+        "points[0].t: -1 s is negative",
+    ),
+    (
+        {"joint_names": ["joint_1", "joint_1", "joint_3"], "points": [{"t": 0, "q": [0, 0, 0]}]},
+        "joint_1 listed more than once",
+    ),
     ({"points": [{"t": 0, "q": [0, 0, 0]}]}, "joint_names: expected a non-empty list"),
-    ({"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": "0", "q": [0, 0, 0]}]}, "points[0].t: expected a finite number"),
-    ('{"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [NaN, 0, 0]}]}', "points[0].q: expected a list of finite numbers"),
+    (
+        {"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": "0", "q": [0, 0, 0]}]},
+        "points[0].t: expected a finite number",
+    ),
+    (
+        '{"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0, "q": [NaN, 0, 0]}]}',
+        "points[0].q: expected a list of finite numbers",
+    ),
     ("[1, 2", "not JSON"),
     ([1, 2], "the top level must be an object"),
 ]
@@ -394,15 +424,21 @@ def test_compile_smoke_option(tmp_path):
     import sys
 
     root = Path(__file__).resolve().parent.parent
-    r = subprocess.run([sys.executable, "-m", "modc", str(root / "examples" / "farm.mod"), "-o", str(tmp_path / "ok"), "--smoke"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", str(root / "examples" / "farm.mod"), "-o", str(tmp_path / "ok"), "--smoke"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 0 and "robot farm (H1-L4-L3): ok" in r.stderr
     bad = tmp_path / "heavy.mod"
     bad.write_text("robot heavy {\n    chain H1 - L4(pivot=-90deg, link=450mm) - L4(link=450mm)\n    payload 1 kg\n"
                    "    pose out (0, -90, 0) deg\n}\n")
     # --torque off lets the static check pass, so the simulation is what refuses the arm
-    r = subprocess.run([sys.executable, "-m", "modc", str(bad), "-o", str(tmp_path / "out"), "--smoke", "--torque", "off"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", str(bad), "-o", str(tmp_path / "out"), "--smoke", "--torque", "off"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 1, r.stderr
     assert "joint_2 sags" in r.stderr and "smoke test failed; nothing written" in r.stderr
     assert not (tmp_path / "out").exists()

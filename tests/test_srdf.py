@@ -15,14 +15,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import EXAMPLES, ROOT, checked_ok
 
-from modc.backends import Build
-from modc.backends import srdf
+from modc.backends import Build, srdf
 from modc.compiler import check_file
 from modc.model import Robot
 from modc.physical import collisions
-
-from conftest import EXAMPLES, ROOT, checked_ok
 
 RESAMPLES = 2000
 RESEED = 20240917  # not the backend's seed
@@ -86,11 +84,11 @@ def test_srdf_parses_and_names_only_urdf_links_and_joints(example_srdfs, compile
         for r in _robots(b):
             root = ET.fromstring(files[f"config/{r.file_stem}.srdf"])
             _, urdf = _urdf(compiled_examples[stem], r)
-            links = {l.get("name") for l in urdf.findall("link")}
+            links = {link.get("name") for link in urdf.findall("link")}
             joints = {j.get("name") for j in urdf.findall("joint")}
             assert root.tag == "robot" and root.get("name") == urdf.get("name")
             named = [c.get(a) for c in root.iter("chain") for a in ("base_link", "tip_link")]
-            named += [l.get("name") for g in root.findall("group") for l in g.findall("link")]
+            named += [link.get("name") for g in root.findall("group") for link in g.findall("link")]
             named += [e.get("parent_link") for e in root.findall("end_effector")]
             named += [v.get("child_link") for v in root.findall("virtual_joint")]
             named += [d.get(a) for d in root.findall("disable_collisions") for a in ("link1", "link2")]
@@ -104,7 +102,12 @@ def test_virtual_joint_and_arm_chain(example_srdfs):
         for r in _robots(b):
             root = ET.fromstring(files[f"config/{r.file_stem}.srdf"])
             (vj,) = root.findall("virtual_joint")
-            assert vj.attrib == {"name": "virtual_joint", "type": "fixed", "parent_frame": "world", "child_link": "base_link"}
+            assert vj.attrib == {
+                "name": "virtual_joint",
+                "type": "fixed",
+                "parent_frame": "world",
+                "child_link": "base_link",
+            }
             arm = [g for g in root.findall("group") if g.get("name") == "arm"]
             assert len(arm) == 1
             (chain,) = arm[0].findall("chain")
@@ -149,7 +152,7 @@ def test_end_effector_only_when_a_tool_is_declared(decl, links):
     if links is None:
         assert set(groups) == {"arm"} and not ees
         return
-    assert [l.get("name") for l in groups["tool"].findall("link")] == links
+    assert [link.get("name") for link in groups["tool"].findall("link")] == links
     (ee,) = ees
     assert ee.attrib == {"name": "tool", "parent_link": "link_3", "group": "tool", "parent_group": "arm"}
 
@@ -171,7 +174,7 @@ def test_every_adjacent_pair_is_disabled_and_only_geometry_links_appear(example_
             root = ET.fromstring(files[f"config/{r.file_stem}.srdf"])
             pairs = _pairs(root)
             path, urdf = _urdf(compiled_examples[stem], r)
-            with_geometry = {l.get("name") for l in urdf.findall("link") if l.find("collision") is not None}
+            with_geometry = {link.get("name") for link in urdf.findall("link") if link.find("collision") is not None}
             for j in urdf.findall("joint"):
                 a, c = j.find("parent").get("link"), j.find("child").get("link")
                 if a in with_geometry and c in with_geometry:
@@ -182,6 +185,19 @@ def test_every_adjacent_pair_is_disabled_and_only_geometry_links_appear(example_
             n = len(with_geometry)
             assert len(pairs) + len(m.enabled) == n * (n - 1) // 2
             assert {frozenset(p) for p in m.enabled}.isdisjoint(pairs)
+
+
+def _geometry_model(gm, owner: list[str], pairs: dict, reason: str):
+    """A copy of gm with the collision pairs the SRDF marks `reason` (owner: geometry index -> link)."""
+    import pinocchio as pin
+
+    g = gm.copy()
+    g.removeAllCollisionPairs()
+    for i in range(len(owner)):
+        for j in range(i + 1, len(owner)):
+            if pairs.get(frozenset((owner[i], owner[j]))) == reason:
+                g.addCollisionPair(pin.CollisionPair(i, j))
+    return g, g.createData()
 
 
 def test_never_pairs_do_not_collide_when_resampled_with_another_seed(example_srdfs, compiled_examples):
@@ -199,27 +215,19 @@ def test_never_pairs_do_not_collide_when_resampled_with_another_seed(example_srd
             model, gm, owner = _pin(path)
             data = model.createData()
             lo, hi = model.lowerPositionLimit, model.upperPositionLimit
-
-            def geometry_model(reason):
-                g = gm.copy()
-                g.removeAllCollisionPairs()
-                for i in range(len(owner)):
-                    for j in range(i + 1, len(owner)):
-                        if pairs.get(frozenset((owner[i], owner[j]))) == reason:
-                            g.addCollisionPair(pin.CollisionPair(i, j))
-                return g, g.createData()
-
-            never, never_data = geometry_model("Never")
+            never, never_data = _geometry_model(gm, owner, pairs, "Never")
             checked_pairs += sum(1 for v in pairs.values() if v == "Never")
             for q in rng.uniform(lo, hi, size=(RESAMPLES, model.nq)):
                 if pin.computeCollisions(model, data, never, never_data, q, True):
                     cp = never.collisionPairs[never_data.collisionPairIndex]
-                    pytest.fail(f"{stem}: {owner[cp.first]} / {owner[cp.second]} marked Never collide at q = {q.tolist()}")
-            default, default_data = geometry_model("Default")
+                    pytest.fail(
+                        f"{stem}: {owner[cp.first]} / {owner[cp.second]} marked Never collide at q = {q.tolist()}"
+                    )
+            default, default_data = _geometry_model(gm, owner, pairs, "Default")
             q0 = np.where((lo <= 0) & (hi >= 0), 0.0, (lo + hi) / 2)
             pin.computeCollisions(model, data, default, default_data, q0, False)
-            hit = {frozenset((owner[cp.first], owner[cp.second]))
-                   for cp, res in zip(default.collisionPairs, default_data.collisionResults) if res.isCollision()}
+            results = zip(default.collisionPairs, default_data.collisionResults, strict=True)
+            hit = {frozenset((owner[cp.first], owner[cp.second])) for cp, res in results if res.isCollision()}
             assert hit == {p for p, v in pairs.items() if v == "Default"}, stem
     assert checked_pairs >= 40  # the examples do exercise this (44 Never pairs)
 
@@ -404,7 +412,7 @@ def test_every_reason_on_a_synthetic_urdf():
 def test_adjacency_collapses_chains_of_geometry_less_links():
     links = ("a", "x", "y", "b", "c")
     edges = (("a", "x"), ("x", "y"), ("y", "b"), ("y", "c"))
-    adj = collisions.adjacent_pairs(links, edges, lambda l: l in {"a", "b", "c"})
+    adj = collisions.adjacent_pairs(links, edges, lambda link: link in {"a", "b", "c"})
     assert adj == {frozenset(p) for p in (("a", "b"), ("a", "c"), ("b", "c"))}
 
 

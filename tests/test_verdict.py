@@ -6,20 +6,21 @@ import math
 
 import numpy as np
 import pytest
+from conftest import checked_ok
 
 from modc.dynamics.model import Dynamics
 from modc.kinematics import Chain
 from modc.sim.contacts import Contact
 from modc.sim.verdict import TRACK_TOL, Hold, Measured, RobotResult, describe, judge_pose
 
-from conftest import checked_ok
-
 pytest.importorskip("pinocchio")
 
 
 @pytest.fixture(scope="module")
 def farm():
-    r = checked_ok("robot farm {\n    chain H1 - H4(pivot=-90deg) - L3(port=45deg)\n    pose ready (0, 30, -45) deg\n}\n").design.robots[0]
+    r = checked_ok(
+        "robot farm {\n    chain H1 - H4(pivot=-90deg) - L3(port=45deg)\n    pose ready (0, 30, -45) deg\n}\n"
+    ).design.robots[0]
     return r, Chain(r), Dynamics(r)
 
 
@@ -48,7 +49,9 @@ def test_each_check_speaks_for_the_engine(farm):
     T = chain.T_base_tool(np.array(q))
     T[0, 3] += 1e-3  # the engine puts tool0 1 mm away
     touching = [Contact("link_1", "link_3", -0.004)]
-    m = Measured("ready", q, T, touching, [Contact("link_2", "shelf", -0.002)], _held(dyn, q, error=3 * TRACK_TOL, effort=0.01))
+    m = Measured(
+        "ready", q, T, touching, [Contact("link_2", "shelf", -0.002)], _held(dyn, q, error=3 * TRACK_TOL, effort=0.01)
+    )
     assert abs(dyn.gravity(np.array(q))[1]) > 0.01  # joint_2 needs more than the actuator gives
     res = judge_pose(r, m, chain, dyn, engine="MuJoCo")
     kinds = [f.kind for f in res.failures]

@@ -24,14 +24,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import xacro
-from hypothesis import HealthCheck, given, settings
-
 from conftest import EXAMPLES, ROOT, checked_ok
+from hypothesis import HealthCheck, given, settings
+from strategies import robot_specs
+
 from modc.backends import BACKENDS, Build, load_all
 from modc.compiler import build, check_file, write_tree
 from modc.kinematics import Chain, transform
 from modc.model import Robot
-from strategies import robot_specs
 
 # The backend registers itself on import. Until load_all() imports it, keep it out of the
 # registry so that other tests' outputs (golden files, report.json) do not change under them.
@@ -130,7 +130,7 @@ def load(path: Path) -> pin.Model:
 
 def config(model: pin.Model, names: list[str], q) -> np.ndarray:
     qp = pin.neutral(model)
-    for name, qi in zip(names, q):
+    for name, qi in zip(names, q, strict=True):
         qp[model.joints[model.getJointId(name)].idx_q] = qi
     return qp
 
@@ -169,7 +169,7 @@ def assert_equivalent(robot: Robot, jinja: pin.Model, xm: pin.Model, seed: int =
     ja = [jinja.getJointId(n) for n in names]
     jb = [xm.getJointId(n) for n in xnames]
     # limits (position, effort, velocity), per joint
-    for a, b, n in zip(ja, jb, names):
+    for a, b, n in zip(ja, jb, names, strict=True):
         ia, ib = jinja.joints[a].idx_q, xm.joints[b].idx_q
         got = [xm.lowerPositionLimit[ib], xm.upperPositionLimit[ib], xm.effortLimit[xm.joints[b].idx_v],
                xm.velocityLimit[xm.joints[b].idx_v]]
@@ -178,7 +178,7 @@ def assert_equivalent(robot: Robot, jinja: pin.Model, xm: pin.Model, seed: int =
         assert_close(got, want, f"{n} limits")
         assert_close(xm.jointPlacements[b].homogeneous, jinja.jointPlacements[a].homogeneous, f"{n} placement")
     # the rigid body moving with each joint, and (index 0) what is fixed to the base
-    for a, b in [(0, 0), *zip(ja, jb)]:
+    for a, b in [(0, 0), *zip(ja, jb, strict=True)]:
         A, B = jinja.inertias[a], xm.inertias[b]
         what = f"body of {jinja.names[a]}"
         assert_close(B.mass, A.mass, f"{what}: mass")
@@ -240,7 +240,9 @@ def test_expansion_passes_check_urdf(pairs):
     assert exe.is_file(), f"check_urdf is expected next to {sys.executable}"
     for p in pairs:
         res = subprocess.run([str(exe), str(p.xacro_urdf)], capture_output=True, text=True, timeout=60)
-        assert res.returncode == 0, f"check_urdf rejects the expansion of {p.robot.file_stem}:\n{res.stdout}\n{res.stderr}"
+        assert res.returncode == 0, (
+            f"check_urdf rejects the expansion of {p.robot.file_stem}:\n{res.stdout}\n{res.stderr}"
+        )
         assert "Successfully Parsed XML" in res.stdout and "root Link: base_link" in res.stdout
 
 
@@ -258,12 +260,14 @@ def test_names_and_joint_types(pairs):
         assert movable == joint_names(p.robot)
         assert all(j.get("type") == "revolute" and j.find("axis").get("xyz") == "0 0 1"
                    for j in b.findall("joint") if j.get("type") != "fixed")
-        links_a = {l.get("name") for l in a.findall("link")}
-        links_b = {l.get("name") for l in b.findall("link")}
+        links_a = {link.get("name") for link in a.findall("link")}
+        links_b = {link.get("name") for link in b.findall("link")}
         assert links_a <= links_b
         assert "base_link" in links_b and "tool0" in links_b
         # every link of the expansion is a body (no massless frames: PyBullet would give them 1 kg)
-        assert all(l.find("inertial") is not None for l in b.findall("link") if l.get("name") != "base_link")
+        assert all(
+            link.find("inertial") is not None for link in b.findall("link") if link.get("name") != "base_link"
+        )
 
 
 def test_extra_links_are_the_papers_frames(pairs):
@@ -273,7 +277,7 @@ def test_extra_links_are_the_papers_frames(pairs):
         chain = Chain(p.robot)
         for q in random_qs(p.robot, 2, seed=7):
             f = frames(model, config(model, joint_names(p.robot), q))
-            for n, (fr, u) in enumerate(zip(chain.frames(q), chain.units), start=1):
+            for n, (fr, u) in enumerate(zip(chain.frames(q), chain.units, strict=True), start=1):
                 assert_close(f[f"unit_{n}_base"], fr["T_base_unit"], f"unit_{n}_base")
                 assert_close(f[f"unit_{n}_twist1"], fr["T_base_twist1"], f"unit_{n}_twist1")
                 assert_close(f[f"link_{n}"], fr["T_base_joint"], f"link_{n}")
@@ -342,9 +346,15 @@ def test_xacro_cli(farm, tmp_path):
 def test_files_and_library_layout():
     c = checked_ok(CHAINS["two_libraries"], "two.mod")
     files = xacro_backend.emit(Build(c.design))
-    assert sorted(files) == ["config/mod2_planar_macro.srdf.xacro", "config/mod3_strict_macro.srdf.xacro",
-                             "urdf/mod2_planar.urdf.xacro", "urdf/mod2_planar_macro.xacro", "urdf/mod3_strict.urdf.xacro",
-                             "urdf/mod3_strict_macro.xacro", "urdf/modc_modules.xacro"]
+    assert sorted(files) == [
+        "config/mod2_planar_macro.srdf.xacro",
+        "config/mod3_strict_macro.srdf.xacro",
+        "urdf/mod2_planar.urdf.xacro",
+        "urdf/mod2_planar_macro.xacro",
+        "urdf/mod3_strict.urdf.xacro",
+        "urdf/mod3_strict_macro.xacro",
+        "urdf/modc_modules.xacro",
+    ]
     lib = files["urdf/modc_modules.xacro"]
     for ident in ("mark2", "mark2_strict"):
         for k in (1, 2, 3, 4):
@@ -440,10 +450,13 @@ def two_arm_case(tmp_path: Path, left: Pair, right: Pair, name: str) -> None:
     mounts = {"left": transform((0, 0.4, 0), (0, 0, 0.5)), "right": transform((0.1, -0.4, 0.2), (0.3, 0, -1))}
     rng = np.random.default_rng(11)
     for _ in range(3):
-        qs = {side: random_qs(p.robot, 1, int(rng.integers(1 << 30)))[-1] for side, p in (("left", left), ("right", right))}
+        qs = {
+            side: random_qs(p.robot, 1, int(rng.integers(1 << 30)))[-1]
+            for side, p in (("left", left), ("right", right))
+        }
         qp = pin.neutral(model)
         for side, p in (("left", left), ("right", right)):
-            for n, qi in zip(joint_names(p.robot, side + "_"), qs[side]):
+            for n, qi in zip(joint_names(p.robot, side + "_"), qs[side], strict=True):
                 qp[model.joints[model.getJointId(n)].idx_q] = qi
         f = frames(model, qp)
         for side, p in (("left", left), ("right", right)):

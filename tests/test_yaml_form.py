@@ -7,8 +7,8 @@ import sys
 
 import jsonschema
 import yaml
-
 from conftest import ROOT
+
 from modc.compiler import build, check_file, check_text
 
 

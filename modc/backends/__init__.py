@@ -34,7 +34,8 @@ def register(name: str, summary: str, heavy: bool = False):
 def load_all() -> dict[str, Backend]:
     # Registration happens on import, in run order: later backends may read earlier outputs
     # (ros installs mjcf/ when the mjcf backend ran); report runs last so that it lists every output.
-    from . import meshes, urdf  # noqa: F401
+    # The order of these imports is the run order: not sorted on purpose.
+    from . import meshes, urdf  # noqa: F401, I001
     from . import srdf  # noqa: F401
     from . import mjcf  # noqa: F401
     from . import ros  # noqa: F401

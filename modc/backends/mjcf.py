@@ -41,8 +41,7 @@ from ..physical.statics import G
 from . import Build, register
 from .format import num, vec
 from .srdf import collision_matrix
-from .templates import comment
-from .templates import render
+from .templates import comment, render
 from .urdf import MATERIALS
 
 TIME_STEP = 1e-3  # s, as `modc sim`

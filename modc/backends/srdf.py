@@ -58,7 +58,7 @@ def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
 
 def robot_warnings(robot: Robot, matrix: collisions.CollisionMatrix) -> list[str]:
     out = []
-    bare = [l for l in matrix.links_without_geometry if l not in FRAME_LINKS]
+    bare = [link for link in matrix.links_without_geometry if link not in FRAME_LINKS]
     if bare:
         out.append(f"robot {robot.name}: link(s) {', '.join(bare)} have no collision geometry; "
                    "MoveIt cannot check them for collisions")
@@ -87,6 +87,7 @@ def context(build: Build, robot: Robot) -> dict:
         parent = next(j.parent for j in desc.joints if j.child == TIP_LINK)
         links = [TIP_LINK] + [j.child for j in desc.joints if j.parent == TIP_LINK]
         tool = {"group": TOOL_GROUP, "links": links, "parent_link": parent}
+    assert robot.library is not None  # resolved before any backend runs
     return {
         "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
         "library": comment(robot.library.name), "version": __version__,

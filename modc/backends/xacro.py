@@ -23,6 +23,7 @@ import keyword
 import math
 import re
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from markupsafe import Markup
@@ -135,9 +136,9 @@ def _trusted(value):
 
 
 def _inertial(i: Inertial) -> dict:
-    I = i.inertia
-    return {"mass": i.mass, "xyz": vec(i.com), "ixx": I[0, 0], "ixy": I[0, 1], "ixz": I[0, 2],
-            "iyy": I[1, 1], "iyz": I[1, 2], "izz": I[2, 2]}
+    inertia = i.inertia
+    return {"mass": i.mass, "xyz": vec(i.com), "ixx": inertia[0, 0], "ixy": inertia[0, 1], "ixz": inertia[0, 2],
+            "iyy": inertia[1, 1], "iyz": inertia[1, 2], "izz": inertia[2, 2]}
 
 
 def _inertial_strings(i: Inertial) -> dict:
@@ -171,7 +172,9 @@ def _check_link_module(lib: Library, variant: str, part: Part, length: float) ->
     ok = (part.frame == "joint" and part.primitives == want and part.scale_x == length
           and math.isclose(part.mass, lm.mass_per_length * length, rel_tol=1e-12))
     if not ok:
-        raise AssertionError(f"link module {part.mesh} is no longer the box LINK_MODULE assumes; update modc/backends/xacro.py")
+        raise AssertionError(
+            f"link module {part.mesh} is no longer the box LINK_MODULE assumes; update modc/backends/xacro.py"
+        )
 
 
 def unit_data(lib: Library, variant: str, kind: int) -> dict:
@@ -202,7 +205,7 @@ def unit_data(lib: Library, variant: str, kind: int) -> dict:
     if {r: d["body"] for r, d in placed.items()} != expected or (link_module is not None) != t.link:
         raise AssertionError(f"unit {variant}{kind}: parts changed ({sorted(placed)}); update modc/backends/xacro.py")
     lo, hi = math.radians(v.lower_deg), math.radians(v.upper_deg)
-    data = {"effort": v.actuator.torque_peak, "velocity": v.actuator.velocity, "lower": lo, "upper": hi}
+    data: dict[str, Any] = {"effort": v.actuator.torque_peak, "velocity": v.actuator.velocity, "lower": lo, "upper": hi}
     for b in BODIES:
         data[b] = _inertial(combine(bodies[b]))
     for role in expected:
@@ -300,6 +303,7 @@ def macro_name(robot: Robot) -> str:
 def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) -> dict:
     desc = build.description(robot)
     lib = robot.library
+    assert lib is not None  # resolved before any backend runs
     units = []
     parent = "base_link"
     for i, u in enumerate(robot.units):
@@ -315,19 +319,26 @@ def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) 
         units.append({"n": n, "name": u.name, "macro": f"{entry.ident}_unit{u.kind}", "variant": _key(u.variant),
                       "parent": parent, "params": params})
         parent = last_frame(n, t.link)
-    links = {l.name: l for l in desc.links}
+    links = {link.name: link for link in desc.links}
     joints = {j.name: j for j in desc.joints}
     payload = None
     if "payload" in links:
-        payload = {"inertial": _inertial_strings(links["payload"].inertial), **_pose(joints["payload_joint"].T_parent_child)}
+        payload_inertial = links["payload"].inertial
+        assert payload_inertial is not None  # a payload has a mass
+        payload = {
+            "inertial": _inertial_strings(payload_inertial),
+            **_pose(joints["payload_joint"].T_parent_child),
+        }
     tool = robot.tool
+    tool_inertial = links["tool0"].inertial
+    assert tool_inertial is not None  # tool0 carries a placeholder inertial
     return {
         "version": __version__, "source": comment(source), "robot": robot.name, "sequence": robot.sequence,
-        "name": robot.file_stem, "macro": macro_name(robot), "library": comment(robot.library.name),
+        "name": robot.file_stem, "macro": macro_name(robot), "library": comment(lib.name),
         "library_file": LIBRARY_FILE, "macro_file": f"{robot.file_stem}_macro.xacro",
         "mesh_root": DEFAULT_MESH_ROOT, "units": units,
         "tool": {"parent": parent, "xyz": vec(tool.xyz), "rpy": vec(tool.rpy),
-                 "inertial": _inertial_strings(links["tool0"].inertial)},
+                 "inertial": _inertial_strings(tool_inertial)},
         "payload": payload,
     }
 

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import sys
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -21,8 +21,13 @@ from .app import (
 @app.command("sim")
 def sim_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
-    robot: Annotated[Optional[str], typer.Option(help="simulate only this robot of the file")] = None,
-    srdf_from: Annotated[Optional[str], typer.Option("--srdf-from", help="a compile output OUT/ whose config/*.srdf disabled collision pairs are honoured")] = None,
+    robot: Annotated[str | None, typer.Option(help="simulate only this robot of the file")] = None,
+    srdf_from: Annotated[
+        str | None,
+        typer.Option(
+            "--srdf-from", help="a compile output OUT/ whose config/*.srdf disabled collision pairs are honoured"
+        ),
+    ] = None,
     library: LibraryOpt = None,
     engine: Annotated[str, typer.Option(help="physics engine: pybullet (the URDF) or mujoco (the MJCF)")] = "pybullet",
 ):
@@ -44,12 +49,16 @@ def sim_cmd(
 def render_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
     out: Annotated[str, typer.Option("-o", "--out", help="PNG file to write")],
-    pose: Annotated[Optional[str], typer.Option(help="named pose (default: home)")] = None,
-    robot: Annotated[Optional[str], typer.Option(help="render only this robot of the file")] = None,
+    pose: Annotated[str | None, typer.Option(help="named pose (default: home)")] = None,
+    robot: Annotated[str | None, typer.Option(help="render only this robot of the file")] = None,
     size: Annotated[str, typer.Option(help="WIDTHxHEIGHT in pixels")] = "800x600",
-    azimuth: Annotated[Optional[float], typer.Option(help="camera azimuth in degrees from +x towards +y (default: chosen)")] = None,
-    elevation: Annotated[Optional[float], typer.Option(help="camera elevation in degrees (default 30)")] = None,
-    colors: Annotated[Optional[int], typer.Option(help="quantise to a palette of this many colours (<= 256) for small files")] = None,
+    azimuth: Annotated[
+        float | None, typer.Option(help="camera azimuth in degrees from +x towards +y (default: chosen)")
+    ] = None,
+    elevation: Annotated[float | None, typer.Option(help="camera elevation in degrees (default 30)")] = None,
+    colors: Annotated[
+        int | None, typer.Option(help="quantise to a palette of this many colours (<= 256) for small files")
+    ] = None,
     library: LibraryOpt = None,
 ):
     """A picture of the arm, its environment and its targets (PyBullet TinyRenderer, headless)."""
@@ -61,7 +70,7 @@ def render_cmd(
         assert width > 0 and height > 0
     except (ValueError, AssertionError):
         _err(f"modc render: --size {size!r}: expected WIDTHxHEIGHT, e.g. 800x600")
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     if colors is not None and not 2 <= colors <= 256:
         _err(f"modc render: --colors {colors}: expected 2 to 256")
         raise typer.Exit(EXIT_USAGE)
@@ -78,8 +87,10 @@ def render_cmd(
 def play_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
     traj: Annotated[str, typer.Option("--traj", help="trajectory JSON, as `modc plan --json` prints")],
-    record: Annotated[Optional[str], typer.Option(help="write a GIF of the motion (headless TinyRenderer)")] = None,
-    robot: Annotated[Optional[str], typer.Option(help="the robot the trajectory is for (files with several robots)")] = None,
+    record: Annotated[str | None, typer.Option(help="write a GIF of the motion (headless TinyRenderer)")] = None,
+    robot: Annotated[
+        str | None, typer.Option(help="the robot the trajectory is for (files with several robots)")
+    ] = None,
     headless: Annotated[bool, typer.Option("--headless", help="never open the PyBullet GUI")] = False,
     library: LibraryOpt = None,
 ):
@@ -89,7 +100,9 @@ def play_cmd(
     from ..sim.scene import UsageError
 
     with usage_errors("play", (UsageError,), writing=record):
-        ok, lines, checked = play(file, traj, record=record, robot=robot, library=library, gui=False if headless else None)
+        ok, lines, checked = play(
+            file, traj, record=record, robot=robot, library=library, gui=False if headless else None
+        )
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not ok:
         from ..diagnostics import Span, codes
@@ -105,10 +118,14 @@ def play_cmd(
 def plan_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
     to: Annotated[str, typer.Option("--to", help="target to move tool0 to (a `target` of the robot)")],
-    json_out: Annotated[bool, typer.Option("--json", help="print the trajectory as JSON on stdout (SPEC section 6)")] = False,
-    robot: Annotated[Optional[str], typer.Option(help="robot of the file (default: the one that has the target)")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="seed of IK starts, RRT-Connect and shortcuts: same file and seed, same motion")] = 0,
-    start: Annotated[Optional[str], typer.Option(help="pose to start from (default: home)")] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="print the trajectory as JSON on stdout (SPEC section 6)")
+    ] = False,
+    robot: Annotated[str | None, typer.Option(help="robot of the file (default: the one that has the target)")] = None,
+    seed: Annotated[
+        int, typer.Option(min=0, help="seed of IK starts, RRT-Connect and shortcuts: same file and seed, same motion")
+    ] = 0,
+    start: Annotated[str | None, typer.Option(help="pose to start from (default: home)")] = None,
     timeout: Annotated[float, typer.Option(min=0.1, help="seconds of path search at most")] = 20.0,
     library: LibraryOpt = None,
 ):
@@ -119,7 +136,7 @@ def plan_cmd(
         result = plan(file, to, robot=robot, seed=seed, start=start, library=library, timeout=timeout)
     except PlanError as e:
         _print_diagnostics(e.diagnostics, e.sources)
-        raise typer.Exit(e.exit_code)
+        raise typer.Exit(e.exit_code) from None
     if json_out:
         sys.stdout.write(result.dumps())
     else:

@@ -80,13 +80,25 @@ def structure(robot: Robot, lib: Library) -> Conversion:
             length = abs(r.a) - x01_next
         spans = {"link": r.span} if length is not None else {}
         spans.update({k: r.span for k, v in (("pivot", pivots[i]), ("port", ports[i])) if v})
-        units.append(UnitSpec(name=f"{lib.rules.first_variant}{kinds[i]}", variant=lib.rules.first_variant, kind=kinds[i],
-                              pivot=pivots[i], port=ports[i], link=length, span=r.span, param_spans=spans))
+        units.append(
+            UnitSpec(
+                name=f"{lib.rules.first_variant}{kinds[i]}",
+                variant=lib.rules.first_variant,
+                kind=kinds[i],
+                pivot=pivots[i],
+                port=ports[i],
+                link=length,
+                span=r.span,
+                param_spans=spans,
+            )
+        )
     return Conversion(tuple(units), Transform(rpy=(0.0, tool_pitch, 0.0)), diags)
 
 
 def with_variants(units: tuple[UnitSpec, ...], variants: list[str]) -> tuple[UnitSpec, ...]:
-    return tuple(u.model_copy(update={"variant": v, "name": f"{v}{u.kind}"}) for u, v in zip(units, variants))
+    return tuple(
+        u.model_copy(update={"variant": v, "name": f"{v}{u.kind}"}) for u, v in zip(units, variants, strict=True)
+    )
 
 
 def choose_variants(robot: Robot, lib: Library, units: tuple[UnitSpec, ...], tool: Transform) -> list[str]:
@@ -100,15 +112,16 @@ def choose_variants(robot: Robot, lib: Library, units: tuple[UnitSpec, ...], too
     if not feasible:  # the chain cannot obey the rules; the checks will say so
         k = max(1, min(eps_h, n - 1 if n > 1 else 1))
         return [heavy] * k + [light] * (n - k)
-    best = None
+    best: tuple[float, list[str]] | None = None
     for k in feasible:
         variants = [heavy] * k + [light] * (n - k)
         trial = robot.model_copy(update={"units": with_variants(units, variants), "tool": tool, "library": lib})
         worst = Statics(trial).worst(samples=64)
         nominal = [lib.variants[v].actuator.torque_nominal for v in variants]
-        margin = min((t_nom - t) / t_nom for t_nom, t in zip(nominal, worst))
+        margin = min((t_nom - t) / t_nom for t_nom, t in zip(nominal, worst, strict=True))
         if best is None or margin > best[0] + 1e-9:
             best = (margin, variants)
+    assert best is not None  # feasible is not empty
     return best[1]
 
 

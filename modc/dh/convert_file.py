@@ -8,6 +8,7 @@ from pathlib import Path
 
 from .. import names
 from ..diagnostics import Diagnostic, Span, codes
+from ..diagnostics.span import NOWHERE
 from ..model import Design, Robot
 from ..model.write import robot_text
 from ..passes import Context, run_all
@@ -32,7 +33,8 @@ def convert_table(text: str, path: str, name: str | None = None, fit_links: bool
         bad = codes.INVALID_NAME.at(Span.point("<command line>"), what="robot", name=names.shown(name or ""),
                                     problem=problem, rule=names.IDENTIFIER_RULE)
         return "", [*diags, bad], False
-    robot = Robot(name=name or _name(path), dh=tuple(rows), dh_fit_links=fit_links, span=where, name_span=where)
+    robot = Robot(name=name or _name(path), dh=tuple(rows), dh_fit_links=fit_links, span=where, name_span=where,
+                  library_span=NOWHERE)  # no `library` statement: --library or the default
     ctx = Context(diagnostics=diags, library_override=library)
     design = run_all(Design(path=path, robots=(robot,)), ctx)
     if ctx.has_errors:

@@ -11,6 +11,7 @@ between the axes about it. Where DH leaves a choice, the usual conventions apply
 """
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,4 +98,4 @@ def realised_dh(chain: Chain, q=None, prefer: list[float] | None = None) -> list
 def axis_angles(chain: Chain, q=None) -> list[float]:
     """Angle between consecutive joint axes (directed), radians: what a twist sets."""
     axes = chain.joint_axes(q)
-    return [float(np.arccos(np.clip(u @ v, -1.0, 1.0))) for (_, u), (_, v) in zip(axes, axes[1:])]
+    return [float(np.arccos(np.clip(u @ v, -1.0, 1.0))) for (_, u), (_, v) in itertools.pairwise(axes)]

@@ -17,10 +17,10 @@ class Span:
     end: int = 0
 
     @staticmethod
-    def point(file: str, line: int = 1, col: int = 1, offset: int = 0) -> "Span":
+    def point(file: str, line: int = 1, col: int = 1, offset: int = 0) -> Span:
         return Span(file, line, col, line, col + 1, offset, offset + 1)
 
-    def to(self, other: "Span") -> "Span":
+    def to(self, other: Span) -> Span:
         """The span from the start of self to the end of other."""
         return Span(self.file, self.line, self.col, other.end_line, other.end_col, self.start, other.end)
 

@@ -1,6 +1,7 @@
 """The paper's assembly rules (section 3): H first, L last, no L -> H, at most ε of each kind."""
 from __future__ import annotations
 
+import itertools
 from collections import Counter
 
 from ..diagnostics import codes
@@ -20,11 +21,13 @@ def run(design: Design, ctx: Context) -> Design:
             ctx.report(codes.FIRST_VARIANT.at(first.span, unit=first.name, want=rules.first_variant), r)
         if last.variant != rules.last_variant:
             ctx.report(codes.LAST_VARIANT.at(last.span, unit=last.name, want=rules.last_variant), r)
-        for before, after in zip(units, units[1:]):
+        for before, after in itertools.pairwise(units):
             allowed = rules.may_follow.get(before.variant, [])
             if after.variant not in allowed:
                 text = "; ".join(f"{v} -> {', '.join(s)}" for v, s in rules.may_follow.items())
-                ctx.report(codes.ILLEGAL_SUCCESSION.at(after.span, before=before.name, after=after.name, allowed=text), r)
+                ctx.report(
+                    codes.ILLEGAL_SUCCESSION.at(after.span, before=before.name, after=after.name, allowed=text), r
+                )
         counts = Counter(u.variant for u in units)
         for variant, count in sorted(counts.items()):
             eps = lib.variants[variant].actuator.epsilon

@@ -24,7 +24,9 @@ def run(design: Design, ctx: Context) -> Design:
             if not u.variant:
                 close = difflib.get_close_matches(u.name.upper(), lib.unit_names(), n=1, cutoff=0.5)
                 suggest = f"; did you mean {close[0]}?" if close else ""
-                ctx.report(codes.UNKNOWN_MODULE.at(u.span, name=u.name, known=", ".join(lib.unit_names()), suggest=suggest), r)
+                ctx.report(
+                    codes.UNKNOWN_MODULE.at(u.span, name=u.name, known=", ".join(lib.unit_names()), suggest=suggest), r
+                )
                 continue
             if not lib.units[u.kind].link:
                 for param in ("port", "link"):
@@ -32,8 +34,15 @@ def run(design: Design, ctx: Context) -> Design:
                         ctx.report(codes.PARAMETER_NOT_APPLICABLE.at(
                             u.param_spans[param], param=param, unit=u.name, kind=u.kind, variant=u.variant), r)
             elif u.link is not None and not (lib.link_length_min <= u.link <= lib.link_length_max):
-                ctx.report(codes.LINK_LENGTH_RANGE.at(
-                    u.param_spans["link"], value=_fmt_len(u.link), low=_fmt_len(lib.link_length_min), high=_fmt_len(lib.link_length_max)), r)
+                ctx.report(
+                    codes.LINK_LENGTH_RANGE.at(
+                        u.param_spans["link"],
+                        value=_fmt_len(u.link),
+                        low=_fmt_len(lib.link_length_min),
+                        high=_fmt_len(lib.link_length_max),
+                    ),
+                    r,
+                )
         n, rules = len(r.units), lib.rules
         if n > rules.max_dof:
             limits = ", ".join(f"{v}: {lib.variants[v].actuator.epsilon}" for v in lib.variants)

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from ..diagnostics import codes
 from ..model import Design
+from ..model.robot import Obstacle, Pose, Target
 from .context import Context
 
 
@@ -13,7 +14,8 @@ def run(design: Design, ctx: Context) -> Design:
             ctx.report(codes.DUPLICATE_ROBOT.at(r.name_span, name=r.name))
         robots.add(r.name)
         names: set[str] = set()
-        for item in sorted((*r.poses, *r.targets, *r.obstacles), key=lambda x: (x.span.line, x.span.col)):
+        items: list[Pose | Target | Obstacle] = [*r.poses, *r.targets, *r.obstacles]
+        for item in sorted(items, key=lambda x: (x.span.line, x.span.col)):
             if item.name in names:
                 ctx.report(codes.DUPLICATE_NAME.at(item.span, name=item.name, robot=r.name))
             names.add(item.name)

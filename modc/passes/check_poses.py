@@ -23,16 +23,36 @@ def run(design: Design, ctx: Context) -> Design:
                 ctx.report(codes.UNKNOWN_JOINT.at(lim.span, robot=r.name, name=lim.joint, dof=r.dof), r)
                 continue
             if not lim.lower < lim.upper:
-                ctx.report(codes.LIMIT_ORDER.at(lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper)), r)
+                ctx.report(
+                    codes.LIMIT_ORDER.at(lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper)), r
+                )
                 continue
             v = lib.variants[r.units[joints[lim.joint] - 1].variant]
             hlo, hhi = math.radians(v.lower_deg), math.radians(v.upper_deg)
             if lim.upper <= hlo or lim.lower >= hhi:
-                ctx.report(codes.LIMIT_DISJOINT.at(
-                    lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper), hlow=_deg(hlo), hhigh=_deg(hhi)), r)
+                ctx.report(
+                    codes.LIMIT_DISJOINT.at(
+                        lim.span,
+                        joint=lim.joint,
+                        low=_deg(lim.lower),
+                        high=_deg(lim.upper),
+                        hlow=_deg(hlo),
+                        hhigh=_deg(hhi),
+                    ),
+                    r,
+                )
             elif lim.lower < hlo - 1e-12 or lim.upper > hhi + 1e-12:
-                ctx.report(codes.LIMIT_EXCEEDS_HARDWARE.at(
-                    lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper), hlow=_deg(hlo), hhigh=_deg(hhi)), r)
+                ctx.report(
+                    codes.LIMIT_EXCEEDS_HARDWARE.at(
+                        lim.span,
+                        joint=lim.joint,
+                        low=_deg(lim.lower),
+                        high=_deg(lim.upper),
+                        hlow=_deg(hlo),
+                        hhigh=_deg(hhi),
+                    ),
+                    r,
+                )
         for pose in r.poses:
             if len(pose.q) != r.dof:
                 ctx.report(codes.POSE_ARITY.at(pose.span, name=pose.name, got=len(pose.q), robot=r.name, dof=r.dof), r)

@@ -22,6 +22,7 @@ def run(design: Design, ctx: Context) -> Design:
     for r in design.robots:
         result = analyse(r, ctx.payload_override)
         lib = r.library
+        assert lib is not None  # no errors: resolve_library found it
         eps_ok = all(sum(u.variant == v for u in r.units) <= lib.variants[v].actuator.epsilon for v in lib.variants)
         eps = " (the chain obeys the paper's ε rule, but the physics says no)" if eps_ok else ""
         for i, j in enumerate(result):

@@ -11,27 +11,30 @@ from .context import Context
 def run(design: Design, ctx: Context) -> Design:
     robots = []
     for r in design.robots:
-        if r.dh is None or r.library is None or not r.dh:
+        lib = r.library
+        if r.dh is None or lib is None or not r.dh:
             robots.append(r)
             continue
         from ..dh.convert import convert
         from ..dh.report import compare
 
-        max_dof = r.library.rules.max_dof
+        max_dof = lib.rules.max_dof
         if len(r.dh) > max_dof:  # converting (and rounding) thousands of rows would only bury this
-            limits = ", ".join(f"{v}: {r.library.variants[v].actuator.epsilon}" for v in r.library.variants)
+            limits = ", ".join(f"{v}: {lib.variants[v].actuator.epsilon}" for v in lib.variants)
             ctx.report(codes.TOO_MANY_UNITS.at(r.dh[max_dof].span, n=len(r.dh), max=max_dof, limits=limits), r)
             robots.append(r)
             continue
 
-        conv = convert(r, r.library)
+        conv = convert(r, lib)
         for d in conv.diagnostics:
             ctx.report(d, r)
         tool = r.tool
         if conv.tool.rpy != (0.0, 0.0, 0.0):
             tool = tool.model_copy(update={"rpy": conv.tool.rpy})
         r = r.model_copy(update={"units": conv.units, "tool": tool})
-        if len(r.units) <= r.library.rules.max_dof and all(u.link is None or r.library.link_length_min <= u.link <= r.library.link_length_max for u in r.units):
+        if len(r.units) <= lib.rules.max_dof and all(
+            u.link is None or lib.link_length_min <= u.link <= lib.link_length_max for u in r.units
+        ):
             rows = compare(r)
             da = max(abs(x["realised"]["a"] - x["requested"]["a"]) for x in rows)
             dal = max(abs(x["realised"]["alpha"] - x["requested"]["alpha"]) for x in rows)
@@ -39,7 +42,16 @@ def run(design: Design, ctx: Context) -> Design:
             hint = "`modc dh FILE` lists every row"
             if da > 1e-3 and not r.dh_fit_links:
                 hint = "write `dh fit-links { … }` to print links that realise a exactly; " + hint
-            ctx.report(codes.DH_APPROXIMATION.at(r.name_span, robot=r.name, da=f"{da * 1000:.1f} mm",
-                                                 dalpha=f"{math.degrees(dal):.2f}deg", dd=f"{dd * 1000:.1f} mm", hint=hint), r)
+            ctx.report(
+                codes.DH_APPROXIMATION.at(
+                    r.name_span,
+                    robot=r.name,
+                    da=f"{da * 1000:.1f} mm",
+                    dalpha=f"{math.degrees(dal):.2f}deg",
+                    dd=f"{dd * 1000:.1f} mm",
+                    hint=hint,
+                ),
+                r,
+            )
         robots.append(r)
     return design.model_copy(update={"robots": tuple(robots)})

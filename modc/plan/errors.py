@@ -15,7 +15,9 @@ class PlanError(Exception):
     """Planning did not produce a trajectory. diagnostics: what to print (with sources for the
     caret excerpts); exit_code: 1 planning failure or errors in the file, 2 usage or I/O."""
 
-    def __init__(self, diagnostics: list[Diagnostic], sources: dict[str, str] | None = None, exit_code: int = EXIT_FAILED):
+    def __init__(
+        self, diagnostics: list[Diagnostic], sources: dict[str, str] | None = None, exit_code: int = EXIT_FAILED
+    ):
         self.diagnostics = list(diagnostics)
         self.sources = dict(sources or {})
         self.exit_code = exit_code

@@ -22,6 +22,7 @@ fewer, shorter segments are faster), then the greedy pass again.
 """
 from __future__ import annotations
 
+import itertools
 import time
 from collections.abc import Callable
 
@@ -129,7 +130,7 @@ def shortcut(checker: CollisionChecker, path: list[np.ndarray], rng: np.random.G
     for _ in range(tries):
         if len(path) < 3:
             break
-        lengths = [float(np.linalg.norm(b - a)) for a, b in zip(path[:-1], path[1:])]
+        lengths = [float(np.linalg.norm(b - a)) for a, b in itertools.pairwise(path)]
         cum = np.concatenate([[0.0], np.cumsum(lengths)])
         s1, s2 = np.sort(rng.random(2) * cum[-1])
         k1, p1 = _point_at(path, cum, s1)
@@ -175,7 +176,7 @@ def certify(checker: CollisionChecker, path: list[np.ndarray], seed: int, budget
     """Every edge of a coarsely checked path certified; an edge that fails is replaced by a
     certified RRT-Connect path between its ends (its ends are valid states)."""
     out = [path[0]]
-    for k, (a, b) in enumerate(zip(path[:-1], path[1:])):
+    for k, (a, b) in enumerate(itertools.pairwise(path)):
         if checker.motion_valid(a, b):
             out.append(b)
             continue
@@ -188,5 +189,14 @@ def certify(checker: CollisionChecker, path: list[np.ndarray], seed: int, budget
     return out
 
 
-__all__ = ["DEFAULT_MAX_CHECKS", "DEFAULT_TIMEOUT", "PlannerUnavailable", "SHORTCUT_TRIES", "find_path", "reduce_vertices", "rrt_connect",
-           "shortcut", "certify"]
+__all__ = [
+    "DEFAULT_MAX_CHECKS",
+    "DEFAULT_TIMEOUT",
+    "PlannerUnavailable",
+    "SHORTCUT_TRIES",
+    "find_path",
+    "reduce_vertices",
+    "rrt_connect",
+    "shortcut",
+    "certify",
+]

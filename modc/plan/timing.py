@@ -16,6 +16,7 @@ are points of the output. Between two samples the mean velocity of joint i is at
 """
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -63,7 +64,7 @@ def s_of_t(t: float, V: float, A: float, T: float) -> float:
 
 
 def path_duration(path, vmax, amax) -> float:
-    return sum(segment_duration(b - a, vmax, amax) for a, b in zip(path[:-1], path[1:]))
+    return sum(segment_duration(b - a, vmax, amax) for a, b in itertools.pairwise(path))
 
 
 def parameterise(path, vmax, amax, period: float = SAMPLE_PERIOD) -> tuple[list[float], list[np.ndarray]]:
@@ -72,7 +73,7 @@ def parameterise(path, vmax, amax, period: float = SAMPLE_PERIOD) -> tuple[list[
     ts: list[float] = [0.0]
     qs: list[np.ndarray] = [path[0].copy()]
     t0 = 0.0
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         dq = b - a
         T = segment_duration(dq, vmax, amax)
         if T <= 0.0 or float(np.max(np.abs(dq))) < MIN_MOTION:

@@ -104,7 +104,10 @@ def srdf_disabled_pairs(srdf: str | Path, include_never: bool = False) -> set[fr
     for e in ET.parse(srdf).getroot().iter("disable_collisions"):
         if e.get("reason") == "Never" and not include_never:
             continue
-        out.add(frozenset((e.get("link1"), e.get("link2"))))
+        link1, link2 = e.get("link1"), e.get("link2")
+        if link1 is None or link2 is None:  # names no pair of links: disables nothing
+            continue
+        out.add(frozenset((link1, link2)))
     return out
 
 

@@ -40,6 +40,12 @@ def pick_robot(checked, traj: trajectory.Trajectory, robot: str | None):
     return choose_robot(checked.design, robot or traj.robot, say='--robot NAME, or "robot" in the trajectory file')
 
 
+def _palette(img) -> list[int]:
+    pal = img.getpalette()
+    assert pal is not None  # a quantised image is a palette image
+    return pal
+
+
 def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
     """A looping GIF, every frame on one adaptive palette (deterministic)."""
     from PIL import Image
@@ -53,8 +59,8 @@ def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
     sheet = Image.new("RGB", (picks[0].width, picks[0].height * len(picks)))
     for k, f in enumerate(picks):
         sheet.paste(f, (0, k * f.height))
-    smooth = sheet.quantize(colors=200, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).getpalette()[:600]
-    vivid = sheet.quantize(colors=55, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE).getpalette()[:165]
+    smooth = _palette(sheet.quantize(colors=200, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE))[:600]
+    vivid = _palette(sheet.quantize(colors=55, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE))[:165]
     palette = Image.new("P", (1, 1))
     palette.putpalette(smooth + vivid + [0, 0, 0] * (256 - (len(smooth) + len(vivid)) // 3))
     pal = [f.quantize(palette=palette, dither=Image.Dither.NONE) for f in frames]
@@ -120,11 +126,11 @@ def _frame(client, stage, r, traj, size: tuple[int, int], azimuth: float | None)
 
     stage.add_tool_axes()
     samples = [traj.at(traj.t[0] + traj.duration * k / (CAMERA_SAMPLES - 1)) for k in range(CAMERA_SAMPLES)]
-    pts = []
+    per_sample = []
     for q in samples:
         stage.set({r.name: q})
-        pts.append(stage.points())
-    pts = np.concatenate(pts)
+        per_sample.append(stage.points())
+    pts = np.concatenate(per_sample)
     stage.add_ground(pts)
     cam = stage.choose_camera(pts, size[0], size[1], azimuth, poses=[{r.name: q} for q in samples])
     if client.gui:
@@ -171,7 +177,7 @@ def _run(client, stage, r, traj, recording: bool, fps: float, size: tuple[int, i
             break
         q_cmd = traj.at(t0 + t)
         q_next = traj.at(t0 + t + TIME_STEP)
-        s.hold(q_cmd, [(b - a) / TIME_STEP for a, b in zip(q_cmd, q_next)])
+        s.hold(q_cmd, [(b - a) / TIME_STEP for a, b in zip(q_cmd, q_next, strict=True)])
         client.stepSimulation()
         if k % 10 == 0:
             run.worst = np.maximum(run.worst, np.abs(s.q() - np.array(traj.at(t0 + t + TIME_STEP))))
@@ -195,7 +201,9 @@ def _report(r, traj, run: _Run) -> list[str]:
     if run.contacts:
         for (a, b), (t_first, depth) in sorted(run.contacts.items(), key=lambda kv: kv[1][0]):
             what = f"obstacle {b}" if b in run.obstacles else b
-            lines.append(f"  warning: {a} collides with {what} from t = {t_first:.2f} s ({depth * 1000:.1f} mm deep at most)")
+            lines.append(
+                f"  warning: {a} collides with {what} from t = {t_first:.2f} s ({depth * 1000:.1f} mm deep at most)"
+            )
     else:
         lines.append("  no collisions (between links, or with the environment)")
     return lines

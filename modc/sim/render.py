@@ -20,11 +20,16 @@ on the rendered silhouette (centred, filling 90 % of the frame).
 """
 from __future__ import annotations
 
+import builtins
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from . import scene
+
+if TYPE_CHECKING:
+    import numpy as np
 
 WIDTH, HEIGHT = 800, 600
 SUPERSAMPLE = 2
@@ -44,6 +49,10 @@ AXIS_LENGTH, AXIS_RADIUS = 0.06, 0.003  # m, the tool0 triad
 AXIS_RGBA = ((0.85, 0.1, 0.1, 1.0), (0.1, 0.7, 0.1, 1.0), (0.1, 0.25, 0.9, 1.0))
 LIGHT = dict(lightDirection=[-0.4, -0.6, 1.0], lightColor=[1.0, 1.0, 1.0], lightDistance=4.0,
              lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.08)
+
+
+def _vec3(v) -> tuple[float, float, float]:
+    return float(v[0]), float(v[1]), float(v[2])
 
 
 @dataclass
@@ -108,7 +117,7 @@ def fit_camera(points, azimuth: float, elevation: float, aspect: float, fov: flo
     eye = target + d * dist
     span = float(np.linalg.norm(pts - eye, axis=1).max())
     near = max(0.01, float((dist - (rel @ d).max()) * 0.5))
-    return Camera(tuple(map(float, eye)), tuple(map(float, target)), tuple(map(float, up)), fov, aspect,
+    return Camera(_vec3(eye), _vec3(target), _vec3(up), fov, aspect,
                   near, span * 3.0 + 1.0, azimuth, elevation)
 
 
@@ -117,18 +126,18 @@ class Stage:
     """A PyBullet world holding every robot of a file (at its world placement) with their
     environments and targets, a ground, and a camera fitted to what is shown."""
 
-    client: object
+    client: Any  # a PyBullet client
     scenes: dict[str, scene.Scene]
     ground: bool = False  # drawn by backdrop() once add_ground() has placed it
     camera: Camera | None = None
     axes: dict = field(default_factory=dict)  # robot name -> tool0 triad body
-    fade_centre: object = None
+    fade_centre: np.ndarray | None = None  # (x, y), set by add_ground()
     fade_radii: tuple[float, float] = (1.0, 2.0)
     ground_z: float = 0.0
     _backdrop: dict = field(default_factory=dict)
 
     @classmethod
-    def build(cls, client, robots, urdfs: dict[str, Path], qs: dict | None = None) -> "Stage":
+    def build(cls, client, robots, urdfs: dict[str, Path], qs: dict | None = None) -> Stage:
         placements = scene.world_placements(robots, qs)
         scenes = {r.name: scene.load_robot(client, r, urdfs[r.name], placements[r.name]) for r in robots}
         return cls(client, scenes)
@@ -147,14 +156,31 @@ class Stage:
                                              ((0, 0, 0), AXIS_RGBA[2]))):
                 pos = [length / 2 if k == j else 0.0 for j in range(3)]
                 orn = self.client.getQuaternionFromEuler(rpy)
-                shapes.append(self.client.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=length, rgbaColor=rgba,
-                                                            visualFramePosition=pos, visualFrameOrientation=orn))
-            body = self.client.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=shapes[0],
-                                               linkMasses=[0.0, 0.0], linkCollisionShapeIndices=[-1, -1],
-                                               linkVisualShapeIndices=shapes[1:], linkPositions=[[0, 0, 0]] * 2,
-                                               linkOrientations=[[0, 0, 0, 1]] * 2, linkInertialFramePositions=[[0, 0, 0]] * 2,
-                                               linkInertialFrameOrientations=[[0, 0, 0, 1]] * 2, linkParentIndices=[0, 0],
-                                               linkJointTypes=[p.JOINT_FIXED] * 2, linkJointAxis=[[0, 0, 1]] * 2)
+                shapes.append(
+                    self.client.createVisualShape(
+                        p.GEOM_CYLINDER,
+                        radius=radius,
+                        length=length,
+                        rgbaColor=rgba,
+                        visualFramePosition=pos,
+                        visualFrameOrientation=orn,
+                    )
+                )
+            body = self.client.createMultiBody(
+                baseMass=0.0,
+                baseCollisionShapeIndex=-1,
+                baseVisualShapeIndex=shapes[0],
+                linkMasses=[0.0, 0.0],
+                linkCollisionShapeIndices=[-1, -1],
+                linkVisualShapeIndices=shapes[1:],
+                linkPositions=[[0, 0, 0]] * 2,
+                linkOrientations=[[0, 0, 0, 1]] * 2,
+                linkInertialFramePositions=[[0, 0, 0]] * 2,
+                linkInertialFrameOrientations=[[0, 0, 0, 1]] * 2,
+                linkParentIndices=[0, 0],
+                linkJointTypes=[p.JOINT_FIXED] * 2,
+                linkJointAxis=[[0, 0, 1]] * 2,
+            )
             self.axes[name] = body
         self.place_axes()
 
@@ -238,10 +264,10 @@ class Stage:
         self._backdrop = {"key": key, "image": bg}
         return bg
 
-    def robot_bodies(self) -> set[int]:
+    def robot_bodies(self) -> builtins.set[int]:  # `set` is a method here
         return {s.body for s in self.scenes.values()}
 
-    def target_bodies(self) -> set[int]:
+    def target_bodies(self) -> builtins.set[int]:
         return {t for s in self.scenes.values() for t in s.targets.values()}
 
     def _objects(self, cam: Camera, W: int, H: int, poses) -> list:
@@ -264,6 +290,7 @@ class Stage:
         import numpy as np
 
         aspect = width / height
+        best: Camera | None
         if azimuth is not None:
             best = fit_camera(points, azimuth, 30.0 if elevation is None else elevation, aspect)
         else:
@@ -279,6 +306,7 @@ class Stage:
                     score += len(robots) * least + 4 * float(np.isin(obj, targets).sum())
                 if score > best_score * 1.05:  # a clearly better view replaces an earlier (more canonical) one
                     best, best_score = cam, score
+        assert best is not None  # views is not empty and every score is >= 0
         self.camera = self.refine(best, aspect, poses)
         return self.camera
 
@@ -314,7 +342,7 @@ class Stage:
             target = target + shift
             dist *= scale
             eye = target - fwd * dist
-            cam = Camera(tuple(map(float, eye)), tuple(map(float, target)), cam.up, cam.fov, cam.aspect,
+            cam = Camera(_vec3(eye), _vec3(target), cam.up, cam.fov, cam.aspect,
                          max(0.01, cam.near * scale), cam.far, cam.azimuth, cam.elevation)
             if abs(scale - 1.0) < 0.02 and abs(u0 + u1) < 0.02 and abs(v0 + v1) < 0.02:
                 break
@@ -341,7 +369,7 @@ class Stage:
         out = out.round().astype(np.uint8)
         img = Image.fromarray(out, "RGB")
         if supersample != 1:
-            img = img.resize((width, height), Image.LANCZOS)
+            img = img.resize((width, height), Image.Resampling.LANCZOS)
         return img
 
 
@@ -386,7 +414,14 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
         img, cam = picture(client, robots, urdfs, qs, width, height, azimuth, elevation)
     save_png(img, out_png, colors)
     who = ", ".join(f"{r.name} ({r.sequence}) at {pose or 'home'}" for r in robots)
-    return True, [f"render: wrote {out_png} ({width}x{height}): {who}; camera azimuth {cam.azimuth:g}°, elevation {cam.elevation:g}°"], checked
+    return (
+        True,
+        [
+            f"render: wrote {out_png} ({width}x{height}): {who}; "
+            f"camera azimuth {cam.azimuth:g}°, elevation {cam.elevation:g}°"
+        ],
+        checked,
+    )
 
 
 def picture(client, robots, urdfs, qs, width: int = WIDTH, height: int = HEIGHT,

@@ -27,10 +27,14 @@ import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ..model import Robot
 from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
 from .contacts import CollisionQueries
+
+if TYPE_CHECKING:
+    import numpy as np
 
 GRAVITY = 9.81  # m/s², the value modc.dynamics uses
 
@@ -219,8 +223,8 @@ def matrix_pose(T) -> tuple[tuple[float, float, float], tuple[float, float, floa
     else:
         s = 2.0 * np.sqrt(1.0 + R[2, 2] - R[0, 0] - R[1, 1])
         w, x, y, z = (R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, 0.25 * s
-    pos = tuple(float(v) for v in np.asarray(T)[:3, 3])
-    return pos, (float(x), float(y), float(z), float(w))
+    p = np.asarray(T)[:3, 3]
+    return (float(p[0]), float(p[1]), float(p[2])), (float(x), float(y), float(z), float(w))
 
 
 MODULE_RADIUS = 0.06  # m: a joint module reaches about this far from its frames
@@ -252,7 +256,7 @@ def extent_points(robot: Robot, q=None, T_world_base=None):
         pts.append(np.array(t.xyz))
         radii.append(TARGET_RADIUS)
     out = []
-    for p, r in zip(pts, radii):
+    for p, r in zip(pts, radii, strict=True):
         w = (T @ np.array([*p, 1.0]))[:3]
         out += [w - r, w + r]
     return np.array(out)
@@ -261,7 +265,7 @@ def extent_points(robot: Robot, q=None, T_world_base=None):
 LAYOUT_GAP = 0.15  # m between robots laid out side by side
 
 
-def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, "object"]:
+def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, np.ndarray]:
     """robot name -> T_world_base. Each robot sits at its `base`; when two robots of one file
     share a placement (both at the default origin, say), they are laid out along the world's y
     axis instead, LAYOUT_GAP apart at the pose shown (qs: name -> q, default home), so that a
@@ -288,11 +292,11 @@ def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, "
 
 @dataclass
 class Scene(CollisionQueries):
-    client: object
+    client: Any  # a PyBullet client (pybullet_utils.bullet_client.BulletClient)
     robot: Robot
     urdf: Path
     body: int
-    T_world_base: object  # 4x4 numpy
+    T_world_base: np.ndarray  # 4x4
     joint_names: list[str]  # joint_1 … joint_n
     joints: dict[str, int]  # joint name -> PyBullet joint index
     links: dict[str, int]  # link name -> PyBullet link index (base_link = -1)
@@ -312,17 +316,23 @@ class Scene(CollisionQueries):
     def q(self):
         import numpy as np
 
-        return np.array([s[0] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+        return np.array(
+            [s[0] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])]
+        )
 
     def qd(self):
         import numpy as np
 
-        return np.array([s[1] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+        return np.array(
+            [s[1] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])]
+        )
 
     def applied_torques(self):
         import numpy as np
 
-        return np.array([s[3] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])])
+        return np.array(
+            [s[3] for s in self.client.getJointStates(self.body, [self.joints[n] for n in self.joint_names])]
+        )
 
     def release_motors(self) -> None:
         """PyBullet starts every joint with a velocity motor (a brake); switch them off."""
@@ -378,7 +388,9 @@ def load_robot(client, robot: Robot, urdf: Path, T_world_base=None, *, environme
     import numpy as np
 
     p = pybullet()
-    T_world_base = transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else np.asarray(T_world_base, dtype=float)
+    T_world_base = (
+        transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else np.asarray(T_world_base, dtype=float)
+    )
     pos, orn = matrix_pose(T_world_base)
     with captured_output() as log:
         body = client.loadURDF(str(urdf), basePosition=pos, baseOrientation=orn, useFixedBase=True,

@@ -78,12 +78,13 @@ def check_urdf_inertials(urdf: Path) -> list[str]:
     for link in ET.parse(urdf).getroot().iter("link"):
         name = link.get("name")
         inertial = link.find("inertial")
-        if inertial is None or inertial.find("mass") is None or inertial.find("inertia") is None:
+        mass_el = None if inertial is None else inertial.find("mass")
+        inertia = None if inertial is None else inertial.find("inertia")
+        if mass_el is None or inertia is None:
             bad.append(f"link {name} has no <inertial> with mass and inertia")
             continue
-        mass = float(inertial.find("mass").get("value", "0"))
-        I = inertial.find("inertia")
-        diag = [float(I.get(k, "0")) for k in ("ixx", "iyy", "izz")]
+        mass = float(mass_el.get("value", "0"))
+        diag = [float(inertia.get(k, "0")) for k in ("ixx", "iyy", "izz")]
         if not mass > 0 or not all(d > 0 for d in diag):
             bad.append(f"link {name} has mass {mass:g} kg and principal inertia {diag}")
     return bad
@@ -137,7 +138,9 @@ def load_failures(client, s, robot, urdf: Path) -> list[Failure]:
         if not mass > 0 or not all(v > 0 for v in inertia):
             out.append(Failure("load", f"{who}: PyBullet gives link {name} mass {mass:g} kg, inertia {inertia}"))
     if len(s.joints) != robot.dof:
-        out.append(Failure("load", f"{who}: PyBullet finds {len(s.joints)} revolute joints, the chain has {robot.dof} modules"))
+        out.append(
+            Failure("load", f"{who}: PyBullet finds {len(s.joints)} revolute joints, the chain has {robot.dof} modules")
+        )
     return out
 
 

@@ -17,6 +17,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeGuard
 
 RANGE_TOL = 1e-9  # rad: q on a joint limit, written with rounding, is still inside
 
@@ -32,7 +33,7 @@ class Trajectory:
     def duration(self) -> float:
         return self.t[-1] - self.t[0]
 
-    def in_order(self, names) -> "Trajectory":
+    def in_order(self, names) -> Trajectory:
         """The same motion with columns in the order of `names` (e.g. joint_1 … joint_n)."""
         idx = [self.joint_names.index(n) for n in names]
         return Trajectory(tuple(names), self.t, tuple(tuple(row[i] for i in idx) for row in self.q), self.robot)
@@ -48,7 +49,7 @@ class Trajectory:
         k = bisect.bisect_right(self.t, time)
         t0, t1 = self.t[k - 1], self.t[k]
         a = (time - t0) / (t1 - t0)
-        return tuple(x0 + a * (x1 - x0) for x0, x1 in zip(self.q[k - 1], self.q[k]))
+        return tuple(x0 + a * (x1 - x0) for x0, x1 in zip(self.q[k - 1], self.q[k], strict=True))
 
     def to_json(self) -> dict:
         doc: dict = {"joint_names": list(self.joint_names)}
@@ -64,7 +65,10 @@ class Trajectory:
         if self.robot is not None:
             lines.append(f'  "robot": {json.dumps(self.robot)},')
         lines.append('  "points": [')
-        pts = [f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}' for t, q in zip(self.t, self.q, strict=True)]
+        pts = [
+            f'    {{"t": {_num(t)}, "q": [{", ".join(_num(x) for x in q)}]}}'
+            for t, q in zip(self.t, self.q, strict=True)
+        ]
         lines.append(",\n".join(pts))
         lines += ["  ]", "}"]
         return "\n".join(lines) + "\n"
@@ -75,7 +79,7 @@ def _num(x: float) -> str:
     return "0.0" if v == 0 else repr(v)
 
 
-def _number(x) -> bool:
+def _number(x: object) -> TypeGuard[float]:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
@@ -100,7 +104,8 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
     if not isinstance(points, list) or not points:
         errors.append("points: expected a non-empty list of {\"t\": seconds, \"q\": [radians…]}")
         return None, errors
-    ts, qs = [], []
+    ts: list[float | None] = []  # None: not a valid time (an error says why)
+    qs: list[tuple[float, ...] | None] = []
     for k, pt in enumerate(points):
         where = f"points[{k}]"
         if not isinstance(pt, dict):
@@ -112,7 +117,9 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
         elif t < 0:
             errors.append(f"{where}.t: {t:g} s is negative")
         elif ts and ts[-1] is not None and t <= ts[-1]:
-            errors.append(f"{where}.t: {t:g} s does not come after points[{k - 1}].t = {ts[-1]:g} s (times must increase)")
+            errors.append(
+                f"{where}.t: {t:g} s does not come after points[{k - 1}].t = {ts[-1]:g} s (times must increase)"
+            )
         ts.append(t if _number(t) else None)
         if not isinstance(q, list) or not all(_number(x) for x in q):
             errors.append(f"{where}.q: expected a list of finite numbers (radians)")
@@ -123,7 +130,9 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
         qs.append(tuple(float(x) for x in q))
     if errors or names is None:
         return None, errors
-    return Trajectory(tuple(names), tuple(float(t) for t in ts), tuple(qs), robot), []
+    # no errors: every time and every q is valid
+    times = tuple(float(t) for t in ts if t is not None)
+    return Trajectory(tuple(names), times, tuple(q for q in qs if q is not None), robot), []
 
 
 def validate_for(traj: Trajectory, robot) -> list[str]:
@@ -133,7 +142,9 @@ def validate_for(traj: Trajectory, robot) -> list[str]:
     unknown = [n for n in traj.joint_names if n not in want]
     missing = [n for n in want if n not in traj.joint_names]
     if unknown:
-        errors.append(f"joint_names: robot {robot.name} has no joint(s) {', '.join(unknown)} (its joints: {', '.join(want)})")
+        errors.append(
+            f"joint_names: robot {robot.name} has no joint(s) {', '.join(unknown)} (its joints: {', '.join(want)})"
+        )
     if missing:
         errors.append(f"joint_names: joint(s) {', '.join(missing)} of robot {robot.name} missing")
     if errors:

@@ -152,12 +152,23 @@ def judge_pose(robot, m: Measured, chain, dyn, engine: str = "PyBullet",
     pr.fk_rot_error = float(np.abs(m.T_base_tool[:3, :3] - T_ref[:3, :3]).max())
     pos_tol, rot_tol = fk_tol
     if pr.fk_pos_error > pos_tol or pr.fk_rot_error > rot_tol:
-        pr.failures.append(Failure("fk", f"{at}: {engine} puts tool0 {pr.fk_pos_error:.3g} m / {pr.fk_rot_error:.3g} (rotation) "
-                                         f"away from modc's kinematics (tolerance {pos_tol:g} m, {rot_tol:g})"))
+        pr.failures.append(
+            Failure(
+                "fk",
+                f"{at}: {engine} puts tool0 {pr.fk_pos_error:.3g} m / {pr.fk_rot_error:.3g} (rotation) "
+                f"away from modc's kinematics (tolerance {pos_tol:g} m, {rot_tol:g})",
+            )
+        )
     for c in m.self_contacts:
-        pr.failures.append(Failure("self-collision", f"{at}: {c.a} and {c.b} collide ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
+        pr.failures.append(
+            Failure("self-collision", f"{at}: {c.a} and {c.b} collide ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b))
+        )
     for c in m.environment_contacts:
-        pr.failures.append(Failure("environment", f"{at}: {c.a} is inside obstacle {c.b} ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)))
+        pr.failures.append(
+            Failure(
+                "environment", f"{at}: {c.a} is inside obstacle {c.b} ({c.depth * 1000:.1f} mm deep)", links=(c.a, c.b)
+            )
+        )
     h = m.hold
     pr.max_velocity = h.max_velocity
     pr.track_error = [float(e) for e in h.worst]
@@ -192,12 +203,22 @@ def _hold_failures(robot, pr: PoseResult, h: Hold, qv, dyn, at: str, engine: str
         variant = robot.units[j].variant
         actuator = robot.library.variants[variant].actuator
         if abs(tau_g[j]) > effort or abs(h.tau_end[j]) >= SATURATION * effort:
-            why = (f"holding the pose needs {abs(tau_g[j]):.2f} N·m, the {variant} actuator ({actuator.model}) peaks at "
-                   f"{effort:g} N·m: it cannot hold the arm")
+            why = (
+                f"holding the pose needs {abs(tau_g[j]):.2f} N·m, the {variant} actuator ({actuator.model}) peaks at "
+                f"{effort:g} N·m: it cannot hold the arm"
+            )
         else:
-            why = (f"the motor is below its {effort:g} N·m peak (needs {abs(tau_g[j]):.2f} N·m) yet the joint does not settle")
-        out.append(Failure(
-            "sag", f"{at}: {name} sags {h.peak[j]:.2f} rad ({_deg(h.peak[j])}) from its target {_deg(qv[j])}: {why}", joint=name))
+            why = (
+                f"the motor is below its {effort:g} N·m peak (needs {abs(tau_g[j]):.2f} N·m) "
+                "yet the joint does not settle"
+            )
+        out.append(
+            Failure(
+                "sag",
+                f"{at}: {name} sags {h.peak[j]:.2f} rad ({_deg(h.peak[j])}) from its target {_deg(qv[j])}: {why}",
+                joint=name,
+            )
+        )
     return out
 
 
