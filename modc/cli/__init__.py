@@ -12,9 +12,11 @@ from typing import Annotated
 import typer
 
 from .. import __version__
+
 # each module registers its commands; import order is the order `modc --help` lists them in
-from . import compile, lint, analysis, motion, view, info, design_cmd  # noqa: F401, I001
+from . import analysis, compile, design_cmd, info, lint, motion, view  # noqa: F401, I001
 from .app import app
+
 
 def _version(value: bool):
     if value:
@@ -23,7 +25,11 @@ def _version(value: bool):
 
 
 @app.callback()
-def _root(version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True, help="print the version")] = False):
+def _root(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="print the version")
+    ] = False,
+):
     pass
 
 

@@ -24,7 +24,8 @@ def _identifier(text: str) -> str:
 # of these: lowering reports a bad one as invalid-name, so no backend can ever see another string.
 Name = Annotated[str, AfterValidator(_identifier)]
 Vec3 = tuple[float, float, float]
-SpanField = Annotated[SkipValidation[Span], Field(default=NOWHERE, exclude=True, repr=False)]
+# the default is assigned at each field (`span: SpanField = NOWHERE`) so that type checkers see it
+SpanField = Annotated[SkipValidation[Span], Field(exclude=True, repr=False)]
 
 
 class _M(BaseModel):
@@ -47,8 +48,8 @@ class UnitSpec(_M):
     pivot: float = 0.0  # rad, twist in the adaptive twist unit (rotation about y, eq. 4)
     port: float = 0.0  # rad, twist at the connection port after the link (rotation about x, eq. 6)
     link: float | None = None  # m, link-module length; None = the library's default
-    span: SpanField
-    param_spans: Annotated[SkipValidation[dict[str, Span]], Field(default_factory=dict, exclude=True, repr=False)]
+    span: SpanField = NOWHERE
+    param_spans: Annotated[SkipValidation[dict[str, Span]], Field(exclude=True, repr=False)] = {}  # pydantic copies it
 
 
 class DHRow(_M):
@@ -58,26 +59,26 @@ class DHRow(_M):
     alpha: float
     d: float
     theta: float = 0.0
-    span: SpanField
+    span: SpanField = NOWHERE
 
 
 class Payload(_M):
     mass: float  # kg
     com: Vec3 = (0.0, 0.0, 0.0)  # m, in the tool0 frame
-    span: SpanField
+    span: SpanField = NOWHERE
 
 
 class Pose(_M):
     name: Name
     q: tuple[float, ...]  # rad, joint_1 first
-    span: SpanField
+    span: SpanField = NOWHERE
 
 
 class JointLimit(_M):
     joint: Name
     lower: float
     upper: float
-    span: SpanField
+    span: SpanField = NOWHERE
 
 
 class Obstacle(_M):
@@ -85,7 +86,7 @@ class Obstacle(_M):
     shape: Literal["box", "sphere", "cylinder"]
     size: tuple[float, ...]  # box: (x, y, z); sphere: (r,); cylinder: (r, length along z)
     origin: Transform
-    span: SpanField
+    span: SpanField = NOWHERE
 
 
 POSITION_TOLERANCE = 0.005  # m: default distance of tool0 from a target that counts as on it
@@ -98,7 +99,7 @@ class Target(_M):
     rpy: Vec3 | None = None  # rad, tool0's orientation in base_link (URDF fixed axes); None: position only
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
-    span: SpanField
+    span: SpanField = NOWHERE
 
 
 def default_position(lower: float, upper: float) -> float:
@@ -124,9 +125,9 @@ class Robot(_M):
     targets: tuple[Target, ...] = ()
     allow: frozenset[str] = frozenset()
     torque: tuple | None = Field(default=None, exclude=True, repr=False)  # set by check_torque
-    span: SpanField
-    name_span: SpanField
-    library_span: SpanField  # the `library` statement, where library errors point
+    span: SpanField = NOWHERE
+    name_span: SpanField = NOWHERE
+    library_span: SpanField = NOWHERE  # the `library` statement, where library errors point
 
     @property
     def dof(self) -> int:
@@ -193,8 +194,8 @@ class Problem(_M):
     modules: tuple[str, ...] | None = None  # allowed unit names; None: every unit of the library
     links: tuple[float, ...] | None = None  # m, link-module lengths to try; None: the library's default
     rank: tuple[str, ...] = RANK_KEYS
-    span: SpanField
-    name_span: SpanField
+    span: SpanField = NOWHERE
+    name_span: SpanField = NOWHERE
     # where each bound was written ("units", "links", "module:H9"), for the library checks
     bound_spans: Annotated[SkipValidation[dict[str, Span]], Field(default_factory=dict, exclude=True, repr=False)]
 

@@ -32,8 +32,11 @@ def choose_robot(design: Design, name: str | None = None, among: Sequence[Robot]
     if name is not None:
         found = next((r for r in robots if r.name == name), None)
         if found is None:
-            raise _fail(f"{design.path} has no robot '{name}'", "robots: " + (", ".join(r.name for r in robots) or "none"),
-                        where)
+            raise _fail(
+                f"{design.path} has no robot '{name}'",
+                "robots: " + (", ".join(r.name for r in robots) or "none"),
+                where,
+            )
         return found
     pool = robots if among is None else list(among)
     if len(pool) == 1:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from .robot import Robot
 
@@ -35,7 +36,7 @@ def vec(values, unit: str) -> str:
     return "(" + ", ".join(values) + f") {unit}"
 
 
-def robot_text(robot: Robot, comments: list[str] = ()) -> str:
+def robot_text(robot: Robot, comments: Sequence[str] = ()) -> str:
     # a comment ends at a line break: text from outside (a file name) must not start a new line
     lines = [f"# {' '.join(c.splitlines())}" if c else "#" for c in comments]
     lines.append(f"robot {robot.name} {{")
@@ -88,7 +89,7 @@ def target_text(t) -> str:
     return s
 
 
-def robot_file_text(robot: Robot, comments: list[str] = ()) -> str:
+def robot_file_text(robot: Robot, comments: Sequence[str] = ()) -> str:
     """A complete robot block: chain, library, placements, payload, limits, poses, the cell and its targets."""
     lines = robot_text(robot, comments).rstrip("\n").split("\n")[:-1]  # without the closing brace
     if robot.library_ref != "mark2" and robot.library_dir is not None:
@@ -105,7 +106,9 @@ def robot_file_text(robot: Robot, comments: list[str] = ()) -> str:
         at = "" if robot.payload.com == (0.0, 0.0, 0.0) else " at " + vec([_num(v) for v in robot.payload.com], "m")
         lines.append(f"    payload {_num(robot.payload.mass * 1000, 6)} g{at}")
     for lim in robot.limits:
-        lines.append(f"    limit {lim.joint} " + vec([_num(math.degrees(lim.lower)), _num(math.degrees(lim.upper))], "deg"))
+        lines.append(
+            f"    limit {lim.joint} " + vec([_num(math.degrees(lim.lower)), _num(math.degrees(lim.upper))], "deg")
+        )
     for p in robot.poses:
         lines.append(f"    pose {p.name} " + vec([_num(math.degrees(x), 6) for x in p.q], "deg"))
     lines += [_obstacle(o) for o in robot.obstacles]

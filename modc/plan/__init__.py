@@ -22,6 +22,7 @@ written in a fixed layout, so the JSON is byte-for-byte reproducible.
 """
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -209,8 +210,11 @@ def _check_start(job: _Job, checker, q_start) -> None:
                 "(a floor may touch it)" if fixed else
                 "choose another start pose with --start, or move the obstacle")
         if job.robot.pose(job.start) is None:  # the implicit home pose
-            hint += "; the file declares no `pose home`, so the start is every joint at 0 (or mid-range where 0 is outside its limits)"
-        raise job.fail(codes.START_IN_COLLISION, job.start_span, pose=job.start, contacts=_contacts_text(hit), hint=hint)
+            hint += ("; the file declares no `pose home`, so the start is every joint at 0 (or mid-range where 0 is "
+                     "outside its limits)")
+        raise job.fail(
+            codes.START_IN_COLLISION, job.start_span, pose=job.start, contacts=_contacts_text(hit), hint=hint
+        )
     if not checker.valid(q_start):
         clearance, pair = checker.clearance(q_start)
         if clearance / 2 < MIN_MARGIN:
@@ -225,9 +229,8 @@ def _goals(job: _Job, checker, q_start):
     target, then the solutions that keep the margin (or, failing that, some clearance)."""
     import numpy as np
 
-    from . import ik
-
     from ..kinematics import rpy_matrix
+    from . import ik
 
     tgt = job.target
     rotation = None if tgt.rpy is None else rpy_matrix(tgt.rpy)
@@ -240,9 +243,16 @@ def _goals(job: _Job, checker, q_start):
             verdict[key] = checker.valid(q)
         return verdict[key]
 
-    solutions, best = ik.solve(solver, tgt.xyz, q_start, IK_SEEDS_PER_JOINT * job.robot.dof, job.seed,
-                               batches=IK_BATCHES, enough=free,
-                               tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf))
+    solutions, best = ik.solve(
+        solver,
+        tgt.xyz,
+        q_start,
+        IK_SEEDS_PER_JOINT * job.robot.dof,
+        job.seed,
+        batches=IK_BATCHES,
+        enough=free,
+        tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf),
+    )
     if not solutions:
         tool = solver.position(best.q)
         raise job.fail(
@@ -329,7 +339,7 @@ def _path(job: _Job, checker, q_start, goals, timeout: float, max_checks: int):
                    f"{max_checks} collision checks each, {timeout:g} s in all",
             hint="try another --seed or --start pose; the target may be enclosed by obstacles")
     # an independent pass over the final polyline (every edge certified again)
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         if not checker.motion_valid(a, b, check_ends=True):  # pragma: no cover - the planner certified it
             raise job.fail(codes.NO_PATH, tgt.span, pose=job.start, target=tgt.name,
                            detail="the simplified path failed its final collision check",

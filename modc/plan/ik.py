@@ -197,4 +197,13 @@ def solve(ik: PositionIK, target, start, count: int, seed: int, batches: int = 1
     return found, best
 
 
-__all__ = ["MAX_ITERATIONS", "ROTATION_WEIGHT", "TOLERANCE", "PositionIK", "Solution", "rotation_vector", "seeds", "solve"]
+__all__ = [
+    "MAX_ITERATIONS",
+    "ROTATION_WEIGHT",
+    "TOLERANCE",
+    "PositionIK",
+    "Solution",
+    "rotation_vector",
+    "seeds",
+    "solve",
+]

@@ -199,7 +199,9 @@ class Robot:
     span: Span
 
 
-DesignStatement = Library | Placement | Payload | Box | Sphere | Cylinder | Target | Allow | Units | Modules | Links | Rank
+DesignStatement = (
+    Library | Placement | Payload | Box | Sphere | Cylinder | Target | Allow | Units | Modules | Links | Rank
+)
 
 
 @dataclass(frozen=True, slots=True)

@@ -5,18 +5,18 @@ so both forms share one meaning and one set of unit diagnostics.
 """
 from __future__ import annotations
 
-from typing import Annotated, Union
+from typing import Annotated, Any, Union
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from ..names import IDENTIFIER, MAX_NAME
 
 # Names are checked while lowering (invalid-name, one rule for both forms); the schema states the rule.
-_NAME_SCHEMA = {"pattern": f"^{IDENTIFIER}$", "maxLength": MAX_NAME}
+_NAME_SCHEMA: dict[str, Any] = {"pattern": f"^{IDENTIFIER}$", "maxLength": MAX_NAME}
 Name = Annotated[str, Field(json_schema_extra=_NAME_SCHEMA)]
-_KEYS = {"propertyNames": _NAME_SCHEMA}
+_KEYS: dict[str, Any] = {"propertyNames": _NAME_SCHEMA}
 
-Quantity = Annotated[Union[str, float], Field(description='a number with its unit, as in .mod: "45deg", "0.22 m", "500 g"')]
+Quantity = Annotated[str | float, Field(description='a number with its unit, as in .mod: "45deg", "0.22 m", "500 g"')]
 Vector = Annotated[str, Field(description='a parenthesised tuple with one unit, as in .mod: "(0.3, 0, 0.25) m"')]
 
 
@@ -64,27 +64,35 @@ class CylinderDoc(_Doc):
 
 class TargetDoc(_Doc):
     at: Vector
-    rpy: Vector | None = Field(None, description="tool0's orientation in base_link (URDF fixed axes), e.g. \"(0, 90, 0) deg\"")
+    rpy: Vector | None = Field(
+        None, description='tool0\'s orientation in base_link (URDF fixed axes), e.g. "(0, 90, 0) deg"'
+    )
     within: str | None = Field(None, description='tolerances: "5 mm" or "5 mm, 2 deg"')
 
 
-TargetValue = Union[Vector, TargetDoc]
+TargetValue = Vector | TargetDoc
 
 
 class RobotDoc(_Doc):
     name: Name
     library: str | None = Field(None, description="built-in library name, or a path to a library YAML file")
-    chain: list[Union[str, UnitItem]] = Field(description='units base first: "H1", "H4(pivot=-90deg)" or {unit: H4, pivot: -90deg}')
+    chain: list[str | UnitItem] = Field(
+        description='units base first: "H1", "H4(pivot=-90deg)" or {unit: H4, pivot: -90deg}'
+    )
     base: PlacementDoc | None = None
     tool: PlacementDoc | None = None
     payload: PayloadDoc | None = None
-    poses: dict[str, Vector] = Field(default_factory=dict, description='name -> joint angles, e.g. home: "(0, 30, -45) deg"',
-                                     json_schema_extra=_KEYS)
+    poses: dict[str, Vector] = Field(
+        default_factory=dict, description='name -> joint angles, e.g. home: "(0, 30, -45) deg"', json_schema_extra=_KEYS
+    )
     limits: dict[str, Vector] = Field(default_factory=dict, description='joint name -> "(lower, upper) deg"',
                                       json_schema_extra=_KEYS)
-    obstacles: list[Union[BoxDoc, SphereDoc, CylinderDoc]] = Field(default_factory=list)
-    targets: dict[str, TargetValue] = Field(default_factory=dict, description='name -> position of tool0 in base_link (or {at, rpy, within})',
-                                            json_schema_extra=_KEYS)
+    obstacles: list[BoxDoc | SphereDoc | CylinderDoc] = Field(default_factory=list)
+    targets: dict[str, TargetValue] = Field(
+        default_factory=dict,
+        description="name -> position of tool0 in base_link (or {at, rpy, within})",
+        json_schema_extra=_KEYS,
+    )
     allow: list[str] = Field(default_factory=list, description="assembly-rule codes to silence, e.g. first-variant")
 
 
@@ -96,10 +104,10 @@ class DesignDoc(_Doc):
     base: PlacementDoc | None = None
     tool: PlacementDoc | None = None
     payload: PayloadDoc | None = None
-    obstacles: list[Union[BoxDoc, SphereDoc, CylinderDoc]] = Field(default_factory=list)
+    obstacles: list[BoxDoc | SphereDoc | CylinderDoc] = Field(default_factory=list)
     targets: dict[str, TargetValue] = Field(default_factory=dict)
     allow: list[str] = Field(default_factory=list)
-    units: Union[int, str, None] = Field(None, description='number of units: 3 or "2 to 4"')
+    units: int | str | None = Field(None, description='number of units: 3 or "2 to 4"')
     modules: list[str] | None = Field(None, description="unit types a chain may use, e.g. [H1, H3, L3, L4]")
     links: str | None = Field(None, description='link lengths to try: "220 mm" or "150 mm to 300 mm step 50 mm"')
     rank: list[str] | None = Field(None, description="objectives in order: modules, mass, margin")

@@ -12,6 +12,9 @@ from . import ast
 
 
 def token_span(file: str, t: Token) -> Span:
+    # the parser runs with positions on: every token it yields has them
+    assert t.line is not None and t.column is not None and t.end_line is not None and t.end_column is not None
+    assert t.start_pos is not None and t.end_pos is not None
     return Span(file, t.line, t.column, t.end_line, t.end_column, t.start_pos, t.end_pos)
 
 
@@ -45,7 +48,9 @@ class ToAst:
         return ast.DesignBlock(self._name(name), tuple(body), self._span(meta))
 
     def units(self, meta, items):
-        return ast.Units(self._count(items[0]), self._count(items[1]) if items[1] is not None else None, self._span(meta))
+        return ast.Units(
+            self._count(items[0]), self._count(items[1]) if items[1] is not None else None, self._span(meta)
+        )
 
     def _count(self, t: Token) -> ast.Quantity:
         return ast.Quantity(_num(t), None, token_span(self.file, t))
