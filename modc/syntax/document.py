@@ -5,7 +5,7 @@ so both forms share one meaning and one set of unit diagnostics.
 """
 from __future__ import annotations
 
-from typing import Annotated, Any, Union
+from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
