@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import EXAMPLES
+from conftest import ARM_EXAMPLES
 
 from modc.compiler import build, check_file
 
@@ -97,7 +97,7 @@ class Lookups:
 @pytest.fixture(scope="module")
 def packages(tmp_path_factory):
     out = {}
-    for ex in EXAMPLES:
+    for ex in ARM_EXAMPLES:
         c = check_file(ex)
         files = build(c)
         d = tmp_path_factory.mktemp(ex.stem)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import EXAMPLES, checked_ok
+from conftest import ARM_EXAMPLES, checked_ok
 
 from modc.backends import Build, load_all
 from modc.backends import ros_target as rt
@@ -67,7 +67,7 @@ def write(files: dict, out: Path) -> Path:
 def packages(tmp_path_factory):
     """(example stem, distro) -> (checked, files, package directory), for every example and distro."""
     out = {}
-    for ex in EXAMPLES:
+    for ex in ARM_EXAMPLES:
         for distro in ("jazzy", "noetic"):
             c, files = compile_files(ex, ros_distro=distro)
             out[ex.stem, distro] = (c, files, write(files, tmp_path_factory.mktemp(f"{ex.stem}_{distro}")))
@@ -123,8 +123,8 @@ def test_package_is_named_after_the_robot_not_the_file(tmp_path):
 
 
 def test_output_is_deterministic():
-    a = compile_files(EXAMPLES[0])[1]
-    b = compile_files(EXAMPLES[0])[1]
+    a = compile_files(ARM_EXAMPLES[0])[1]
+    b = compile_files(ARM_EXAMPLES[0])[1]
     assert a == b
 
 
@@ -150,7 +150,7 @@ def test_distro_precedence():
     ("jazzy", "trac_ik", "trac_ik_kinematics_plugin"), ("humble", "kdl", "moveit_kinematics"),
     ("noetic", "kdl", "moveit_kinematics")])
 def test_ik_plugin_is_released_in_the_distro(distro, solver, package):
-    c, files = compile_files(EXAMPLES[0], ros_distro=distro)
+    c, files = compile_files(ARM_EXAMPLES[0], ros_distro=distro)
     kin = yaml.safe_load(files["config/kinematics.yaml"])
     (group,) = kin.values()
     assert group["kinematics_solver"] == rt.IK_PLUGINS[solver][0]
@@ -161,7 +161,7 @@ def test_ik_plugin_is_released_in_the_distro(distro, solver, package):
 
 
 def test_ik_solver_option():
-    c, files = compile_files(EXAMPLES[0], ros_distro="humble", ik_solver="pick_ik")
+    c, files = compile_files(ARM_EXAMPLES[0], ros_distro="humble", ik_solver="pick_ik")
     assert yaml.safe_load(files["config/kinematics.yaml"])["arm"]["kinematics_solver"] == "pick_ik/PickIkPlugin"
     with pytest.raises(rt.RosOptionError, match="not released for ROS humble"):
         build(c, ros_distro="humble", ik_solver="trac_ik")
@@ -176,7 +176,7 @@ def test_cli_reads_the_environment_below_its_options(tmp_path, monkeypatch):
 
     from modc.cli.app import app
 
-    src = str(EXAMPLES[0])
+    src = str(ARM_EXAMPLES[0])
     runner = CliRunner()
     monkeypatch.setenv("ROS_DISTRO", "noetic")
     r = runner.invoke(app, ["compile", src, "-o", str(tmp_path / "a"), "-q", "--collision-samples", "0"])
@@ -387,15 +387,15 @@ def test_awkward_file_names_stay_inert(tmp_path):
 
 def test_library_output_ignores_the_environment(monkeypatch):
     """Only the CLI reads $ROS_DISTRO / $ROS_VERSION: build() (and so the golden files) does not."""
-    before = compile_files(EXAMPLES[0], collision_samples=0)[1]
+    before = compile_files(ARM_EXAMPLES[0], collision_samples=0)[1]
     monkeypatch.setenv("ROS_DISTRO", "noetic")
     monkeypatch.setenv("ROS_VERSION", "1")
-    after = compile_files(EXAMPLES[0], collision_samples=0)[1]
+    after = compile_files(ARM_EXAMPLES[0], collision_samples=0)[1]
     assert after == before and "<buildtool_depend>ament_cmake</buildtool_depend>" in after["package.xml"]
 
 
 def test_effort_command_interface():
-    c, files = compile_files(EXAMPLES[0], command_interface="effort", collision_samples=0)
+    c, files = compile_files(ARM_EXAMPLES[0], command_interface="effort", collision_samples=0)
     robot = c.design.robots[0]
     arm = yaml.safe_load(files["config/ros2_controllers.yaml"])["arm_controller"]["ros__parameters"]
     assert arm["command_interfaces"] == ["effort"]
