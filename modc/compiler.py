@@ -2,13 +2,11 @@
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .diagnostics import Diagnostic, Span, codes
-from .files import REPORT, write_files
 from .model import Design
 from .model.lower import lower
 from .passes import Context, run_all
@@ -98,27 +96,39 @@ def build(checked: Checked, only: list[str] | None = None, **options) -> dict[st
     return dict(sorted(b.files.items()))
 
 
-def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False) -> None:
-    """Write files into a fresh directory next to OUT, then swap it in: OUT is either the old
-    tree or the complete new one, never half-written. Refuses to replace a directory modc did
-    not make unless force is set."""
+def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False,
+               inputs: Sequence[str | os.PathLike] = ()) -> None:
+    """Write files into a fresh directory next to OUT and exchange it with OUT atomically (see
+    modc.files): OUT is either the old tree or the complete new one, never half-written or
+    missing. OUT may be replaced when it is missing, empty, or exactly what modc wrote there
+    (its manifest lists every file, unchanged); otherwise only with force, which replaces it
+    whatever it holds. Never (even with force): OUT a plain file, the current directory or
+    one of its ancestors, or a directory holding one of `inputs`."""
+    from .files import ForeignOutput, replace_tree
+
     out = Path(out)
+    where = Span.point(str(out))
     if out.exists() and not out.is_dir():
-        raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
-    if out.is_dir() and any(out.iterdir()) and not (out / REPORT).is_file() and not force:
-        raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
-    parent = out.resolve().parent
-    parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent))
+        raise InputError(codes.OUTPUT_NOT_MODC.at(where, path=str(out), found="it is not a directory"))
+    target = Path(os.path.abspath(out))
+    cwd = Path(os.getcwd())
+    if any(t == c or t in c.parents for t in (target, target.resolve()) for c in (cwd, cwd.resolve())):
+        what = "the current directory or one of its parents"
+        raise InputError(codes.OUTPUT_UNSAFE.at(where, path=str(out), what=what))
+    for src in inputs:
+        if target.resolve() in Path(os.path.abspath(src)).resolve().parents:
+            what = f"the directory holding the input {src}"
+            raise InputError(codes.OUTPUT_UNSAFE.at(where, path=str(out), what=what))
     try:
-        write_files(files, tmp)
-        old = None
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=parent))
-            os.replace(out, old / "tree")
-        os.replace(tmp, out)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        if not force and out.is_symlink():
+            _refuse_foreign(out, ["(OUT itself is a symbolic link)"])
+        replace_tree(files, target, force)
+    except ForeignOutput as e:
+        _refuse_foreign(out, e.entries)
+
+
+def _refuse_foreign(out: Path, entries: list[str]) -> None:
+    if not entries:
+        return
+    shown = ", ".join(entries[:5]) + (f" and {len(entries) - 5} more" if len(entries) > 5 else "")
+    raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out), found=f"it holds {shown}"))

@@ -63,6 +63,7 @@ ANALYSIS_CODES = {"torque-over-peak", "torque-over-nominal", "epsilon-disagrees"
 FUNCTION_CASES = {
     "file-not-found": "test_file_not_found",
     "output-not-modc": "test_output_not_modc",
+    "output-unsafe": "test_output_unsafe",
     "unsupported-input": "test_unsupported_input",
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
@@ -388,7 +389,7 @@ def test_output_not_modc(tmp_path):
     empty.mkdir()
     write_tree(files, empty)
     write_tree({"report.json": "{}"}, empty)
-    assert sorted(p.name for p in empty.iterdir()) == ["report.json"]
+    assert sorted(p.name for p in empty.iterdir()) == [".modc-manifest.json", "report.json"]
     write_tree(files, foreign, force=True)
     assert not (foreign / "thesis.tex").exists()
 
@@ -403,6 +404,17 @@ def test_output_not_modc_from_the_command_line(tmp_path):
     assert p.returncode == 2, p.stderr
     assert "error[output-not-modc]" in p.stderr and "Traceback" not in p.stderr
     assert [x.name for x in out.iterdir()] == ["notes.txt"]
+
+
+def test_output_unsafe(tmp_path, monkeypatch):
+    """OUT the working directory, a parent of it, or the directory of the input: never replaced."""
+    monkeypatch.chdir(tmp_path)
+    for out, inputs in ((".", ()), ("..", ()), ("src", ["src/a.mod"])):
+        with pytest.raises(InputError) as e:
+            write_tree({"a.txt": "x"}, out, force=True, inputs=inputs)
+        d = e.value.diagnostic
+        assert d.code == "output-unsafe" and d.hint and out in d.message
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_unsupported_input(tmp_path, capsys):

@@ -24,7 +24,7 @@ def compile_cmd(
     out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
     library: LibraryOpt = None,
     only: Annotated[Optional[str], typer.Option(help="comma-separated backends to run (default: all); see `modc backends`")] = None,
-    force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
+    force: Annotated[bool, typer.Option(help="replace OUT whatever it holds (deletes files modc did not write)")] = False,
     collision_samples: Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")] = 10_000,
     seed: Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")] = 0,
     smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
@@ -67,7 +67,7 @@ def compile_cmd(
             raise typer.Exit(EXIT_ERRORS)
     files = build(checked, selected, collision_samples=collision_samples, seed=seed)
     with usage_errors("compile", writing=out):
-        write_tree(files, out, force=force)
+        write_tree(files, out, force=force, inputs=[file])
     if verbose:
         for rel in files:
             _err(f"  wrote {out.rstrip('/')}/{rel}")
