@@ -39,19 +39,40 @@ class InputError(Exception):
         self.diagnostic = diagnostic
 
 
+class SourceError(InputError):
+    """A file that was read but whose bytes are wrong (not UTF-8, too large): an error in the
+    file, exit 1 like any other (check_file reports it as the file's diagnostic)."""
+
+    def __init__(self, diagnostic: Diagnostic, text: str | None = None):
+        super().__init__(diagnostic)
+        self.text = text  # what can be shown of the file (undecodable bytes replaced), for the excerpt
+
+
 def read_source(path: str | os.PathLike) -> str:
+    """The text of an input file. Only regular files are read, and at most MAX_BYTES + 1 bytes of
+    them (a link to /dev/zero or a FIFO is refused at once). InputError when it cannot be read;
+    SourceError when it is too large or not UTF-8. A lone CR is read as a line end."""
+    from .files import read_bounded
+    from .syntax.parser import MAX_BYTES, normalize_newlines
+
     p = str(path)
     try:
-        data = Path(p).read_bytes()
+        data, size = read_bounded(p, MAX_BYTES)
     except OSError as e:
         raise InputError(codes.FILE_NOT_FOUND.at(Span.point(p), path=p, detail=e.strerror or str(e))) from None
+    if size > MAX_BYTES:
+        raise SourceError(codes.INPUT_TOO_LARGE.at(Span.point(p), what="the file", size=f"{size:,} bytes",
+                                                   limit=f"{MAX_BYTES:,} bytes"))
     try:
-        return data.decode("utf-8-sig")
+        return normalize_newlines(data.decode("utf-8-sig"))
     except UnicodeDecodeError as e:
-        line = data[: e.start].count(b"\n") + 1
-        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
-        diag = codes.BAD_ENCODING.at(Span(p, line, col, line, col + 1, e.start, e.start + 1), detail=f"byte 0x{data[e.start]:02x}")
-        raise InputError(diag) from None
+        # line and column in characters, counting line ends as the parser does
+        before = normalize_newlines(data[: e.start].decode("utf-8-sig"))
+        line = before.count("\n") + 1
+        col = len(before) - (before.rfind("\n") + 1) + 1
+        at = Span(p, line, col, line, col + 1, len(before), len(before) + 1)
+        diag = codes.BAD_ENCODING.at(at, detail=f"byte 0x{data[e.start]:02x}")
+        raise SourceError(diag, normalize_newlines(data.decode("utf-8-sig", errors="replace"))) from None
 
 
 def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
@@ -66,6 +87,9 @@ def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
 
 def check_text(text: str, path: str = "<string>", library: str | None = None, **options) -> Checked:
     """Parse, lower and run the passes. options go to the pass Context (analyses=…, torque_severity=…)."""
+    from .syntax.parser import normalize_newlines
+
+    text = normalize_newlines(text)  # the same length: offsets into the original stay right
     tree, diags = parse_text(text, path)
     ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
@@ -77,7 +101,12 @@ def check_file(path: str | os.PathLike, library: str | None = None, **options) -
     p = str(path)
     if not p.endswith((".mod", *YAML_SUFFIXES)):
         raise InputError(codes.UNSUPPORTED_INPUT.at(Span.point(p), path=p))
-    text = read_source(p)
+    try:
+        text = read_source(p)
+    except SourceError as e:
+        from .model import Design
+
+        return Checked(Design(path=p), [e.diagnostic], {p: e.text} if e.text is not None else {})
     return check_text(text, p, library, **options)
 
 

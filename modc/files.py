@@ -207,3 +207,30 @@ class ForeignOutput(Exception):
     def __init__(self, entries: list[str]):
         super().__init__(", ".join(entries))
         self.entries = entries
+
+
+class NotAFile(OSError):
+    """An input path that is not a regular file (a device, a FIFO, a socket, a directory)."""
+
+
+def read_bounded(path: str | os.PathLike, limit: int) -> tuple[bytes, int]:
+    """At most limit + 1 bytes of a regular file, and its size. Devices (a link to /dev/zero),
+    FIFOs and sockets are refused before anything is read, and opening never blocks."""
+    import stat
+
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = "a directory" if stat.S_ISDIR(st.st_mode) else "not a regular file"
+            raise NotAFile(errno.EINVAL, kind, str(path))
+        chunks, got = [], 0
+        while got <= limit:
+            block = os.read(fd, min(1 << 20, limit + 1 - got))
+            if not block:
+                break
+            chunks.append(block)
+            got += len(block)
+        return b"".join(chunks), max(st.st_size, got)
+    finally:
+        os.close(fd)

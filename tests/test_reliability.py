@@ -201,3 +201,80 @@ def test_sigkill_of_the_compiler_itself(tmp_path):
     r = subprocess.run([sys.executable, "-m", "modc", str(QUICK), "-o", str(out)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert tree(out) == before and listing(tmp_path) == ["out"]
+
+
+# --- crash sites: diagnostics within seconds, bounded memory ------------------------------------
+
+def lint(*args: str, cwd: Path | None = None, timeout: float = 30) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "modc", "lint", *args], capture_output=True, text=True,
+                          timeout=timeout, cwd=cwd)
+
+
+def test_devices_and_fifos_are_refused_at_once(tmp_path):
+    zero = tmp_path / "zero.mod"
+    zero.symlink_to("/dev/zero")
+    fifo = tmp_path / "fifo.mod"
+    os.mkfifo(fifo)
+    for path in (zero, fifo):
+        t = time.monotonic()
+        r = lint(str(path), timeout=20)  # a FIFO used to block forever, /dev/zero to read 3.8 GB
+        assert time.monotonic() - t < 10
+        assert r.returncode == 2 and "error[file-not-found]" in r.stderr and "not a regular file" in r.stderr
+        assert "Traceback" not in r.stderr
+
+
+def test_size_limit_counts_bytes_and_reads_no_more(tmp_path):
+    from modc.compiler import check_file, check_text
+    from modc.syntax.parser import MAX_BYTES
+
+    body = "robot farm {\n    chain H1 - L4(port=45deg) - L1\n}\n"
+    accents = body + "# " + "é" * (MAX_BYTES // 2) + "\n"  # fewer characters than the limit, more bytes
+    assert len(accents) < MAX_BYTES < len(accents.encode())
+    assert [d.code for d in check_text(accents, "a.mod").diagnostics] == ["input-too-large"]
+    big = tmp_path / "big.mod"
+    big.write_text(accents, encoding="utf-8")
+    [d] = check_file(big).diagnostics
+    assert d.code == "input-too-large" and f"{len(accents.encode()):,} bytes" in d.message
+
+
+def test_library_files_have_a_size_limit(tmp_path):
+    from modc.model.library import MAX_LIBRARY_BYTES
+
+    lib = tmp_path / "huge.yaml"
+    lib.write_text("name: huge\n" + "# padding\n" * (MAX_LIBRARY_BYTES // 10 + 1))
+    src = tmp_path / "a.mod"
+    src.write_text('robot a {\n    library "huge.yaml"\n    chain H1 - L1\n}\n')
+    t = time.monotonic()
+    r = lint(str(src))
+    assert time.monotonic() - t < 10
+    assert r.returncode == 1 and "error[library-invalid]" in r.stderr and "too large" in r.stderr, r.stderr
+
+
+def test_deep_yaml_and_huge_unit_numbers_are_diagnostics(tmp_path):
+    from modc.compiler import check_text
+
+    deep = "robots:\n  - name: a\n    chain: " + "[" * 500 + "]" * 500 + "\n"
+    assert [d.code for d in check_text(deep, "deep.yaml").diagnostics] == ["yaml-syntax"]
+    lib = tmp_path / "deep-lib.yaml"
+    lib.write_text("name: " + "[" * 2000 + "]" * 2000 + "\n")
+    c = check_text(f'robot a {{\n    library "{lib}"\n    chain H1 - L1\n}}\n', "a.mod")
+    assert [d.code for d in c.diagnostics] == ["library-invalid"]
+    for name in ("L" + "1" * 5000, "L1²"):
+        c = check_text(f"robot a {{\n    chain H1 - {name}\n}}\n", "a.mod")
+        assert [d.code for d in c.diagnostics] == ["unknown-module"] or c.diagnostics[0].code.endswith("character")
+    c = check_text("robot a {\n    chain H1 - L1\n    limit joint_" + "9" * 5000 + " (0, 1) deg\n}\n", "a.mod")
+    assert [d.code for d in c.diagnostics] == ["unknown-joint"]
+
+
+def test_lint_without_files_is_a_usage_error(tmp_path):
+    (tmp_path / "empty").mkdir()
+    for arg, what in (("empty", "holds no .mod file"), ("src/**/*.mod", "matches no file")):
+        r = lint(arg, cwd=tmp_path)
+        assert r.returncode == 2 and what in r.stderr and "Traceback" not in r.stderr
+
+
+def test_bad_encoding_is_an_error_in_the_file(tmp_path):
+    src = tmp_path / "latin1.mod"
+    src.write_bytes("robot farm {\n    chain H1 - L1   # 45°\n}\n".encode("latin-1"))
+    r = lint(str(src))
+    assert r.returncode == 1 and f"{src}:2:25: error[bad-encoding]" in r.stderr and "chain H1" in r.stderr

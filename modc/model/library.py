@@ -176,8 +176,10 @@ class Library(_Frozen):
     def split(self, name: str) -> tuple[str, int] | None:
         """'H4' -> ('H', 4) if the library defines it."""
         for v in sorted(self.variants, key=len, reverse=True):
-            if name.startswith(v) and name[len(v):].isdigit():
-                k = int(name[len(v):])
+            digits = name[len(v):]
+            # ASCII and short: int() refuses 4,300+ digits and some Unicode digits ('²')
+            if name.startswith(v) and digits.isascii() and digits.isdigit() and len(digits) <= 9:
+                k = int(digits)
                 if k in self.units:
                     return v, k
         return None
@@ -187,16 +189,26 @@ class LibraryError(Exception):
     pass
 
 
+MAX_LIBRARY_BYTES = 1_000_000  # the shipped libraries are 4 kB; a 6 MB one took 30 s and 550 MB
+
+
 @cache
 def _load_path(path: str, mtime: float) -> Library:
     import yaml
 
     from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
 
+    from ..files import read_bounded
+
     try:
-        data = yaml.load(Path(path).read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
+        if size > MAX_LIBRARY_BYTES:
+            raise LibraryError(f"the file is too large ({size:,} bytes; the limit is {MAX_LIBRARY_BYTES:,})")
+        data = yaml.load(raw.decode("utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     except (OSError, UnicodeDecodeError) as e:
         raise LibraryError(str(e)) from None
+    except RecursionError:
+        raise LibraryError("the YAML is nested too deeply") from None
     except yaml.YAMLError as e:
         raise LibraryError(f"YAML error: {e}") from None
     from pydantic import ValidationError

@@ -11,6 +11,23 @@ from .errors import EXAMPLES, HINTS, TERMINAL_NAMES
 MAX_BYTES = 256_000  # a real .mod file is a few kB; beyond this, checking would take seconds
 
 
+def normalize_newlines(text: str) -> str:
+    """A lone CR (old Mac line ends) as LF: one character for one, so offsets do not move and a
+    comment ends at the end of its line. CRLF is left alone (the grammar treats CR as space)."""
+    import re
+
+    return re.sub(r"\r(?!\n)", "\n", text) if "\r" in text else text
+
+
+def too_large(text: str, file: str) -> Diagnostic | None:
+    """input-too-large when text is more than MAX_BYTES bytes of UTF-8 (not characters: 200k 'é' is 400 kB)."""
+    size = len(text) if len(text) > MAX_BYTES else len(text.encode("utf-8", "surrogatepass"))
+    if size <= MAX_BYTES:
+        return None
+    shown = f"{size:,} bytes" if len(text) <= MAX_BYTES else f"{len(text):,} characters"
+    return codes.INPUT_TOO_LARGE.at(Span.point(file), what="the file", size=shown, limit=f"{MAX_BYTES:,} bytes")
+
+
 @cache
 def _lark():
     from lark import Lark
@@ -30,9 +47,9 @@ def grammar_keywords() -> set[str]:
 
 def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]]:
     """Parse one file. On a syntax error returns no robots and one diagnostic."""
-    if len(text) > MAX_BYTES:
-        d = codes.INPUT_TOO_LARGE.at(Span.point(file), what="the file", size=f"{len(text):,} characters", limit=f"{MAX_BYTES:,}")
-        return ast.File(file, ()), [d]
+    big = too_large(text, file)
+    if big is not None:
+        return ast.File(file, ()), [big]
     from lark.exceptions import UnexpectedInput
 
     from .transform import ToAst
