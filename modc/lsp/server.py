@@ -227,8 +227,10 @@ def formatting(ls: ModcServer, params: types.DocumentFormattingParams):
 def serve() -> None:
     """Run the server on stdin/stdout until the client says exit (or closes the pipe)."""
     logging.basicConfig(level=logging.WARNING, format="modc lsp: %(message)s")
+    from .transport import FramedReader
+
     stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # a stray print() anywhere must never corrupt the protocol stream
-    server.start_io(stdin, stdout)
+    server.start_io(FramedReader(stdin), stdout)  # only well-formed frames reach pygls
     if server.exit_code:
         sys.exit(server.exit_code)
