@@ -278,3 +278,17 @@ def test_bad_encoding_is_an_error_in_the_file(tmp_path):
     src.write_bytes("robot farm {\n    chain H1 - L1   # 45°\n}\n".encode("latin-1"))
     r = lint(str(src))
     assert r.returncode == 1 and f"{src}:2:25: error[bad-encoding]" in r.stderr and "chain H1" in r.stderr
+
+
+def test_fmt_formats_the_issues_8000_unit_chain():
+    """(Its speed, linear in the chain, is measured by benchmarks/bench_fmt.py.)"""
+    import gc
+
+    from modc.syntax.format import format_text
+
+    text = "robot a {\n    chain H1 - " + " - ".join(["L4(port=45deg)"] * 8000) + "\n}\n"
+    out, errors = format_text(text, "long.mod")
+    assert out is not None and not errors and out.count("\n") > 1000  # wrapped at 100 columns
+    assert format_text(out, "long.mod")[0] == out
+    assert gc.isenabled()
+    assert format_text("robot a {\r    chain H1 - L1\r}\r", "cr.mod")[0] == "robot a {\n    chain H1 - L1\n}\n"
