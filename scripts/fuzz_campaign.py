@@ -211,7 +211,7 @@ def run(args) -> int:
             if state["inputs"] >= args.inputs and kind not in ("valid", "grammar", "text"):
                 state["batch"] += 1  # only compiles are still wanted: skip kinds that never compile
                 continue
-            batch = draw_batch(gens[kind], BATCH, args.seed * 1_000_003 + k)
+            batch = draw_batch(gens[kind], args.batch, args.seed * 1_000_003 + k)
             for i, item in enumerate(batch):
                 t0 = time.monotonic()
                 finding = None
@@ -268,6 +268,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--timeout", type=float, default=5.0, help="seconds one input may take (a full compile: 6x)")
     p.add_argument("--collision-samples", type=int, default=1000)
     p.add_argument("--memory", type=int, default=4096, help="address-space limit in MB (0: none)")
+    p.add_argument("--batch", type=int, default=BATCH, help="inputs drawn per batch (keep it for a resumed campaign)")
     p.add_argument("--stop-after", type=int, default=0, help="stop after this batch number (to test resuming)")
     p.add_argument("--progress", action="store_true")
     return run(p.parse_args(argv))
