@@ -229,7 +229,8 @@ def run(args) -> int:
                 except BaseException as e:  # noqa: BLE001  (a finding, whatever it is)
                     if isinstance(e, KeyboardInterrupt):
                         raise
-                    finding = {"type": "traceback", "detail": _signature(e), "traceback": traceback.format_exc()[-3000:]}
+                    finding = {"type": "traceback", "detail": _signature(e),
+                               "traceback": traceback.format_exc()[-3000:]}
                 finally:
                     signal.setitimer(signal.ITIMER_REAL, 0)
                 state["inputs"] += 1
@@ -238,7 +239,8 @@ def run(args) -> int:
                     state["findings"] += 1
                     state[{"traceback": "tracebacks", "hang": "hangs", "escape": "escapes"}[finding["type"]]] += 1
                     shown = item if isinstance(item, str) else item.decode("latin-1")
-                    finding.update(kind=kind, batch=k, index=i, seconds=round(time.monotonic() - t0, 2), input=shown[:4000])
+                    finding.update(kind=kind, batch=k, index=i, seconds=round(time.monotonic() - t0, 2),
+                                   input=shown[:4000])
                     with open(findings_path, "a", encoding="utf-8") as f:
                         f.write(json.dumps(finding) + "\n")
                     print(f"finding: {finding['type']} {finding['detail']} ({kind} batch {k} #{i})", file=sys.stderr)
@@ -249,7 +251,8 @@ def run(args) -> int:
             tmp.write_text(json.dumps(state, indent=1))
             os.replace(tmp, state_path)  # a killed campaign resumes at this batch
             if args.progress:
-                print(f"batch {k}: {state['inputs']} inputs, {state['compiles']} compiles, {state['findings']} findings",
+                print(f"batch {k}: {state['inputs']} inputs, {state['compiles']} compiles, "
+                      f"{state['findings']} findings",
                       file=sys.stderr)
             if args.stop_after and state["batch"] >= args.stop_after:
                 break
