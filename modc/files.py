@@ -102,7 +102,7 @@ def _sibling_pattern(name: str) -> re.Pattern[str]:
 
 def remove_leftovers(out: Path) -> list[Path]:
     """Remove the siblings a killed run left next to out (only directories with modc's names)."""
-    removed = []
+    removed: list[Path] = []
     pattern = _sibling_pattern(out.name)
     try:
         names = os.listdir(out.parent)

@@ -214,7 +214,7 @@ def run(args) -> int:
             batch = draw_batch(gens[kind], args.batch, args.seed * 1_000_003 + k)
             for i, item in enumerate(batch):
                 t0 = time.monotonic()
-                finding = None
+                finding: dict[str, object] | None = None
                 try:
                     signal.setitimer(signal.ITIMER_REAL, args.timeout)
                     text = check_one(kind, item, work)
@@ -237,7 +237,7 @@ def run(args) -> int:
                 state["by_kind"][kind] += 1
                 if finding:
                     state["findings"] += 1
-                    state[{"traceback": "tracebacks", "hang": "hangs", "escape": "escapes"}[finding["type"]]] += 1
+                    state[{"traceback": "tracebacks", "hang": "hangs", "escape": "escapes"}[str(finding["type"])]] += 1
                     shown = item if isinstance(item, str) else item.decode("latin-1")
                     finding.update(kind=kind, batch=k, index=i, seconds=round(time.monotonic() - t0, 2),
                                    input=shown[:4000])

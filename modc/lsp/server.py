@@ -17,6 +17,7 @@ import functools
 import logging
 import sys
 import traceback
+from typing import BinaryIO, cast
 from urllib.parse import unquote
 
 from lsprotocol import types
@@ -231,6 +232,7 @@ def serve() -> None:
 
     stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # a stray print() anywhere must never corrupt the protocol stream
-    server.start_io(FramedReader(stdin), stdout)  # only well-formed frames reach pygls
+    # only well-formed frames reach pygls (it reads through readline() and read(n), all FramedReader has)
+    server.start_io(cast(BinaryIO, FramedReader(stdin)), stdout)
     if server.exit_code:
         sys.exit(server.exit_code)
