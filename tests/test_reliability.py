@@ -292,3 +292,11 @@ def test_fmt_formats_the_issues_8000_unit_chain():
     assert format_text(out, "long.mod")[0] == out
     assert gc.isenabled()
     assert format_text("robot a {\r    chain H1 - L1\r}\r", "cr.mod")[0] == "robot a {\n    chain H1 - L1\n}\n"
+
+
+def test_no_file_is_written_outside_out(tmp_path):
+    out = tmp_path / "out"
+    for rel in ("../escape.txt", "/tmp/abs.txt", "a/../../b.txt", MANIFEST):
+        with pytest.raises(ValueError):
+            write_tree({"ok.txt": "x", rel: "y"}, out)
+        assert listing(tmp_path) == [], rel
