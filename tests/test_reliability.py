@@ -300,3 +300,17 @@ def test_no_file_is_written_outside_out(tmp_path):
         with pytest.raises(ValueError):
             write_tree({"ok.txt": "x", rel: "y"}, out)
         assert listing(tmp_path) == [], rel
+
+
+def test_concurrent_writers_to_one_out_are_serialised(tmp_path):
+    """Two processes replacing the same OUT at once: both succeed (the flock on the parent keeps
+    one from removing the other's sibling as a leftover), OUT is one complete tree, nothing left over."""
+    out, n = tmp_path / "out", 150
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    once = WORKER.replace("for k in range(10**6):", "for k in range(int(sys.argv[3]), int(sys.argv[3]) + 6):")
+    procs = [subprocess.Popen([sys.executable, "-c", once, str(out), str(n), str(start)], env=env,
+                              stderr=subprocess.PIPE, text=True) for start in (0, 1)]
+    for p in procs:
+        _, err = p.communicate(timeout=120)
+        assert p.returncode == 0, err
+    assert _state(out, n) in ("A", "B") and listing(tmp_path) == ["out"]
