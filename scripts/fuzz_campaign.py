@@ -2,11 +2,14 @@
 
     python scripts/fuzz_campaign.py --state /tmp/fuzz --inputs 100000 --compiles 2000 --seed 1
 
-Inputs come in batches of BATCH from six generators, in turn: grammar-aware .mod text
+Inputs come in batches of BATCH from seven generators, in turn: grammar-aware .mod text
 (tests/test_fuzz.py's mod_file), valid arms (tests/strategies.py's valid_chains), text and byte
 mutations of the examples (test_fuzz's text_mutation, byte_mutation: bytes go through a file on
 disk and check_file), the YAML form (mutations of examples/quickstart.yaml and random YAML
-documents) and DH CSV tables (random and mutated, through dh2mod's convert_table). Every .mod
+documents), DH CSV tables (random and mutated, through dh2mod's convert_table), and the
+hand-made attack families of issue 10 at random sizes ("hostile": unit and joint numbers with
+thousands of digits, YAML nested up to 2,000 deep or full of aliases, chains of thousands of
+units, multi-byte text around the size limit, CR line ends, stray bytes). Every .mod
 input that parses is also formatted (`modc fmt`'s format_text; its output must be a fixed point).
 Batch k of seed S is drawn by hypothesis with seed (S, k): the same state file and seed give the
 same inputs, and an interrupted campaign resumes at the batch it was in (--state holds
@@ -38,7 +41,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 BATCH = 100
-KINDS = ("grammar", "valid", "text", "bytes", "yaml", "csv")
+KINDS = ("grammar", "valid", "text", "bytes", "yaml", "csv", "hostile")
 
 
 class Hang(BaseException):  # not an Exception: modc code catching Exception must not swallow it
@@ -98,7 +101,29 @@ def _strategies():
                       st.sampled_from(["0", "0.3", "-1.5708", "1e308", "nan", "inf", "", "x", "1,2", "0.1 m"]))
     tables = st.lists(st.lists(cells, min_size=2, max_size=5).map(",".join), max_size=9).map(
         lambda rows: "a,alpha,d,theta\n" + "\n".join(rows) + "\n")
+    example = (ROOT / "examples" / "farm.mod").read_text(encoding="utf-8")
+    def sized(*scales: int):  # hypothesis favours small integers: draw the magnitude first, then jitter it
+        return st.tuples(st.sampled_from(scales), st.integers(0, 99)).map(lambda t: max(1, t[0] + t[0] * t[1] // 100))
+
+    digits = sized(1, 10, 300, 2000, 4300, 6000).map(lambda n: "1" * n)
+    hostile = st.one_of(  # the attack families of issue 10, sized at random: (form, input)
+        digits.map(lambda d: ("mod", f"robot a {{\n    chain H1 - L{d}\n}}\n")),
+        digits.map(lambda d: ("mod", f"robot a {{\n    chain H1 - L1\n    limit joint_{d} (0, 1) deg\n}}\n")),
+        digits.map(lambda d: ("yaml", f"robots:\n  - name: a\n    chain: [H1, L{d}]\n")),
+        st.tuples(sized(5, 100, 300, 600, 1000), st.sampled_from(["[", "{a: ", "- "])).map(
+            lambda t: ("yaml", "robots:\n  - name: a\n    chain: " + t[1] * t[0] + "x"
+                       + {"[": "]", "{a: ": "}", "- ": ""}[t[1]] * t[0] + "\n")),
+        sized(1, 100, 1500).map(lambda n: ("mod", "robot a {\n    chain H1 - " + " - ".join(["L4(port=45deg)"] * n)
+                                            + "\n}\n")),
+        sized(10, 100_000, 127_000).map(lambda n: ("mod", "robot a {\n    chain H1 - L1\n}\n# " + "é" * n + "\n")),
+        st.sampled_from(["\r", "\r\n", "\n\r"]).map(lambda nl: ("mod", example.replace("\n", nl))),
+        st.integers(1, 9).map(lambda k: ("yaml", "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+            f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]\n" for i in range(1, k + 1))
+            + f"robots:\n  - name: a\n    chain: *a{k}\n")),
+        st.binary(max_size=64).map(lambda b: ("bytes", b"robot a {\n    chain H1 - L1  # " + b + b"\n}\n")),
+    )
     return {
+        "hostile": hostile,
         "grammar": F.mod_file(),
         "valid": S.valid_chains(),
         "text": F.text_mutation().map(lambda case: case[1]),
@@ -131,6 +156,8 @@ def check_one(kind: str, item, work: Path):
     """Check one input the way the product does; returns the text when it should be compiled."""
     from modc.compiler import check_file, check_text
 
+    if kind == "hostile":
+        kind, item = {"mod": "grammar", "yaml": "yaml", "bytes": "bytes"}[item[0]], item[1]
     if kind == "csv":
         from modc.dh.convert_file import convert_table
 
@@ -208,7 +235,7 @@ def run(args) -> int:
         while state["inputs"] < args.inputs or state["compiles"] < args.compiles:
             k = state["batch"]
             kind = KINDS[k % len(KINDS)]
-            if state["inputs"] >= args.inputs and kind not in ("valid", "grammar", "text"):
+            if state["inputs"] >= args.inputs and kind not in ("valid", "grammar", "text", "hostile"):
                 state["batch"] += 1  # only compiles are still wanted: skip kinds that never compile
                 continue
             batch = draw_batch(gens[kind], args.batch, args.seed * 1_000_003 + k)
@@ -238,7 +265,8 @@ def run(args) -> int:
                 if finding:
                     state["findings"] += 1
                     state[{"traceback": "tracebacks", "hang": "hangs", "escape": "escapes"}[str(finding["type"])]] += 1
-                    shown = item if isinstance(item, str) else item.decode("latin-1")
+                    payload = item[1] if isinstance(item, tuple) else item  # hostile: (form, input)
+                    shown = payload if isinstance(payload, str) else payload.decode("latin-1")
                     finding.update(kind=kind, batch=k, index=i, seconds=round(time.monotonic() - t0, 2),
                                    input=shown[:4000])
                     with open(findings_path, "a", encoding="utf-8") as f:
