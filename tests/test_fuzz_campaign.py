@@ -16,7 +16,7 @@ SCRIPT = ROOT / "scripts" / "fuzz_campaign.py"
 
 def campaign(state: Path, *extra: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, str(SCRIPT), "--state", str(state), "--seed", "7", "--batch", "15",
-                           "--inputs", "90", "--compiles", "3", *extra], capture_output=True, text=True, timeout=300)
+                           "--inputs", "105", "--compiles", "3", *extra], capture_output=True, text=True, timeout=300)
 
 
 def test_a_seeded_slice_finds_nothing_and_resumes(tmp_path):
@@ -26,7 +26,7 @@ def test_a_seeded_slice_finds_nothing_and_resumes(tmp_path):
     rest = campaign(tmp_path / "s")
     assert rest.returncode == 0, rest.stderr[-3000:]
     state = json.loads(rest.stdout)
-    assert state["inputs"] == 90 and state["batch"] == 6 and state["findings"] == 0
+    assert state["inputs"] == 105 and state["batch"] == 7 and state["findings"] == 0
     assert set(state["by_kind"].values()) == {15} and state["compiles"] == 3
     assert not (tmp_path / "s" / "findings.jsonl").exists()
 
