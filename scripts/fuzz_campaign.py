@@ -19,8 +19,11 @@ Inputs that check without errors are compiled in full (every backend, collision 
 --collision-samples poses) into a fresh directory OUT inside an otherwise empty temporary
 directory that is also the working directory; anything written beside OUT is a finding.
 
-A finding is an exception escaping modc (a traceback), a hang (one input over --timeout seconds,
-by SIGALRM) or a file outside OUT. The process runs with an address-space limit (--memory MB), so
+A finding is an exception escaping modc (a traceback), a hang or a file outside OUT. A hang is
+one input taking more than --timeout seconds of CPU time (SIGPROF: other load on the machine
+does not count; a first campaign timed wall-clock and, at load average 8 on 2 cores, flagged
+inputs that take under 1 s alone) or more than --wall seconds of wall-clock time (SIGALRM: an
+input that blocks, e.g. reading a FIFO, uses no CPU). The process runs with an address-space limit (--memory MB), so
 unbounded memory shows as a MemoryError finding. Exit status: 0 with no findings, 1 otherwise.
 """
 from __future__ import annotations
@@ -49,7 +52,7 @@ class Hang(BaseException):  # not an Exception: modc code catching Exception mus
 
 
 def _alarm(signum, frame):
-    raise Hang()
+    raise Hang("wall-clock" if signum == signal.SIGALRM else "CPU")
 
 
 # --- generators (hypothesis strategies, drawn with a fixed seed per batch) -------------------------
@@ -228,6 +231,7 @@ def run(args) -> int:
     if args.memory:
         resource.setrlimit(resource.RLIMIT_AS, (args.memory * 2**20, resource.RLIM_INFINITY))
     signal.signal(signal.SIGALRM, _alarm)
+    signal.signal(signal.SIGPROF, _alarm)
     gens = _strategies()
     work = Path(tempfile.mkdtemp(prefix="modc-fuzz-work-"))
     started = time.monotonic()
@@ -243,16 +247,19 @@ def run(args) -> int:
                 t0 = time.monotonic()
                 finding: dict[str, object] | None = None
                 try:
-                    signal.setitimer(signal.ITIMER_REAL, args.timeout)
+                    signal.setitimer(signal.ITIMER_PROF, args.timeout)
+                    signal.setitimer(signal.ITIMER_REAL, args.wall)
                     text = check_one(kind, item, work)
                     if text is not None and state["compiles"] < args.compiles:
-                        signal.setitimer(signal.ITIMER_REAL, args.timeout * 6)  # a full compile does more
+                        signal.setitimer(signal.ITIMER_PROF, args.timeout * 6)  # a full compile does more
+                        signal.setitimer(signal.ITIMER_REAL, args.wall * 6)
                         escape = compile_one(text, args.collision_samples)
                         state["compiles"] += 1
                         if escape:
                             finding = {"type": "escape", "detail": escape}
-                except Hang:
-                    finding = {"type": "hang", "detail": f"over {args.timeout} s"}
+                except Hang as e:
+                    limit = args.wall if e.args[0] == "wall-clock" else args.timeout
+                    finding = {"type": "hang", "detail": f"over {limit} s of {e.args[0]} time"}
                 except BaseException as e:  # noqa: BLE001  (a finding, whatever it is)
                     if isinstance(e, KeyboardInterrupt):
                         raise
@@ -260,6 +267,7 @@ def run(args) -> int:
                                "traceback": traceback.format_exc()[-3000:]}
                 finally:
                     signal.setitimer(signal.ITIMER_REAL, 0)
+                    signal.setitimer(signal.ITIMER_PROF, 0)
                 state["inputs"] += 1
                 state["by_kind"][kind] += 1
                 if finding:
@@ -296,7 +304,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--inputs", type=int, default=100_000)
     p.add_argument("--compiles", type=int, default=2_000)
-    p.add_argument("--timeout", type=float, default=5.0, help="seconds one input may take (a full compile: 6x)")
+    p.add_argument("--timeout", type=float, default=5.0, help="CPU seconds one input may take (a full compile: 6x)")
+    p.add_argument("--wall", type=float, default=60.0, help="wall-clock seconds one input may take (a compile: 6x)")
     p.add_argument("--collision-samples", type=int, default=1000)
     p.add_argument("--memory", type=int, default=4096, help="address-space limit in MB (0: none)")
     p.add_argument("--batch", type=int, default=BATCH, help="inputs drawn per batch (keep it for a resumed campaign)")

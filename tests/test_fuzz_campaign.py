@@ -48,13 +48,18 @@ def test_crashes_and_hangs_are_recorded(tmp_path, monkeypatch):
         calls["n"] += 1
         if calls["n"] == 1:
             raise ZeroDivisionError("planted")
-        time.sleep(5)
+        if calls["n"] == 2:
+            while True:  # spins: CPU time
+                pass
+        time.sleep(5)  # blocks: wall-clock time
 
     monkeypatch.setattr(modc.compiler, "check_text", broken)
     monkeypatch.setattr(mod, "KINDS", ("yaml",))
-    rc = mod.main(["--state", str(tmp_path), "--batch", "2", "--inputs", "2", "--compiles", "0",
-                   "--timeout", "0.3", "--memory", "0"])
+    rc = mod.main(["--state", str(tmp_path), "--batch", "3", "--inputs", "3", "--compiles", "0",
+                   "--timeout", "0.3", "--wall", "1", "--memory", "0"])
     assert rc == 1
     found = [json.loads(line) for line in (tmp_path / "findings.jsonl").read_text().splitlines()]
-    assert [f["type"] for f in found] == ["traceback", "hang"]
+    assert [(f["type"], f["detail"]) for f in found[1:]] == [("hang", "over 0.3 s of CPU time"),
+                                                             ("hang", "over 1.0 s of wall-clock time")]
+    assert found[0]["type"] == "traceback"
     assert found[0]["detail"].startswith("ZeroDivisionError") and "planted" in found[0]["traceback"]
