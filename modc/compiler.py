@@ -2,13 +2,11 @@
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .diagnostics import Diagnostic, Span, codes
-from .files import REPORT, write_files
 from .model import Design
 from .model.lower import lower
 from .passes import Context, run_all
@@ -41,19 +39,40 @@ class InputError(Exception):
         self.diagnostic = diagnostic
 
 
+class SourceError(InputError):
+    """A file that was read but whose bytes are wrong (not UTF-8, too large): an error in the
+    file, exit 1 like any other (check_file reports it as the file's diagnostic)."""
+
+    def __init__(self, diagnostic: Diagnostic, text: str | None = None):
+        super().__init__(diagnostic)
+        self.text = text  # what can be shown of the file (undecodable bytes replaced), for the excerpt
+
+
 def read_source(path: str | os.PathLike) -> str:
+    """The text of an input file. Only regular files are read, and at most MAX_BYTES + 1 bytes of
+    them (a link to /dev/zero or a FIFO is refused at once). InputError when it cannot be read;
+    SourceError when it is too large or not UTF-8. A lone CR is read as a line end."""
+    from .files import read_bounded
+    from .syntax.parser import MAX_BYTES, normalize_newlines
+
     p = str(path)
     try:
-        data = Path(p).read_bytes()
+        data, size = read_bounded(p, MAX_BYTES)
     except OSError as e:
         raise InputError(codes.FILE_NOT_FOUND.at(Span.point(p), path=p, detail=e.strerror or str(e))) from None
+    if size > MAX_BYTES:
+        raise SourceError(codes.INPUT_TOO_LARGE.at(Span.point(p), what="the file", size=f"{size:,} bytes",
+                                                   limit=f"{MAX_BYTES:,} bytes"))
     try:
-        return data.decode("utf-8-sig")
+        return normalize_newlines(data.decode("utf-8-sig"))
     except UnicodeDecodeError as e:
-        line = data[: e.start].count(b"\n") + 1
-        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
-        diag = codes.BAD_ENCODING.at(Span(p, line, col, line, col + 1, e.start, e.start + 1), detail=f"byte 0x{data[e.start]:02x}")
-        raise InputError(diag) from None
+        # line and column in characters, counting line ends as the parser does
+        before = normalize_newlines(data[: e.start].decode("utf-8-sig"))
+        line = before.count("\n") + 1
+        col = len(before) - (before.rfind("\n") + 1) + 1
+        at = Span(p, line, col, line, col + 1, len(before), len(before) + 1)
+        diag = codes.BAD_ENCODING.at(at, detail=f"byte 0x{data[e.start]:02x}")
+        raise SourceError(diag, normalize_newlines(data.decode("utf-8-sig", errors="replace"))) from None
 
 
 def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
@@ -68,6 +87,9 @@ def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
 
 def check_text(text: str, path: str = "<string>", library: str | None = None, **options) -> Checked:
     """Parse, lower and run the passes. options go to the pass Context (analyses=…, torque_severity=…)."""
+    from .syntax.parser import normalize_newlines
+
+    text = normalize_newlines(text)  # the same length: offsets into the original stay right
     tree, diags = parse_text(text, path)
     ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
@@ -79,7 +101,12 @@ def check_file(path: str | os.PathLike, library: str | None = None, **options) -
     p = str(path)
     if not p.endswith((".mod", *YAML_SUFFIXES)):
         raise InputError(codes.UNSUPPORTED_INPUT.at(Span.point(p), path=p))
-    text = read_source(p)
+    try:
+        text = read_source(p)
+    except SourceError as e:
+        from .model import Design
+
+        return Checked(Design(path=p), [e.diagnostic], {p: e.text} if e.text is not None else {})
     return check_text(text, p, library, **options)
 
 
@@ -98,27 +125,39 @@ def build(checked: Checked, only: list[str] | None = None, **options) -> dict[st
     return dict(sorted(b.files.items()))
 
 
-def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False) -> None:
-    """Write files into a fresh directory next to OUT, then swap it in: OUT is either the old
-    tree or the complete new one, never half-written. Refuses to replace a directory modc did
-    not make unless force is set."""
+def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False,
+               inputs: Sequence[str | os.PathLike] = ()) -> None:
+    """Write files into a fresh directory next to OUT and exchange it with OUT atomically (see
+    modc.files): OUT is either the old tree or the complete new one, never half-written or
+    missing. OUT may be replaced when it is missing, empty, or exactly what modc wrote there
+    (its manifest lists every file, unchanged); otherwise only with force, which replaces it
+    whatever it holds. Never (even with force): OUT a plain file, the current directory or
+    one of its ancestors, or a directory holding one of `inputs`."""
+    from .files import ForeignOutput, replace_tree
+
     out = Path(out)
+    where = Span.point(str(out))
     if out.exists() and not out.is_dir():
-        raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
-    if out.is_dir() and any(out.iterdir()) and not (out / REPORT).is_file() and not force:
-        raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out)))
-    parent = out.resolve().parent
-    parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent))
+        raise InputError(codes.OUTPUT_NOT_MODC.at(where, path=str(out), found="it is not a directory"))
+    target = Path(os.path.abspath(out))
+    cwd = Path(os.getcwd())
+    if any(t == c or t in c.parents for t in (target, target.resolve()) for c in (cwd, cwd.resolve())):
+        what = "the current directory or one of its parents"
+        raise InputError(codes.OUTPUT_UNSAFE.at(where, path=str(out), what=what))
+    for src in inputs:
+        if target.resolve() in Path(os.path.abspath(src)).resolve().parents:
+            what = f"the directory holding the input {src}"
+            raise InputError(codes.OUTPUT_UNSAFE.at(where, path=str(out), what=what))
     try:
-        write_files(files, tmp)
-        old = None
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=parent))
-            os.replace(out, old / "tree")
-        os.replace(tmp, out)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        if not force and out.is_symlink():
+            _refuse_foreign(out, ["(OUT itself is a symbolic link)"])
+        replace_tree(files, target, force)
+    except ForeignOutput as e:
+        _refuse_foreign(out, e.entries)
+
+
+def _refuse_foreign(out: Path, entries: list[str]) -> None:
+    if not entries:
+        return
+    shown = ", ".join(entries[:5]) + (f" and {len(entries) - 5} more" if len(entries) > 5 else "")
+    raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out), found=f"it holds {shown}"))

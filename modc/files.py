@@ -1,18 +1,245 @@
-"""Output trees held in memory ({relative path: text or bytes}, as backends produce them)."""
+"""Output trees: held in memory ({relative path: text or bytes}, as backends produce them), and
+put on disk so that nothing of the user's is lost and OUT is never half-written.
+
+Every tree modc writes holds MANIFEST: each file's relative path and SHA-256. A directory is
+modc's output only if everything in it is listed there, unchanged; that is what may be replaced
+without --force. The new tree is written into a sibling directory named `.OUT.modc-new-XXXX`
+and exchanged with OUT in one renameat2(RENAME_EXCHANGE) call, so at every instant OUT is the
+complete old tree or the complete new one; the old tree, now under the sibling's name, is then
+removed. Siblings named `.OUT.modc-new-*` / `.OUT.modc-old-*` are left only by a killed run and
+are removed by the next run for the same OUT (under an flock on the parent directory, so two
+concurrent runs never remove each other's work).
+"""
 from __future__ import annotations
 
+import errno
+import hashlib
+import json
+import os
+import re
+import shutil
+import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-REPORT = "report.json"  # written by the report backend into every output tree; its presence marks a tree modc wrote
+REPORT = "report.json"  # written by the report backend into every output tree
+MANIFEST = ".modc-manifest.json"  # written by write_tree into every output tree: what modc wrote there
+MANIFEST_LIMIT = 16_000_000  # bytes: a manifest larger than this is not one modc wrote
+_SIBLING = "modc-new", "modc-old"
+
+
+def _encode(content: str | bytes) -> bytes:
+    return content if isinstance(content, bytes) else content.encode("utf-8")
+
+
+def manifest_text(files: Mapping[str, str | bytes]) -> str:
+    """The manifest of a tree (sorted, so the same tree gives the same bytes)."""
+    listing = {rel: hashlib.sha256(_encode(c)).hexdigest() for rel, c in sorted(files.items())}
+    return json.dumps({"modc-manifest": 1, "files": listing}, indent=2, sort_keys=True) + "\n"
 
 
 def write_files(files: Mapping[str, str | bytes], root: Path) -> None:
     """Write a tree under root exactly as `modc FILE -o OUT` does (UTF-8, '\\n' line ends)."""
     for rel, content in files.items():
+        parts = Path(rel).parts
+        if not parts or Path(rel).is_absolute() or ".." in parts or MANIFEST in parts[:1]:
+            # a backend bug, never the user's input (names pass the identifier rule): refuse to leave OUT
+            raise ValueError(f"refusing to write {rel!r}: not a relative path inside OUT")
         target = root / rel
         target.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
-            target.write_bytes(content)
+        target.write_bytes(_encode(content))
+
+
+def _hash_file(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _read_manifest(out: Path) -> dict[str, str] | None:
+    path = out / MANIFEST
+    try:
+        if path.is_symlink() or not path.is_file() or path.stat().st_size > MANIFEST_LIMIT:
+            return None
+        doc = json.loads(path.read_bytes())
+    except (OSError, ValueError):
+        return None
+    listing = doc.get("files") if isinstance(doc, dict) else None
+    if not isinstance(listing, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in listing.items()):
+        return None
+    return listing
+
+
+def foreign_entries(out: Path) -> list[str]:
+    """What in directory `out` modc did not write, or changed since: paths relative to out
+    ("name (modified)" for a changed file). Empty: out is empty or exactly modc's output.
+    Symbolic links are never followed: a link is itself foreign."""
+    entries: list[tuple[str, Path]] = []
+    for dirpath, dirnames, filenames in os.walk(out):
+        base = Path(dirpath)
+        for name in sorted(dirnames):
+            if (base / name).is_symlink():
+                filenames.append(name)  # a link to a directory: an entry, not a place to walk into
+        dirnames[:] = sorted(d for d in dirnames if not (base / d).is_symlink())
+        entries += [((base / f).relative_to(out).as_posix(), base / f) for f in sorted(filenames)]
+    if not entries:
+        return []
+    listing = _read_manifest(out)
+    if listing is None:
+        return sorted(rel for rel, _ in entries)
+    bad = []
+    for rel, path in sorted(entries):
+        if rel == MANIFEST:
+            continue
+        if rel not in listing or path.is_symlink() or not path.is_file():
+            bad.append(rel)
+        elif _hash_file(path) != listing[rel]:
+            bad.append(f"{rel} (modified)")
+    return bad
+
+
+def _sibling_pattern(name: str) -> re.Pattern[str]:
+    return re.compile(rf"\.{re.escape(name)}\.(?:{'|'.join(_SIBLING)})-[A-Za-z0-9_]+")
+
+
+def remove_leftovers(out: Path) -> list[Path]:
+    """Remove the siblings a killed run left next to out (only directories with modc's names)."""
+    removed: list[Path] = []
+    pattern = _sibling_pattern(out.name)
+    try:
+        names = os.listdir(out.parent)
+    except OSError:
+        return removed
+    for name in names:
+        path = out.parent / name
+        if pattern.fullmatch(name) and path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+            removed.append(path)
+    return removed
+
+
+def _renameat2():
+    import ctypes
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        fn = libc.renameat2
+    except (OSError, AttributeError):
+        return None
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    fn.restype = ctypes.c_int
+    return fn
+
+
+AT_FDCWD, RENAME_EXCHANGE = -100, 2
+
+
+def exchange(a: Path, b: Path) -> bool:
+    """Swap two directories atomically (Linux renameat2(RENAME_EXCHANGE)). False when the
+    system or file system does not support it; raises OSError for any other failure."""
+    import ctypes
+
+    fn = _renameat2()
+    if fn is None:
+        return False
+    if fn(AT_FDCWD, os.fsencode(a), AT_FDCWD, os.fsencode(b), RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _lock(directory: Path) -> int:
+    """An exclusive flock on the directory (released when the fd is closed or the process dies).
+    Where the file system has no locks (some network mounts) runs are simply not serialised."""
+    import fcntl
+
+    fd = os.open(directory, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+    except OSError:
+        pass
+    return fd
+
+
+def replace_tree(files: Mapping[str, str | bytes], out: Path, force: bool) -> None:
+    """Put files (and their manifest) at out. The caller has decided that out may be replaced
+    (it is missing, empty, modc's own output, or force is set); this re-checks that under the
+    lock and raises ForeignOutput otherwise."""
+    parent = out.parent
+    parent.mkdir(parents=True, exist_ok=True)
+    fd = _lock(parent)
+    try:
+        remove_leftovers(out)
+        if not force and out.is_dir() and not out.is_symlink():
+            bad = foreign_entries(out)
+            if bad:
+                raise ForeignOutput(bad)
+        new = Path(tempfile.mkdtemp(prefix=f".{out.name}.{_SIBLING[0]}-", dir=parent))
+        try:
+            # the manifest first: a run killed while writing leaves a sibling whose every file is listed
+            (new / MANIFEST).write_text(manifest_text(files), encoding="utf-8")
+            write_files(files, new)
+            os.chmod(new, 0o777 & ~_umask())
+            if not os.path.lexists(out):
+                os.rename(new, out)
+                return
+            if exchange(new, out):
+                old = new  # the old tree now sits under the sibling's name
+            else:  # no RENAME_EXCHANGE (old kernel, some network file systems): two renames
+                old = Path(tempfile.mkdtemp(prefix=f".{out.name}.{_SIBLING[1]}-", dir=parent))
+                os.rename(out, old / "tree")
+                os.rename(new, out)
+        except BaseException:
+            shutil.rmtree(new, ignore_errors=True)
+            raise
+        if old.is_symlink() or not old.is_dir():
+            old.unlink()  # out was a link or a file (--force): remove the link, never its target
         else:
-            target.write_text(content, encoding="utf-8", newline="\n")
+            shutil.rmtree(old, ignore_errors=True)
+    finally:
+        os.close(fd)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+class ForeignOutput(Exception):
+    """out holds files modc did not write (or changed since)."""
+
+    def __init__(self, entries: list[str]):
+        super().__init__(", ".join(entries))
+        self.entries = entries
+
+
+class NotAFile(OSError):
+    """An input path that is not a regular file (a device, a FIFO, a socket, a directory)."""
+
+
+def read_bounded(path: str | os.PathLike, limit: int) -> tuple[bytes, int]:
+    """At most limit + 1 bytes of a regular file, and its size. Devices (a link to /dev/zero),
+    FIFOs and sockets are refused before anything is read, and opening never blocks."""
+    import stat
+
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = "a directory" if stat.S_ISDIR(st.st_mode) else "not a regular file"
+            raise NotAFile(errno.EINVAL, kind, str(path))
+        chunks, got = [], 0
+        while got <= limit:
+            block = os.read(fd, min(1 << 20, limit + 1 - got))
+            if not block:
+                break
+            chunks.append(block)
+            got += len(block)
+        return b"".join(chunks), max(st.st_size, got)
+    finally:
+        os.close(fd)

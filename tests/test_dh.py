@@ -171,7 +171,8 @@ def test_dh2mod_cli_json_shape(tmp_path):
 @pytest.mark.parametrize("text, code, line, col", [
     ("a,b,c\n0,0,0\n", "dh-csv-header", 1, 1),
     ("a,alpha,d,theta\n0,zero,0.1,0\n", "dh-csv-value", 2, 3),
-    ("a,alpha,d,theta\n0,nan,0.1,0\n", "dh-csv-value", 2, 3),
+    ("a,alpha,d,theta\n0,nan,0.1,0\n", "not-finite", 2, 3),  # the same check as a dh block
+    ("a,alpha,d,theta\n1e308,0,0.1,0\n", "out-of-range", 2, 1),
     ("a,alpha,d,theta\n0,0,0.1\n", "dh-csv-value", 2, 1),
     ("a,alpha,d,theta\n", "dh-empty", 1, 1),
     ("a,alpha,d,theta\n" + "0,0,0.1,0\n" * 7, "too-many-units", 8, 1),

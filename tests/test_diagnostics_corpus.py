@@ -32,8 +32,7 @@ fails until it is there.
 "Reported on line L" means ``diagnostic.span.line == L`` (for ``expect-in``: on line L of FILE). Each case is checked the way the
 product checks it (``check_file`` for .mod/.yaml, ``convert_table`` for .csv) and the set of
 (line, severity, code) reported must equal the set expected: nothing missing, nothing extra.
-A file ``check_file`` rejects with ``InputError`` (bad-encoding) counts as reporting that one
-diagnostic. Lines are counted on the raw bytes decoded with replacement characters, so a corpus
+A file that is not UTF-8 is reported by ``check_file`` as one bad-encoding diagnostic (exit 1). Lines are counted on the raw bytes decoded with replacement characters, so a corpus
 file need not be valid UTF-8. The same expectations are checked through the command line
 (``modc lint --format json``, ``modc check`` for cases with analyses, ``modc dh2mod`` for CSV),
 with its exit code.
@@ -55,7 +54,7 @@ from pathlib import Path
 
 import pytest
 
-from modc.compiler import InputError, check_file, check_text, read_source, write_tree
+from modc.compiler import InputError, SourceError, check_file, check_text, read_source, write_tree
 from modc.diagnostics import REGISTRY, Diagnostic
 from modc.diagnostics.render import render_json, render_text
 
@@ -76,6 +75,7 @@ ANALYSIS_CODES = {"torque-over-peak", "torque-over-nominal", "epsilon-disagrees"
 FUNCTION_CASES = {
     "file-not-found": "test_file_not_found",
     "output-not-modc": "test_output_not_modc",
+    "output-unsafe": "test_output_unsafe",
     "unsupported-input": "test_unsupported_input",
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",
@@ -102,7 +102,10 @@ YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
 
 
 def source_text(path: Path) -> str:
-    return path.read_bytes().decode("utf-8-sig", errors="replace")
+    """The text lines are counted in: undecodable bytes replaced, a lone CR a line end (as modc counts)."""
+    from modc.syntax.parser import normalize_newlines
+
+    return normalize_newlines(path.read_bytes().decode("utf-8-sig", errors="replace"))
 
 
 def pinned(path: Path) -> list[tuple[int | str, str, str, str | None]]:
@@ -132,7 +135,9 @@ def refresh_messages(path: Path, diags: list[Diagnostic]) -> None:
     by_key: dict[tuple[int | str, str, str], list[str]] = {}
     for d in sorted(diags, key=lambda d: (d.span.line, d.span.col)):
         by_key.setdefault((where(path, d.span.file, d.span.line), d.severity.value, d.code), []).append(d.message)
-    raw = path.read_bytes().split(b"\n")
+    # lines as the product counts them (CR LF, lone CR or LF), their ends kept
+    parts = re.split(rb"(\r\n|\r|\n)", path.read_bytes())
+    raw, ends = parts[0::2], parts[1::2] + [b""]
     for i, chunk in enumerate(raw):
         line = chunk.decode("utf-8", errors="replace")
         first = _EXPECT.search(line)
@@ -155,7 +160,7 @@ def refresh_messages(path: Path, diags: list[Diagnostic]) -> None:
 
         if chunk.endswith(tail.encode("utf-8")):
             raw[i] = chunk[: len(chunk) - len(tail.encode("utf-8"))] + _EXPECT.sub(items, tail).encode("utf-8")
-    path.write_bytes(b"\n".join(raw))
+    path.write_bytes(b"".join(line + end for line, end in zip(raw, ends, strict=True)))
 
 
 def xfail_reason(path: Path) -> str | None:
@@ -409,6 +414,8 @@ def text_heads(stderr: str, path: Path) -> set[tuple[int, str, str]]:
 def _exit_code_for(path: Path, got: set) -> int:
     try:
         read_source(path)
+    except SourceError:  # not UTF-8 or too large: an error in the file
+        return 1
     except InputError:
         return 2
     return 1 if any(sev == "error" for _, sev, _ in got) else 0
@@ -491,7 +498,7 @@ def test_output_not_modc(tmp_path):
     empty.mkdir()
     write_tree(files, empty)
     write_tree({"report.json": "{}"}, empty)
-    assert sorted(p.name for p in empty.iterdir()) == ["report.json"]
+    assert sorted(p.name for p in empty.iterdir()) == [".modc-manifest.json", "report.json"]
     write_tree(files, foreign, force=True)
     assert not (foreign / "thesis.tex").exists()
 
@@ -508,6 +515,17 @@ def test_output_not_modc_from_the_command_line(tmp_path):
     assert p.returncode == 2, p.stderr
     assert "error[output-not-modc]" in p.stderr and "Traceback" not in p.stderr
     assert [x.name for x in out.iterdir()] == ["notes.txt"]
+
+
+def test_output_unsafe(tmp_path, monkeypatch):
+    """OUT the working directory, a parent of it, or the directory of the input: never replaced."""
+    monkeypatch.chdir(tmp_path)
+    for out, inputs in ((".", ()), ("..", ()), ("src", ["src/a.mod"])):
+        with pytest.raises(InputError) as e:
+            write_tree({"a.txt": "x"}, out, force=True, inputs=inputs)
+        d = e.value.diagnostic
+        assert d.code == "output-unsafe" and d.hint and out in d.message
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_unsupported_input(tmp_path, capsys):
@@ -566,11 +584,13 @@ def test_bad_payload(tmp_path, capsys):
 def test_bad_encoding_points_at_the_byte(tmp_path):
     src = tmp_path / "latin1.mod"
     src.write_bytes("robot farm {\n    chain H1 - L1   # 45° \n}\n".encode("latin-1"))
-    with pytest.raises(InputError) as e:
-        check_file(src)
-    d = e.value.diagnostic
+    [d] = check_file(src).diagnostics
     assert d.code == "bad-encoding" and "0xb0" in d.message
     assert (d.span.line, d.span.col) == (2, 25)
+    # columns in characters, lines ended by CR alone counted
+    src.write_bytes("robot farm {\r    chain H1 - L1 # é°\r}\n".encode("utf-8").replace("°".encode(), b"\xb0"))
+    [d] = check_file(src).diagnostics
+    assert (d.code, d.span.line, d.span.col) == ("bad-encoding", 2, 22)
 
 
 def test_utf8_bom_is_accepted(tmp_path):

@@ -65,7 +65,9 @@ def assert_sane(text: str, path: str = "fuzz.mod", fuzzing: bool = False) -> Che
         if fuzzing and _known_crash(e):
             assume(False)
         raise AssertionError(f"check_text raised {type(e).__name__}: {e}\ninput: {text[:2000]!r}") from e
-    n_lines = text.count("\n") + 1  # Lark's count; a diagnostic at end of file is on the last line
+    from modc.syntax.parser import normalize_newlines
+
+    n_lines = normalize_newlines(text).count("\n") + 1  # modc's count (a lone CR ends a line too)
     for d in c.diagnostics:
         assert d.code in REGISTRY, d
         assert d.severity == REGISTRY[d.code].severity, d

@@ -120,11 +120,14 @@ def dh2mod_cmd(
     library: LibraryOpt = None,
 ):
     """Convert a standard DH table into a module chain (paper section 4.2); .mod text on stdout."""
-    from ..compiler import InputError, read_source
+    from ..compiler import InputError, SourceError, read_source
     from ..dh.convert_file import convert_table
 
     try:
         text = read_source(table)
+    except SourceError as e:  # an error in the table (not UTF-8, too large): exit 1
+        _print_diagnostics([e.diagnostic], {table: e.text} if e.text is not None else {})
+        raise typer.Exit(EXIT_ERRORS) from None
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
         raise typer.Exit(EXIT_USAGE)

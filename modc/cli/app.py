@@ -59,20 +59,28 @@ LibraryOpt = Annotated[
 ]
 
 
-def _expand(paths: list[str]) -> list[str]:
+def _expand(paths: list[str], prog: str = "modc") -> list[str]:
     """Files as given; directories searched for *.mod; glob patterns (also '**') expanded here,
-    so quoted patterns work in CI shells. Sorted and de-duplicated, for stable output."""
+    so quoted patterns work in CI shells. Sorted and de-duplicated, for stable output. A directory
+    without .mod files or a pattern matching no file ends the command (exit 2): a mistyped CI
+    glob must not pass as "0 files, no errors"."""
     import glob
     from pathlib import Path
 
     out: list[str] = []
     for p in paths:
         if Path(p).is_dir():
-            out += sorted(str(f) for f in Path(p).rglob("*.mod"))
+            found = sorted(str(f) for f in Path(p).rglob("*.mod"))
+            what = "directory holds no .mod file"
         elif glob.has_magic(p):
-            out += sorted(f for f in glob.glob(p, recursive=True) if Path(f).is_file())
+            found = sorted(f for f in glob.glob(p, recursive=True) if Path(f).is_file())
+            what = "pattern matches no file"
         else:
-            out.append(p)
+            found, what = [p], ""
+        if not found:
+            _err(f"{prog}: {p}: the {what}")
+            raise typer.Exit(EXIT_USAGE)
+        out += found
     return list(dict.fromkeys(out))
 
 

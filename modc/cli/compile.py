@@ -37,7 +37,7 @@ def compile_cmd(
     out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
     library: LibraryOpt = None,
     only: OnlyOpt = None,
-    force: Annotated[bool, typer.Option(help="replace OUT even if modc did not create it")] = False,
+    force: Annotated[bool, typer.Option(help="replace OUT whatever it holds (deletes files modc did not write)")] = False,
     collision_samples: SamplesOpt = 10_000,
     seed: SeedOpt = 0,
     smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
@@ -87,7 +87,7 @@ def compile_cmd(
     ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
     files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     with usage_errors("compile", writing=out):
-        write_tree(files, out, force=force)
+        write_tree(files, out, force=force, inputs=[file])
     if verbose:
         for rel in files:
             _err(f"  wrote {out.rstrip('/')}/{rel}")

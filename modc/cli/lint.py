@@ -50,7 +50,7 @@ def lint_cmd(
 
     Verbosity.quiet = quiet
     diags, sources, io_error = [], {}, False
-    paths = _expand(files)
+    paths = _expand(files, "modc lint")
     for path in paths:
         try:
             c = check_file(path, library)
@@ -85,17 +85,22 @@ def fmt_cmd(
     ] = False,
 ):
     """Rewrite .mod files in the canonical layout (comments kept, meaning unchanged)."""
-    from ..compiler import YAML_SUFFIXES, InputError, read_source
+    from ..compiler import YAML_SUFFIXES, InputError, SourceError, read_source
     from ..syntax.format import FormatterBug, format_text, rewrite_file
 
     diags, sources, io_error, changed = [], {}, False, []
-    for path in _expand(files):
+    for path in _expand(files, "modc fmt"):
         if path.endswith(YAML_SUFFIXES):
             _err(f"modc fmt: {path}: only .mod files are formatted")
             io_error = True
             continue
         try:
             text = read_source(path)
+        except SourceError as e:  # an error in the file: reported like a syntax error
+            diags.append(e.diagnostic)
+            if e.text is not None:
+                sources[path] = e.text
+            continue
         except InputError as e:
             diags.append(e.diagnostic)
             io_error = True

@@ -1,10 +1,9 @@
 """Read a DH table from CSV (header a,alpha,d,theta; metres and radians), with cell spans."""
 from __future__ import annotations
 
-import math
-
 from ..diagnostics import Diagnostic, Span, codes
 from ..model import DHRow
+from ..model.lower import DH_PARAMS, magnitude_error
 
 COLUMNS = ("a", "alpha", "d", "theta")
 REQUIRED = ("a", "alpha", "d")
@@ -46,8 +45,9 @@ def read_csv(text: str, path: str) -> tuple[list[DHRow], list[Diagnostic]]:
                 diags.append(codes.DH_CSV_VALUE.at(span, row=row_no, column=name, problem=f"{cell.strip()!r} is not a number"))
                 ok = False
                 continue
-            if not math.isfinite(v):
-                diags.append(codes.DH_CSV_VALUE.at(span, row=row_no, column=name, problem=f"{cell.strip()} is not finite"))
+            bad = magnitude_error([v], f"DH {name} in row {row_no}", span, DH_PARAMS[name])
+            if bad is not None:  # the check a dh block in a .mod file gets
+                diags.append(bad)
                 ok = False
                 continue
             values[name] = v

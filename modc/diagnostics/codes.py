@@ -229,7 +229,11 @@ NO_DESIGN = _register("no-design", E, "`modc design` found no chain that does ev
 FILE_NOT_FOUND = _register("file-not-found", E, "an input file that cannot be read",
     "cannot read '{path}': {detail}", "check the path")
 OUTPUT_NOT_MODC = _register("output-not-modc", E, "an output directory that modc did not create",
-    "'{path}' exists and was not written by modc", "choose a new or empty directory, or pass --force to replace it")
+    "'{path}' is not modc's output: {found}",
+    "modc replaces only a directory it wrote (listed, unchanged, in its .modc-manifest.json); choose a new or "
+    "empty directory, or pass --force to replace it and everything in it")
+OUTPUT_UNSAFE = _register("output-unsafe", E, "an output directory modc never replaces, even with --force",
+    "'{path}' is {what}; replacing it would delete it", "write the output into a new directory, e.g. -o build/out")
 UNSUPPORTED_INPUT = _register("unsupported-input", E, "an input file type modc cannot read",
     "'{path}' is neither .mod nor .yaml/.yml", "pass a .mod file or its YAML form")
 

@@ -59,7 +59,8 @@ class LineIndex:
     def __init__(self, text: str, encoding: str = UTF16):
         self.text = text
         self.encoding = encoding if encoding in (UTF8, UTF16, UTF32) else UTF16
-        self.starts = [0] + [m.end() for m in re.finditer("\n", text)]
+        # line ends as LSP counts them and modc reads them: LF, CRLF, and a lone CR
+        self.starts = [0] + [m.end() for m in re.finditer(r"\r(?!\n)|\n", text)]
 
     def line_text(self, line: int) -> str:
         """Line (0-based) without its line break ('' beyond the end)."""

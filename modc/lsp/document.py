@@ -168,7 +168,7 @@ def block_joints(block: Block) -> list[tuple[str, tuple[int, int]]] | None:
 
 def joint_number(text: str) -> int | None:
     """N of a `joint_N` name."""
-    m = re.fullmatch(r"joint_(\d+)", text)
+    m = re.fullmatch(r"joint_([0-9]{1,9})", text)  # bounded: int() refuses 4,300+ digits
     return int(m.group(1)) if m is not None else None
 
 

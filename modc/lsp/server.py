@@ -18,6 +18,7 @@ import functools
 import logging
 import sys
 import traceback
+from typing import BinaryIO, cast
 from urllib.parse import unquote
 
 from lsprotocol import types
@@ -244,8 +245,11 @@ def formatting(ls: ModcServer, params: types.DocumentFormattingParams):
 def serve() -> None:
     """Run the server on stdin/stdout until the client says exit (or closes the pipe)."""
     logging.basicConfig(level=logging.WARNING, format="modc lsp: %(message)s")
+    from .transport import FramedReader
+
     stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # a stray print() anywhere must never corrupt the protocol stream
-    server.start_io(stdin, stdout)
+    # only well-formed frames reach pygls (it reads through readline() and read(n), all FramedReader has)
+    server.start_io(cast(BinaryIO, FramedReader(stdin)), stdout)
     if server.exit_code:
         sys.exit(server.exit_code)

@@ -197,8 +197,10 @@ class Library(_Frozen):
     def split(self, name: str) -> tuple[str, int] | None:
         """'H4' -> ('H', 4) if the library defines it."""
         for v in sorted(self.variants, key=len, reverse=True):
-            if name.startswith(v) and name[len(v):].isdigit():
-                k = int(name[len(v):])
+            digits = name[len(v):]
+            # ASCII and short: int() refuses 4,300+ digits and some Unicode digits ('²')
+            if name.startswith(v) and digits.isascii() and digits.isdigit() and len(digits) <= 9:
+                k = int(digits)
                 if k in self.units:
                     return v, k
         return None
@@ -248,17 +250,27 @@ def _where(text: str, file: str, loc: tuple) -> Span:
     return _node_span(file, node if isinstance(node, yaml.ScalarNode) or key is None else key)
 
 
+MAX_LIBRARY_BYTES = 1_000_000  # the shipped libraries are 4 kB; a 6 MB one took 30 s and 550 MB
+
+
 @cache
 def _load_path(path: str, mtime: float) -> Library:
     import yaml
 
     from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
 
+    from ..files import read_bounded
+
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
+        if size > MAX_LIBRARY_BYTES:
+            raise LibraryError(f"the file is too large ({size:,} bytes; the limit is {MAX_LIBRARY_BYTES:,})")
+        text = raw.decode("utf-8")
         data = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     except (OSError, UnicodeDecodeError) as e:
         raise LibraryError(str(e)) from None
+    except RecursionError:
+        raise LibraryError("the YAML is nested too deeply") from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
         span = Span.point(path, mark.line + 1, mark.column + 1, mark.index) if mark else None

@@ -17,6 +17,20 @@ DH_PARAMS = {"a": "a length", "alpha": "an angle", "d": "a length", "theta": "an
 ONCE = ("chain", "dh", "library", "base", "tool", "payload")
 
 
+def magnitude_error(values, what: str, span, kind: str | None = None, scale: float = 1.0) -> Diagnostic | None:
+    """not-finite or out-of-range for values (in the unit `scale` converts to SI), else None.
+    The one range check of every quantity: .mod and YAML text, and DH tables read by dh2mod."""
+    if not all(math.isfinite(v) for v in values):
+        return codes.NOT_FINITE.at(span, what=what)
+    if kind is not None:
+        limit = Q.LIMIT[kind]
+        worst = max((abs(v * scale) for v in values), default=0.0)
+        if worst > limit:
+            unit = Q.SI[kind]
+            return codes.OUT_OF_RANGE.at(span, what=what, value=f"{worst:g} {unit}", limit=f"{limit:g} {unit}")
+    return None
+
+
 class _Lowerer:
     def __init__(self, diags: list[Diagnostic]):
         self.diags = diags
@@ -47,17 +61,10 @@ class _Lowerer:
         return None
 
     def _finite(self, values, what, span, kind: str | None = None, scale: float = 1.0) -> bool:
-        if not all(math.isfinite(v) for v in values):
-            self.error(codes.NOT_FINITE.at(span, what=what))
-            return False
-        if kind is not None:
-            limit = Q.LIMIT[kind]
-            worst = max((abs(v * scale) for v in values), default=0.0)
-            if worst > limit:
-                unit = Q.SI[kind]
-                self.error(codes.OUT_OF_RANGE.at(span, what=what, value=f"{worst:g} {unit}", limit=f"{limit:g} {unit}"))
-                return False
-        return True
+        d = magnitude_error(values, what, span, kind, scale)
+        if d is not None:
+            self.error(d)
+        return d is None
 
     def quantity(self, q: ast.Quantity, kind: str, what: str) -> float | None:
         s = self._scale(q.unit, kind, what, q.span)

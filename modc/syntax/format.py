@@ -299,20 +299,26 @@ def format_text(text: str, path: str = "<string>") -> tuple[str | None, list[Dia
     that does not parse is never formatted. On success the list is empty (warnings such as an
     empty file are lint's business, not fmt's). Raises FormatterBug if the result would not lex
     into the same tokens and comments (checked on every call)."""
-    from .parser import parse
-
-    _, diags = parse(text, path)
-    errors = [d for d in diags if d.is_error]
-    if errors:
-        return None, errors
     from lark.exceptions import LarkError
 
-    out, toks, comments = _layout(text)
-    try:
-        _, toks2, comments2 = _layout(out)
-    except LarkError as e:
-        raise FormatterBug(f"formatting {path} would make it unparsable ({e.__class__.__name__}); "
-                           "the file is left as it is") from None
+    from .parser import collector_paused, normalize_newlines, parse, too_large
+
+    big = too_large(text, path)
+    if big is not None:
+        return None, [big]
+    text = normalize_newlines(text)
+    with collector_paused():
+        try:  # one parse when the text is fine; the checker's parse only to explain why it is not
+            out, toks, comments = _layout(text)
+        except LarkError:
+            errors = [d for d in parse(text, path)[1] if d.is_error]
+            assert errors, "the formatter's grammar and the parser's disagree"
+            return None, errors
+        try:
+            _, toks2, comments2 = _layout(out)
+        except LarkError as e:
+            raise FormatterBug(f"formatting {path} would make it unparsable ({e.__class__.__name__}); "
+                               "the file is left as it is") from None
     if toks2 != toks or comments2 != comments:
         raise FormatterBug(f"formatting {path} would change its tokens or comments; the file is left as it is")
     return out, []

@@ -5,7 +5,7 @@ import re
 
 from ..diagnostics import Diagnostic, Span, codes
 from . import ast
-from .parser import MAX_BYTES
+from .parser import too_large
 
 
 def _span(file: str, node) -> Span:
@@ -257,11 +257,15 @@ def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
     from .document import Document
 
     diags: list[Diagnostic] = []
-    if len(text) > MAX_BYTES:
-        diags.append(codes.INPUT_TOO_LARGE.at(Span.point(file), what="the file", size=f"{len(text):,} characters", limit=f"{MAX_BYTES:,}"))
-        return ast.File(file, ()), diags
+    big = too_large(text, file)
+    if big is not None:
+        return ast.File(file, ()), [big]
     try:
         node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except RecursionError:  # nesting hundreds deep: PyYAML composes recursively
+        detail = "nested hundreds of levels deep (a robot file needs five)"
+        diags.append(codes.YAML_SYNTAX.at(Span.point(file), detail=detail))
+        return ast.File(file, ()), diags
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)

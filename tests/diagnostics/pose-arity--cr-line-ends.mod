@@ -1,0 +1,1 @@
+# Old Mac line ends (CR only): every line is counted.# expect-line 5: error[pose-arity] pose 'home' has 2 values; robot 'farm' has 3 jointsrobot farm {    chain H1 - L4(port=45deg) - L1  # a comment ends at its CR    pose home (0, 30) deg}
