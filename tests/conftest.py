@@ -10,7 +10,9 @@ from modc.compiler import Checked, build, check_file, check_text, write_tree
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = sorted((ROOT / "examples").glob("*.mod"))
 # examples with at least one arm (farm_cell.mod holds only a `design` problem)
-ARM_EXAMPLES = [p for p in EXAMPLES if any(ln.startswith("robot ") for ln in p.read_text(encoding="utf-8").splitlines())]
+ARM_EXAMPLES = [
+    p for p in EXAMPLES if any(ln.startswith("robot ") for ln in p.read_text(encoding="utf-8").splitlines())
+]
 
 
 def checked_ok(text: str, path: str = "t.mod") -> Checked:

@@ -19,7 +19,14 @@ from modc.kinematics import Chain
 PI = math.pi
 # Paper section 5.1, Table 4 (a m, alpha rad, d m)
 EXAMPLE_A = [(0, -PI / 2, 0.148), (0.3, 0.26, 0), (0.3, 0, 0), (0.3, 0.26, 0), (0.3, PI / 2, 0), (0, 0, 0.075)]
-EXAMPLE_B = [(0, -PI / 2, 0.148), (0.3, 2.36, 0), (0.3, 2.36, 0), (0, -PI / 2, 0.148), (0, -PI / 2, 0.148), (0, 0, 0.075)]
+EXAMPLE_B = [
+    (0, -PI / 2, 0.148),
+    (0.3, 2.36, 0),
+    (0.3, 2.36, 0),
+    (0, -PI / 2, 0.148),
+    (0, -PI / 2, 0.148),
+    (0, 0, 0.075),
+]
 # Paper Table 3 with the symbolic values made concrete (a = 0.22 m, d = 0.147 m, alpha2 = 45°,
 # RAVEN-II's 75° and 52°)
 TABLE3 = {
@@ -55,7 +62,7 @@ def test_example_a_follows_the_rules_where_the_paper_contradicts_them():
     the rule there; every other unit is as published."""
     got = sequence(EXAMPLE_A).split("-")
     published = "H1-H4-H4-L1-L4-L2".split("-")
-    assert [i for i, (g, p) in enumerate(zip(got, published)) if g != p] == [3]
+    assert [i for i, (g, p) in enumerate(zip(got, published, strict=True)) if g != p] == [3]
     assert got[3] == "L4" and EXAMPLE_A[3][0] != 0
 
 
@@ -101,8 +108,11 @@ def _twists_within_half_step(rows, fit):
     return c
 
 
-@pytest.mark.parametrize("rows", [EXAMPLE_A, EXAMPLE_B] + [TABLE3[k][0] for k in ("planar", "spatial", "skew", "wrist", "raven")],
-                         ids=["A", "B", "planar", "spatial", "skew", "wrist", "raven"])
+@pytest.mark.parametrize(
+    "rows",
+    [EXAMPLE_A, EXAMPLE_B] + [TABLE3[k][0] for k in ("planar", "spatial", "skew", "wrist", "raven")],
+    ids=["A", "B", "planar", "spatial", "skew", "wrist", "raven"],
+)
 @pytest.mark.parametrize("fit", [False, True])
 def test_realised_twists_measured_in_pinocchio(rows, fit):
     _twists_within_half_step(rows, fit)
@@ -153,7 +163,9 @@ def test_dh_block_in_mod_equals_dh2mod():
 
 def test_dh_command_json(tmp_path):
     (tmp_path / "b.mod").write_text(convert(EXAMPLE_B, fit=True)[0])
-    r = subprocess.run([sys.executable, "-m", "modc", "dh", str(tmp_path / "b.mod"), "--json"], capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", "dh", str(tmp_path / "b.mod"), "--json"], capture_output=True, text=True
+    )
     assert r.returncode == 0, r.stderr
     joints = json.loads(r.stdout)["robots"][0]["joints"]
     assert [round(j["realised"]["a"], 9) for j in joints] == [0, 0.3, 0.3, 0, 0, 0]
@@ -161,11 +173,17 @@ def test_dh_command_json(tmp_path):
 
 def test_dh2mod_cli_json_shape(tmp_path):
     (tmp_path / "b.csv").write_text(csv(EXAMPLE_B))
-    r = subprocess.run([sys.executable, "-m", "modc", "dh2mod", str(tmp_path / "b.csv"), "--json"], capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "modc", "dh2mod", str(tmp_path / "b.csv"), "--json"], capture_output=True, text=True
+    )
     assert r.returncode == 0
     doc = json.loads(r.stdout)
     assert doc["sequence"] == "H1-H4-H4-L2-L2-L2"
-    assert set(doc["joints"][0]) == {"requested", "realised"} and set(doc["joints"][0]["realised"]) == {"a", "alpha", "d"}
+    assert set(doc["joints"][0]) == {"requested", "realised"} and set(doc["joints"][0]["realised"]) == {
+        "a",
+        "alpha",
+        "d",
+    }
 
 
 @pytest.mark.parametrize("text, code, line, col", [

@@ -29,10 +29,12 @@ The message text may be left out (``# expect: error[code]``) while writing a cas
 the comments (the refresh path; review the diff), and ``test_every_expectation_pins_its_message``
 fails until it is there.
 
-"Reported on line L" means ``diagnostic.span.line == L`` (for ``expect-in``: on line L of FILE). Each case is checked the way the
-product checks it (``check_file`` for .mod/.yaml, ``convert_table`` for .csv) and the set of
-(line, severity, code) reported must equal the set expected: nothing missing, nothing extra.
-A file that is not UTF-8 is reported by ``check_file`` as one bad-encoding diagnostic (exit 1). Lines are counted on the raw bytes decoded with replacement characters, so a corpus
+"Reported on line L" means ``diagnostic.span.line == L`` (for ``expect-in``: on line L of FILE).
+Each case is checked the way the product checks it (``check_file`` for .mod/.yaml,
+``convert_table`` for .csv) and the set of (line, severity, code) reported must equal the set
+expected: nothing missing, nothing extra.
+A file that is not UTF-8 is reported by ``check_file`` as one bad-encoding diagnostic (exit 1).
+Lines are counted on the raw bytes decoded with replacement characters, so a corpus
 file need not be valid UTF-8. The same expectations are checked through the command line
 (``modc lint --format json``, ``modc check`` for cases with analyses, ``modc dh2mod`` for CSV),
 with its exit code.
@@ -588,7 +590,7 @@ def test_bad_encoding_points_at_the_byte(tmp_path):
     assert d.code == "bad-encoding" and "0xb0" in d.message
     assert (d.span.line, d.span.col) == (2, 25)
     # columns in characters, lines ended by CR alone counted
-    src.write_bytes("robot farm {\r    chain H1 - L1 # é°\r}\n".encode("utf-8").replace("°".encode(), b"\xb0"))
+    src.write_bytes("robot farm {\r    chain H1 - L1 # é°\r}\n".encode().replace("°".encode(), b"\xb0"))
     [d] = check_file(src).diagnostics
     assert (d.code, d.span.line, d.span.col) == ("bad-encoding", 2, 22)
 
@@ -707,8 +709,10 @@ def test_no_design(tmp_path, capsys):
     """`modc design` with no chain that does the tasks: exit 1, a diagnostic on the design block
     saying what came closest, nothing written."""
     src = tmp_path / "far.mod"
-    src.write_text("design cell {\n    target near at (0.3, 0, 0.2) m\n    target far at (3, 0, 0) m\n    units 2 to 3\n}\n",
-                   encoding="utf-8")
+    src.write_text(
+        "design cell {\n    target near at (0.3, 0, 0.2) m\n    target far at (3, 0, 0) m\n    units 2 to 3\n}\n",
+        encoding="utf-8",
+    )
     out = tmp_path / "out"
     rc, stdout, err = run_cli(capsys, "design", str(src), "-o", str(out))
     assert rc == 1, err

@@ -37,7 +37,9 @@ YAML_FORM = importlib.util.find_spec("modc.syntax.yaml_form") is not None
 EXAMPLE_FILES = sorted((ROOT / "examples").glob("*.mod"))
 EXAMPLES = {p.name: p.read_bytes() for p in EXAMPLE_FILES}
 
-FUZZ = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+FUZZ = settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large]
+)
 
 # Known crashes (bugs reported to the lead, each pinned by an xfail test below): a crash raised
 # from one of these modc functions with this exception type rejects the example (hypothesis
@@ -105,7 +107,9 @@ UNIT_NAMES = mostly(st.sampled_from(["H1", "H2", "H3", "H4", "L1", "L2", "L3", "
 PARAM_NAMES = mostly(st.sampled_from(["pivot", "port", "link"]), st.sampled_from(["pivt", "twist", "Port", "x"]))
 NAMES = mostly(st.sampled_from(["farm", "cell", "a", "_x", "p1", "home", "shelf", "H1", "joint_1", "wrist"]),
                st.sampled_from(["robot", "chain", "9lives", "é", "a-b", ""]), odds=30)
-JOINTS = mostly(st.sampled_from(["joint_1", "joint_2", "joint_3"]), st.sampled_from(["joint_7", "joint_0", "j1", "base"]), odds=4)
+JOINTS = mostly(
+    st.sampled_from(["joint_1", "joint_2", "joint_3"]), st.sampled_from(["joint_7", "joint_0", "j1", "base"]), odds=4
+)
 CODE_NAMES = mostly(st.sampled_from(["first-variant", "last-variant", "illegal-succession", "epsilon-exceeded"]),
                     st.sampled_from([*REGISTRY, "foo", "first_variant", "Missing-Unit"]), odds=3)
 SPACE = st.sampled_from([" ", "\n", "\n", "  ", "\t", " # note\n", "\r\n"])
@@ -196,14 +200,17 @@ def statement(draw):
     if kind == "sphere":
         return f"sphere {draw(NAMES)} radius {draw(quantity('length'))}{draw(at())}"
     if kind == "cylinder":
-        return f"cylinder {draw(NAMES)} radius {draw(quantity('length'))} length {draw(quantity('length'))}{draw(at())}{draw(rpy())}"
+        name, radius, length = draw(NAMES), draw(quantity("length")), draw(quantity("length"))
+        return f"cylinder {name} radius {radius} length {length}{draw(at())}{draw(rpy())}"
     if kind == "target":
         return f"target {draw(NAMES)}{draw(at())}"
     return "allow " + ", ".join(draw(st.lists(CODE_NAMES, min_size=1, max_size=3)))
 
 
 JUNK = st.one_of(
-    st.sampled_from(["}", "{", "robot", "(", ")", "-", "=", ",", "@", "$", '"open string', "# comment", "42", "deg", "chain"]),
+    st.sampled_from(
+        ["}", "{", "robot", "(", ")", "-", "=", ",", "@", "$", '"open string', "# comment", "42", "deg", "chain"]
+    ),
     st.text(min_size=1, max_size=6),
 )
 
@@ -260,7 +267,10 @@ def test_generated_chains_never_crash(units, library):
 # --- (b) mutations of the examples -----------------------------------------------------------------
 
 ALPHABET = st.one_of(
-    st.sampled_from(list("{}()-=,#\"\n\t .0123456789eE+") + ["deg", "rad", "mm", "H", "L", "robot", "chain", "\r", "\x00", "é", "\u2028"]),
+    st.sampled_from(
+        list('{}()-=,#"\n\t .0123456789eE+')
+        + ["deg", "rad", "mm", "H", "L", "robot", "chain", "\r", "\x00", "é", "\u2028"]
+    ),
     st.characters(),
 )
 
@@ -447,8 +457,10 @@ def test_huge_twist_angle_in_radians(param):
 
 @pytest.mark.parametrize("limit", ["(1, 0) deg", "(171, 175) deg"], ids=["inverted", "disjoint"])
 def test_inverted_limit_with_a_dh_table(limit):
-    text = ("robot planar {\n    dh {\n        row a=0.3 m, alpha=0deg, d=0 m\n        row a=0 m, alpha=0deg, d=0.075 m\n"
-            f"    }}\n    limit joint_1 {limit}\n}}\n")
+    text = (
+        "robot planar {\n    dh {\n        row a=0.3 m, alpha=0deg, d=0 m\n        row a=0 m, alpha=0deg, d=0.075 m\n"
+        f"    }}\n    limit joint_1 {limit}\n}}\n"
+    )
     c = assert_sane(text)
     assert any(d.is_error and d.span.line == 6 for d in c.diagnostics), c.diagnostics
 
@@ -491,11 +503,18 @@ def valid_arm(draw):
     if draw(st.booleans()):
         extra.append(f"payload {draw(st.floats(0.001, 20)):.4g} kg at (0, 0, {draw(st.floats(-1, 1)):.3g}) m")
     if draw(st.booleans()):
-        extra.append(f"tool at ({draw(st.floats(-1, 1)):.3g}, 0, {draw(st.floats(-1, 1)):.3g}) m rpy (0, {draw(st.integers(-180, 180))}, 0) deg")
+        extra.append(
+            f"tool at ({draw(st.floats(-1, 1)):.3g}, 0, {draw(st.floats(-1, 1)):.3g}) m "
+            f"rpy (0, {draw(st.integers(-180, 180))}, 0) deg"
+        )
     if draw(st.booleans()):
-        extra.append(f"base at (0, 0, 0.5) m rpy ({draw(st.integers(-180, 180))}, {draw(st.integers(-180, 180))}, 0) deg")
+        extra.append(
+            f"base at (0, 0, 0.5) m rpy ({draw(st.integers(-180, 180))}, {draw(st.integers(-180, 180))}, 0) deg"
+        )
     if draw(st.booleans()):
-        extra.append(f"limit joint_{draw(st.integers(1, k + m))} ({draw(st.integers(-170, 0))}, {draw(st.integers(1, 170))}) deg")
+        extra.append(
+            f"limit joint_{draw(st.integers(1, k + m))} ({draw(st.integers(-170, 0))}, {draw(st.integers(1, 170))}) deg"
+        )
     return "robot arm {\n    chain " + " - ".join(units) + "\n    " + "\n    ".join(extra) + "\n}\n"
 
 
@@ -507,7 +526,9 @@ def test_torque_analysis_on_valid_arms_never_crashes(text):
         c = check_text(text, "arm.mod", analyses=TORQUE)
     except Exception as e:
         raise AssertionError(f"{type(e).__name__}: {e}\n{text}") from e
-    assert {d.code for d in c.diagnostics} <= {"torque-over-peak", "torque-over-nominal", "limit-exceeds-hardware"}, c.diagnostics
+    assert {d.code for d in c.diagnostics} <= {"torque-over-peak", "torque-over-nominal", "limit-exceeds-hardware"}, (
+        c.diagnostics
+    )
     for d in c.diagnostics:
         assert 1 <= d.span.line <= text.count("\n") + 1 and d.hint
 

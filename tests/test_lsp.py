@@ -12,7 +12,6 @@ from typing import Any
 import pytest
 
 from modc.compiler import check_text
-from modc.syntax.parser import normalize_newlines
 from modc.diagnostics import REGISTRY
 from modc.lsp import convert
 from modc.lsp.client import Client
@@ -22,6 +21,7 @@ from modc.lsp.formatting import formatting
 from modc.lsp.hover import hover
 from modc.lsp.language import keyword_doc, statements
 from modc.lsp.symbols import definition, symbols
+from modc.syntax.parser import normalize_newlines
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT / "tests" / "diagnostics"
@@ -727,7 +727,8 @@ GRAMMAR_PLUS = {
     "     | allow\n": "     | allow\n     | gripper\n",
     'allow: "allow"': 'gripper: "gripper" NAME at\nallow: "allow"',
     # a new top-level block with its own statement
-    "start: (robot | design)*": 'start: (robot | design | fixture)*\nfixture: "fixture" NAME "{" use* "}"\nuse: "use" NAME',
+    "start: (robot | design)*": 'start: (robot | design | fixture)*\n'
+    'fixture: "fixture" NAME "{" use* "}"\nuse: "use" NAME',
 }
 
 
@@ -767,7 +768,9 @@ def test_a_new_statement_needs_no_language_server_change(grammar_plus):
     from modc.lsp import language
 
     assert "gripper" in language.statements() and "gripper" in language.name_takers()
-    assert language.declaration_keywords() == {"robot", "design", "fixture"} and language.statements("fixture") == ("use",)
+    assert language.declaration_keywords() == {"robot", "design", "fixture"} and language.statements("fixture") == (
+        "use",
+    )
     got = _labels(complete(Analysis("robot a {\n    chain H1 - L1\n    ", "/x/a.mod"), 33))
     assert got[-1] == "gripper" and got[:-1] == list(language.statements())[:-1]
     text = "robot a {\n    chain H1 - L1\n    gripper g "

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import sys
-from typing import Annotated, Optional
+from typing import Annotated, NoReturn
 
 import typer
 
@@ -32,9 +32,16 @@ def _mass(text: str) -> float | None:
 @app.command("check")
 def check_cmd(
     file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
-    payload: Annotated[Optional[str], typer.Option(help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")] = None,
+    payload: Annotated[
+        str | None, typer.Option(help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")
+    ] = None,
     json_out: Annotated[bool, typer.Option("--json", help="print the torque table as JSON")] = False,
-    traj: Annotated[Optional[str], typer.Option("--traj", help="also the torques along this trajectory (inverse dynamics), e.g. from `modc plan --json`")] = None,
+    traj: Annotated[
+        str | None,
+        typer.Option(
+            "--traj", help="also the torques along this trajectory (inverse dynamics), e.g. from `modc plan --json`"
+        ),
+    ] = None,
     library: LibraryOpt = None,
 ):
     """Torque feasibility: the worst static gravity torque of every joint over its range, against
@@ -56,31 +63,48 @@ def check_cmd(
         checked = check_file(file, library, analyses=COMPILE_ANALYSES, payload_override=mass)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     robots = [r for r in checked.design.robots if r.torque is not None]
     along = _along(traj, checked.design, robots, mass) if traj is not None and checked.ok else {}
     if json_out:
-        doc = {"robots": [{"name": r.name, "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
-                           "joints": [j.to_json() for j in r.torque],
-                           **({"trajectory": {"file": traj, "joints": [j.to_json() for j in along[r.name]]}} if r.name in along else {})}
-                          for r in robots]}
+        doc = {
+            "robots": [
+                {
+                    "name": r.name,
+                    "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
+                    "joints": [j.to_json() for j in r.torque or ()],
+                    **(
+                        {"trajectory": {"file": traj, "joints": [j.to_json() for j in along[r.name]]}}
+                        if r.name in along
+                        else {}
+                    ),
+                }
+                for r in robots
+            ]
+        }
         print(json.dumps(doc, indent=2))
     else:
         for r in robots:
-            print(f"robot {r.name} ({r.sequence}), payload {mass if mass is not None else (r.payload.mass if r.payload else 0):g} kg")
-            print(f"  {'joint':<9}{'unit':<6}{'worst |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}  worst pose (deg)")
-            for j in r.torque:
+            shown = mass if mass is not None else (r.payload.mass if r.payload else 0.0)
+            print(f"robot {r.name} ({r.sequence}), payload {shown:g} kg")
+            head = f"  {'joint':<9}{'unit':<6}{'worst |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}"
+            print(f"{head}  worst pose (deg)")
+            for j in r.torque or ():
                 pose = ", ".join(f"{math.degrees(x):.0f}" for x in j.q)
-                print(f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}  ({pose})  {j.level}")
+                row = f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}"
+                print(f"{row}  ({pose})  {j.level}")
             if r.name in along:
                 print(f"  along {traj} (inverse dynamics):")
-                print(f"  {'joint':<9}{'unit':<6}{'peak |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}  at t (s)")
+                head = f"  {'joint':<9}{'unit':<6}{'peak |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}"
+                print(f"{head}  at t (s)")
                 for j in along[r.name]:
-                    print(f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}  {j.t:.3f}  {j.level}")
+                    row = f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}"
+                    print(f"{row}  {j.t:.3f}  {j.level}")
     _print_diagnostics(checked.diagnostics, checked.sources)
     over = [j for peaks in along.values() for j in peaks if j.level == "over-peak"]
     for j in over:
-        _err(f"modc check: {j.name} ({j.variant}) needs {j.tau:.3g} N·m at t = {j.t:.3f} s of {traj}, above its peak {j.tau_max:g} N·m")
+        _err(f"modc check: {j.name} ({j.variant}) needs {j.tau:.3g} N·m at t = {j.t:.3f} s of {traj}, "
+             f"above its peak {j.tau_max:g} N·m")
     raise typer.Exit(EXIT_OK if checked.ok and not over else EXIT_ERRORS)
 
 
@@ -92,7 +116,7 @@ def _along(traj_path: str, design, robots, mass) -> dict:
     from ..model.select import choose_robot
     from ..sim.trajectory import load, validate_for
 
-    def invalid(lines):
+    def invalid(lines) -> NoReturn:
         _print_diagnostics([codes.TRAJ_INVALID.at(Span.point(traj_path), detail=line) for line in lines], {})
         raise typer.Exit(EXIT_ERRORS)
 
@@ -101,7 +125,9 @@ def _along(traj_path: str, design, robots, mass) -> dict:
     if traj is None:
         invalid(errors)
     with usage_errors("check"):
-        robot = choose_robot(design, traj.robot, robots, say='"robot" in the trajectory file', where=Span.point(traj_path))
+        robot = choose_robot(
+            design, traj.robot, robots, say='"robot" in the trajectory file', where=Span.point(traj_path)
+        )
     errors = validate_for(traj, robot)
     if errors:
         invalid(errors)
@@ -114,9 +140,13 @@ def _along(traj_path: str, design, robots, mass) -> dict:
 @app.command("dh2mod")
 def dh2mod_cmd(
     table: Annotated[str, typer.Argument(help="CSV with header a,alpha,d,theta (metres, radians), one row per joint")],
-    json_out: Annotated[bool, typer.Option("--json", help="print requested vs realised DH as JSON instead of .mod text")] = False,
-    fit_links: Annotated[bool, typer.Option("--fit-links", help="print link modules at the lengths that realise each a exactly")] = False,
-    name: Annotated[Optional[str], typer.Option(help="robot name (default: from the file name)")] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="print requested vs realised DH as JSON instead of .mod text")
+    ] = False,
+    fit_links: Annotated[
+        bool, typer.Option("--fit-links", help="print link modules at the lengths that realise each a exactly")
+    ] = False,
+    name: Annotated[str | None, typer.Option(help="robot name (default: from the file name)")] = None,
     library: LibraryOpt = None,
 ):
     """Convert a standard DH table into a module chain (paper section 4.2); .mod text on stdout."""
@@ -130,7 +160,7 @@ def dh2mod_cmd(
         raise typer.Exit(EXIT_ERRORS) from None
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     out, diags, ok = convert_table(text, table, name=name, fit_links=fit_links, library=library, as_json=json_out)
     _print_diagnostics(diags, {table: text})
     if not ok:
@@ -154,7 +184,7 @@ def dh_cmd(
         checked = check_file(file, library)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE)
+        raise typer.Exit(EXIT_USAGE) from None
     if not checked.ok:
         _print_diagnostics(checked.diagnostics, checked.sources)
         raise typer.Exit(EXIT_ERRORS)

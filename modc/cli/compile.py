@@ -37,7 +37,9 @@ def compile_cmd(
     out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
     library: LibraryOpt = None,
     only: OnlyOpt = None,
-    force: Annotated[bool, typer.Option(help="replace OUT whatever it holds (deletes files modc did not write)")] = False,
+    force: Annotated[
+        bool, typer.Option(help="replace OUT whatever it holds (deletes files modc did not write)")
+    ] = False,
     collision_samples: SamplesOpt = 10_000,
     seed: SeedOpt = 0,
     smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,

@@ -20,7 +20,9 @@ def _cells(line: str) -> list[tuple[str, int]]:
 
 def read_csv(text: str, path: str) -> tuple[list[DHRow], list[Diagnostic]]:
     diags: list[Diagnostic] = []
-    lines = [(i, l) for i, l in enumerate(text.splitlines(), start=1) if l.strip() and not l.lstrip().startswith("#")]
+    lines = [
+        (i, ln) for i, ln in enumerate(text.splitlines(), start=1) if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if not lines:
         return [], [codes.DH_EMPTY.at(Span.point(path))]
     head_no, head = lines[0]
@@ -37,12 +39,14 @@ def read_csv(text: str, path: str) -> tuple[list[DHRow], list[Diagnostic]]:
                                                problem=f"{len(cells)} cells for {len(names)} columns"))
             continue
         values, ok = {}, True
-        for name, (cell, col) in zip(names, cells):
+        for name, (cell, col) in zip(names, cells, strict=True):  # counts compared just above
             span = Span(path, line_no, col, line_no, col + max(1, len(cell)))
             try:
                 v = float(cell)
             except ValueError:
-                diags.append(codes.DH_CSV_VALUE.at(span, row=row_no, column=name, problem=f"{cell.strip()!r} is not a number"))
+                diags.append(
+                    codes.DH_CSV_VALUE.at(span, row=row_no, column=name, problem=f"{cell.strip()!r} is not a number")
+                )
                 ok = False
                 continue
             bad = magnitude_error([v], f"DH {name} in row {row_no}", span, DH_PARAMS[name])

@@ -31,7 +31,7 @@ class Code:
     hint: str = ""
     allowable: bool = False  # may be silenced with `allow NAME` inside a robot block (assembly rules)
 
-    def at(self, span: Span, **fields) -> "Diagnostic":
+    def at(self, span: Span, **fields) -> Diagnostic:
         from .diagnostic import Diagnostic
 
         return Diagnostic(
@@ -46,7 +46,9 @@ class Code:
 REGISTRY: dict[str, Code] = {}
 
 
-def _register(name: str, severity: Severity, summary: str, message: str, hint: str = "", allowable: bool = False) -> Code:
+def _register(
+    name: str, severity: Severity, summary: str, message: str, hint: str = "", allowable: bool = False
+) -> Code:
     assert name not in REGISTRY, name
     code = Code(name, severity, summary, message, hint, allowable)
     REGISTRY[name] = code
@@ -69,8 +71,13 @@ MISSING_EQUALS = _register("missing-equals", E, "a unit parameter without '='",
 EXPECTED_STATEMENT = _register("expected-statement", E, "something that is not a statement inside a robot block",
     "expected a statement, found {found}",
     "statements are: {statements}")
-EXPECTED_ROBOT = _register("expected-robot", E, "top-level content outside a `robot NAME { … }` block",
-    "expected 'robot NAME {{', found {found}", "every statement lives inside a robot block: robot arm {{ chain H1 - L1 }}")
+EXPECTED_ROBOT = _register(
+    "expected-robot",
+    E,
+    "top-level content outside a `robot NAME { … }` block",
+    "expected 'robot NAME {{', found {found}",
+    "every statement lives inside a robot block: robot arm {{ chain H1 - L1 }}",
+)
 EMPTY_FILE = _register("empty-file", W, "a file with no robot block",
     "no robot is defined in this file", "add a block such as: robot arm {{ chain H1 - L1 }}")
 INPUT_TOO_LARGE = _register("input-too-large", E, "a file or chain beyond the size modc accepts",
@@ -133,12 +140,30 @@ TOO_FEW_UNITS = _register("too-few-units", E, "fewer units than the library's mi
 FIRST_VARIANT = _register("first-variant", E, "link 1 must be of the base variant (paper rule 1: H)",
     "the first unit is {unit}; the paper's rule 1 fixes link 1 as {want}", "start the chain with an {want} unit, "
     "or write `allow first-variant` for a sub-assembly such as a wrist", allowable=True)
-LAST_VARIANT = _register("last-variant", E, "link n must be of the end variant (paper rule 1: L)",
-    "the last unit is {unit}; the paper's rule 1 fixes link n as {want}", "end the chain with an {want} unit", allowable=True)
-ILLEGAL_SUCCESSION = _register("illegal-succession", E, "a variant that may not follow the previous one (L→H)",
-    "{after} may not follow {before} (paper rules 2-3: {allowed})", "heavier modules go nearer the base", allowable=True)
-EPSILON_EXCEEDED = _register("epsilon-exceeded", E, "more modules of one variant than ε allows",
-    "{count} {variant} modules exceed ε = {eps} (paper rule 4, Table 1)", "replace some {variant} units or use another variant", allowable=True)
+LAST_VARIANT = _register(
+    "last-variant",
+    E,
+    "link n must be of the end variant (paper rule 1: L)",
+    "the last unit is {unit}; the paper's rule 1 fixes link n as {want}",
+    "end the chain with an {want} unit",
+    allowable=True,
+)
+ILLEGAL_SUCCESSION = _register(
+    "illegal-succession",
+    E,
+    "a variant that may not follow the previous one (L→H)",
+    "{after} may not follow {before} (paper rules 2-3: {allowed})",
+    "heavier modules go nearer the base",
+    allowable=True,
+)
+EPSILON_EXCEEDED = _register(
+    "epsilon-exceeded",
+    E,
+    "more modules of one variant than ε allows",
+    "{count} {variant} modules exceed ε = {eps} (paper rule 4, Table 1)",
+    "replace some {variant} units or use another variant",
+    allowable=True,
+)
 
 # --- twists ------------------------------------------------------------------------------------
 TWIST_NOT_REALISABLE = _register("twist-not-realisable", E, "a twist the library's hardware cannot set",
@@ -150,27 +175,51 @@ TWIST_ROUNDED = _register("twist-rounded", W, "a DH twist the modules can only a
 DH_APPROXIMATION = _register("dh-approximation", N, "how closely the converted modules realise a DH table",
     "robot '{robot}' realises its DH table within |da| <= {da}, |dalpha| <= {dalpha}, |dd| <= {dd}",
     "{hint}")
-DH_CSV_HEADER = _register("dh-csv-header", E, "a DH CSV file whose header is not a,alpha,d,theta",
-    "the header must name the columns a, alpha, d, theta; found {found}", "the first line reads: a,alpha,d,theta (metres and radians)")
-DH_CSV_VALUE = _register("dh-csv-value", E, "a DH CSV cell that is not a finite number",
-    "row {row}, column '{column}': {problem}", "cells are plain numbers: metres for a and d, radians for alpha and theta")
+DH_CSV_HEADER = _register(
+    "dh-csv-header",
+    E,
+    "a DH CSV file whose header is not a,alpha,d,theta",
+    "the header must name the columns a, alpha, d, theta; found {found}",
+    "the first line reads: a,alpha,d,theta (metres and radians)",
+)
+DH_CSV_VALUE = _register(
+    "dh-csv-value",
+    E,
+    "a DH CSV cell that is not a finite number",
+    "row {row}, column '{column}': {problem}",
+    "cells are plain numbers: metres for a and d, radians for alpha and theta",
+)
 DH_EMPTY = _register("dh-empty", E, "a DH table (CSV file or dh block) without complete rows",
     "the DH table has no rows", "add one row per joint, base first")
 
 # --- torque (paper section 3: epsilon comes from a worst-case torque analysis) -------------------
-TORQUE_OVER_PEAK = _register("torque-over-peak", E, "a joint whose worst static gravity torque exceeds its actuator's peak",
+TORQUE_OVER_PEAK = _register(
+    "torque-over-peak",
+    E,
+    "a joint whose worst static gravity torque exceeds its actuator's peak",
     "{joint} ({unit}) must hold {tau} against gravity at q = {pose}, above its peak {tau_max}",
-    "use a stronger module there, shorter links or a lighter payload{eps}")
-TORQUE_OVER_NOMINAL = _register("torque-over-nominal", W, "a joint whose worst static gravity torque exceeds its nominal torque",
+    "use a stronger module there, shorter links or a lighter payload{eps}",
+)
+TORQUE_OVER_NOMINAL = _register(
+    "torque-over-nominal",
+    W,
+    "a joint whose worst static gravity torque exceeds its nominal torque",
     "{joint} ({unit}) must hold {tau} against gravity at q = {pose}, above its nominal {tau_nom} (peak {tau_max})",
-    "the actuator can hold this only briefly; use a stronger module, shorter links or a lighter payload{eps}")
+    "the actuator can hold this only briefly; use a stronger module, shorter links or a lighter payload{eps}",
+)
 EPSILON_DISAGREES = _register("epsilon-disagrees", N, "the paper's ε rule and the torque check disagree",
     "{message}", "ε is the paper's rule of thumb; the torque check is the physics behind it")
 BAD_PAYLOAD = _register("bad-payload", E, "a --payload value that is not a mass",
     "--payload {value!r} is not a mass", "write e.g. --payload 0.5kg or --payload 500g (a plain number means kg)")
 
-TRAJ_INVALID = _register("traj-invalid", E, "a trajectory file that does not fit the format or the robot",
-    "{detail}", "a trajectory is {{\"joint_names\": [...], \"points\": [{{\"t\": s, \"q\": [rad, ...]}}, ...]}}, as `modc plan --json` prints")
+TRAJ_INVALID = _register(
+    "traj-invalid",
+    E,
+    "a trajectory file that does not fit the format or the robot",
+    "{detail}",
+    'a trajectory is {{"joint_names": [...], "points": [{{"t": s, "q": [rad, ...]}}, ...]}}, '
+    "as `modc plan --json` prints",
+)
 
 # --- planning: `modc plan` (exit 1; 2 for names given on the command line) ----------------------
 TARGET_UNKNOWN = _register("target-unknown", E, "`plan --to` naming a target the robot does not declare",
@@ -204,8 +253,13 @@ UNKNOWN_JOINT = _register("unknown-joint", E, "a joint name that does not exist"
     "robot '{robot}' has no joint '{name}'", "joints are named joint_1 … joint_{dof}")
 LIMIT_ORDER = _register("limit-order", E, "a joint limit whose lower bound is not below its upper bound",
     "limit for {joint}: lower {low} is not below upper {high}", "write the limit as (lower, upper)")
-LIMIT_DISJOINT = _register("limit-disjoint", E, "a joint limit that does not overlap the module's range at all",
-    "limit for {joint} ({low}..{high}) lies outside the module's range {hlow}..{hhigh}", "give a range inside {hlow}..{hhigh}")
+LIMIT_DISJOINT = _register(
+    "limit-disjoint",
+    E,
+    "a joint limit that does not overlap the module's range at all",
+    "limit for {joint} ({low}..{high}) lies outside the module's range {hlow}..{hhigh}",
+    "give a range inside {hlow}..{hhigh}",
+)
 LIMIT_EXCEEDS_HARDWARE = _register("limit-exceeds-hardware", W, "a joint limit wider than the module's range",
     "limit for {joint} ({low}..{high}) is wider than the module's range {hlow}..{hhigh}",
     "the library's range is used where yours is wider")

@@ -257,9 +257,8 @@ MAX_LIBRARY_BYTES = 1_000_000  # the shipped libraries are 4 kB; a 6 MB one took
 def _load_path(path: str, mtime: float) -> Library:
     import yaml
 
-    from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
-
     from ..files import read_bounded
+    from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
 
     try:
         raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
@@ -301,6 +300,7 @@ def resolve(ref: str, relative_to: Path | None = None) -> Path | None:
 @cache
 def _builtin(ref: str) -> Library:
     path = resolve(ref)
+    assert path is not None, ref  # a built-in library ships with modc
     return _load_path(str(path.resolve()), path.stat().st_mtime)
 
 

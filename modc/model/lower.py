@@ -5,12 +5,13 @@ from __future__ import annotations
 import difflib
 import math
 from pathlib import Path
+from typing import Any, Literal
 
 from .. import names
 from ..diagnostics import REGISTRY, Diagnostic, codes
 from ..syntax import ast
 from . import quantities as Q
-from .robot import Design, DHRow, JointLimit, Obstacle, Payload, Pose, Problem, Robot, Target, Transform, UnitSpec
+from .robot import Design, DHRow, JointLimit, Obstacle, Payload, Pose, Problem, Robot, Target, Transform, UnitSpec, Vec3
 
 UNIT_PARAMS = {"pivot": "an angle", "port": "an angle", "link": "a length"}
 DH_PARAMS = {"a": "a length", "alpha": "an angle", "d": "a length", "theta": "an angle"}
@@ -82,6 +83,10 @@ class _Lowerer:
             return None
         return tuple(x * s for x in v.values)
 
+    def vec3(self, v: ast.Vector, kind: str, what: str) -> Vec3 | None:
+        t = self.vector(v, kind, what)
+        return None if t is None else (t[0], t[1], t[2])
+
     def params(self, params: tuple[ast.Param, ...], allowed: dict[str, str]) -> tuple[dict[str, float], dict]:
         """Named quantities -> SI values (and their spans), reporting unknown and repeated names."""
         values: dict[str, float] = {}
@@ -91,7 +96,9 @@ class _Lowerer:
             if key not in allowed:
                 close = difflib.get_close_matches(key, list(allowed), n=1)
                 suggest = f"; did you mean '{close[0]}'?" if close else ""
-                self.error(codes.UNKNOWN_PARAMETER.at(p.name.span, name=key, allowed=", ".join(allowed), suggest=suggest))
+                self.error(
+                    codes.UNKNOWN_PARAMETER.at(p.name.span, name=key, allowed=", ".join(allowed), suggest=suggest)
+                )
                 continue
             if key in spans:
                 self.error(codes.DUPLICATE_PARAMETER.at(p.span, name=key))
@@ -106,7 +113,7 @@ class _Lowerer:
         values, spans = self.params(u.params, UNIT_PARAMS)
         if not self.name(u.name, "unit"):
             return None
-        return UnitSpec(name=u.name.text, span=u.span, param_spans=spans, **values)
+        return UnitSpec(name=u.name.text, span=u.span, param_spans=spans, **values)  # type: ignore[arg-type]
 
     def dh(self, table: ast.DH) -> tuple[DHRow, ...]:
         rows, complete = [], True
@@ -126,21 +133,26 @@ class _Lowerer:
         return tuple(rows) if complete else ()
 
     def placement(self, p: ast.Placement) -> Transform:
-        xyz = self.vector(p.at, "a length", f"{p.keyword} position") if p.at else None
-        rpy = self.vector(p.rpy, "an angle", f"{p.keyword} orientation") if p.rpy else None
+        xyz = self.vec3(p.at, "a length", f"{p.keyword} position") if p.at else None
+        rpy = self.vec3(p.rpy, "an angle", f"{p.keyword} orientation") if p.rpy else None
         return Transform(xyz=xyz or (0.0, 0.0, 0.0), rpy=rpy or (0.0, 0.0, 0.0))
 
     def target(self, st: ast.Target) -> Target | None:
         what = f"target '{_say(st.name)}'"
-        xyz = self.vector(st.at, "a length", what)
-        rpy = self.vector(st.rpy, "an angle", f"orientation of {what}") if st.rpy else None
+        xyz = self.vec3(st.at, "a length", what)
+        rpy = self.vec3(st.rpy, "an angle", f"orientation of {what}") if st.rpy else None
         tol: dict[str, float] = {}
         if st.within is not None:
             w = st.within
             pos = self.quantity(w.position, "a length", f"position tolerance of {what}")
-            ang = self.quantity(w.orientation, "an angle", f"orientation tolerance of {what}") if w.orientation else None
-            for key, value, q in (("position_tolerance", pos, w.position), ("orientation_tolerance", ang, w.orientation)):
-                if value is not None and value <= 0:
+            ang = (
+                self.quantity(w.orientation, "an angle", f"orientation tolerance of {what}") if w.orientation else None
+            )
+            for key, value, q in (
+                ("position_tolerance", pos, w.position),
+                ("orientation_tolerance", ang, w.orientation),
+            ):
+                if value is not None and value <= 0 and q is not None:
                     self.error(codes.NONPOSITIVE_SIZE.at(q.span, what=f"the {key.replace('_', ' ')} of {what}",
                                                          value=f"{q.value:g} {q.unit}"))
                 elif value is not None:
@@ -177,7 +189,7 @@ class _Lowerer:
                 fields[st.keyword] = self.placement(st)
             case ast.Payload():
                 mass = self.quantity(st.mass, "a mass", "payload mass")
-                com = self.vector(st.at, "a length", "payload centre of mass") if st.at else (0.0, 0.0, 0.0)
+                com = self.vec3(st.at, "a length", "payload centre of mass") if st.at else (0.0, 0.0, 0.0)
                 if mass is not None and com is not None:
                     fields["payload"] = Payload(mass=mass, com=com, span=st.span)
             case ast.Pose():
@@ -219,7 +231,7 @@ class _Lowerer:
         named = self.name(r.name, "robot")
         rname = _say(r.name)
         fields: dict = {}
-        seen: dict[str, object] = {}
+        seen: dict[str, Any] = {}
         acc = self._acc(source_dir)
         for st in r.body:
             self.cell_statement(st, rname, fields, seen, acc)
@@ -256,12 +268,14 @@ class _Lowerer:
 
     def obstacle(self, st) -> Obstacle | None:
         name = _say(st.name)
-        at = self.vector(st.at, "a length", f"position of '{name}'")
-        rpy = self.vector(st.rpy, "an angle", f"orientation of '{name}'") if getattr(st, "rpy", None) else (0.0, 0.0, 0.0)
+        at = self.vec3(st.at, "a length", f"position of '{name}'")
+        rpy = (
+            self.vec3(st.rpy, "an angle", f"orientation of '{name}'") if getattr(st, "rpy", None) else (0.0, 0.0, 0.0)
+        )
         match st:
             case ast.Box():
-                size = self.vector(st.size, "a length", f"size of box '{name}'")
-                shape = "box"
+                size: tuple[float, ...] | None = self.vec3(st.size, "a length", f"size of box '{name}'")
+                shape: Literal["box", "sphere", "cylinder"] = "box"
             case ast.Sphere():
                 r = self.quantity(st.radius, "a length", f"radius of sphere '{name}'")
                 size, shape = (None if r is None else (r,)), "sphere"

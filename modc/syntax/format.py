@@ -187,13 +187,15 @@ def _elements(text: str, toks: list[_Tok]) -> list[_Elem]:
     """Tokens and comments in source order. Between two tokens the text is only whitespace and
     comments (the grammar ignores nothing else), so every '#' in such a gap starts a comment."""
     elems: list[_Elem] = []
-    pos = 0
+    pos = last = 0
 
     def gap(lo: int, hi: int) -> None:
         nonlocal last
         for m in _COMMENT.finditer(text, lo, hi):
             before = text[last:m.start()]
-            elems.append(_Elem(_Comment(m.group().rstrip(), bool(elems) and "\n" not in before), before.count("\n") >= 2))
+            elems.append(
+                _Elem(_Comment(m.group().rstrip(), bool(elems) and "\n" not in before), before.count("\n") >= 2)
+            )
             last = m.end()
 
     for t in toks:

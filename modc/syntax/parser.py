@@ -44,7 +44,11 @@ def grammar_keywords() -> set[str]:
     """The keywords of the grammar (used by editors' grammars and their tests)."""
     import re
 
-    return {t.pattern.value for t in _lark().terminals if t.pattern.type == "str" and re.fullmatch(r"[a-z]+(?:-[a-z]+)*", t.pattern.value)}
+    return {
+        t.pattern.value
+        for t in _lark().terminals
+        if t.pattern.type == "str" and re.fullmatch(r"[a-z]+(?:-[a-z]+)*", t.pattern.value)
+    }
 
 
 @contextmanager
@@ -117,7 +121,7 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
 
     line, col = max(1, e.line if e.line != -1 else 1), max(1, e.column if e.column != -1 else 1)
     if isinstance(e, UnexpectedCharacters):
-        pos = e.pos_in_stream
+        pos = e.pos_in_stream or 0
         span = Span(file, line, col, line, col + 1, pos, pos + 1)
         label = _label(e, text)
         if label == "missing-equals":
@@ -130,11 +134,15 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
         span = _eof_span(text, file)
         if name is not None:
             return codes.UNCLOSED_BLOCK.at(span, name=name)
-        return codes.SYNTAX_ERROR.at(span, found="end of file", expected=_expected(getattr(e, "expected", ())), hint="the file ends too early")
+        return codes.SYNTAX_ERROR.at(
+            span, found="end of file", expected=_expected(getattr(e, "expected", ())), hint="the file ends too early"
+        )
 
-    assert isinstance(e, UnexpectedToken)
+    assert isinstance(e, UnexpectedToken) and token is not None
     found = f"'{token}'" if token.type not in ("$END",) else "end of file"
-    span = Span(file, line, col, token.end_line or line, token.end_column or col + 1, token.start_pos or 0, token.end_pos or 0)
+    span = Span(
+        file, line, col, token.end_line or line, token.end_column or col + 1, token.start_pos or 0, token.end_pos or 0
+    )
     label = _rule_label(e) or _label(e, text)
     if label == "missing-dash":
         return codes.MISSING_DASH.at(span, found=found)

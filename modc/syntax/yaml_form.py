@@ -74,8 +74,11 @@ class _Reader:
         try:
             tree = _lark().parse(str(text), start=rule)
         except UnexpectedInput:
-            what = {"unit_text": "a unit such as H4(pivot=-90deg)", "quantity_text": "a number with a unit such as 45deg",
-                    "vector_text": "a vector such as (0.3, 0, 0.25) m"}[rule]
+            what = {
+                "unit_text": "a unit such as H4(pivot=-90deg)",
+                "quantity_text": "a number with a unit such as 45deg",
+                "vector_text": "a vector such as (0.3, 0, 0.25) m",
+            }[rule]
             self.diags.append(codes.YAML_SCHEMA.at(span, detail=f"{_dotted(path)}: expected {what}, got {text!r}"))
             return None
         node = ToAst(self.file).transform(tree).children[0]
@@ -87,11 +90,23 @@ class _Reader:
         for name, text in r.poses.items():
             v = self._vec(text, path + ("poses", name))
             if v is not None:
-                body.append(ast.Pose(ast.Name(name, self.span(path + ("poses", name, "__key__"))), v, self.span(path + ("poses", name))))
+                body.append(
+                    ast.Pose(
+                        ast.Name(name, self.span(path + ("poses", name, "__key__"))),
+                        v,
+                        self.span(path + ("poses", name)),
+                    )
+                )
         for name, text in r.limits.items():
             v = self._vec(text, path + ("limits", name))
             if v is not None:
-                body.append(ast.Limit(ast.Name(name, self.span(path + ("limits", name, "__key__"))), v, self.span(path + ("limits", name))))
+                body.append(
+                    ast.Limit(
+                        ast.Name(name, self.span(path + ("limits", name, "__key__"))),
+                        v,
+                        self.span(path + ("limits", name)),
+                    )
+                )
         return ast.Robot(ast.Name(r.name, self.span(path + ("name",))), tuple(body), self.span(path))
 
     def design(self, d, path: tuple) -> ast.DesignBlock:
@@ -104,7 +119,9 @@ class _Reader:
                 body.append(ast.Units(nums[0], nums[1] if len(nums) > 1 else None, self.span(p)))
         if d.modules is not None:
             p = path + ("modules",)
-            body.append(ast.Modules(tuple(ast.Name(m, self.span(p + (i,))) for i, m in enumerate(d.modules)), self.span(p)))
+            body.append(
+                ast.Modules(tuple(ast.Name(m, self.span(p + (i,))) for i, m in enumerate(d.modules)), self.span(p))
+            )
         if d.links is not None:
             p = path + ("links",)
             import re
@@ -123,7 +140,12 @@ class _Reader:
         try:
             return ast.Quantity(float(text), None, self.span(path))
         except ValueError:
-            self.diags.append(codes.YAML_SCHEMA.at(self.span(path), detail=f"{_dotted(path)}: expected a number of units such as 3 or \"2 to 4\", got {text!r}"))
+            self.diags.append(
+                codes.YAML_SCHEMA.at(
+                    self.span(path),
+                    detail=f'{_dotted(path)}: expected a number of units such as 3 or "2 to 4", got {text!r}',
+                )
+            )
             return None
 
     def _target(self, name: str, value, p: tuple):
@@ -156,7 +178,9 @@ class _Reader:
                     if val is not None:
                         q = self._sub("quantity_text", val, p + (key,))
                         if q is not None:
-                            params.append(ast.Param(ast.Name(key, self.span(p + (key, "__key__"))), q, self.span(p + (key,))))
+                            params.append(
+                                ast.Param(ast.Name(key, self.span(p + (key, "__key__"))), q, self.span(p + (key,)))
+                            )
                 u = ast.Unit(ast.Name(item.unit, self.span(p + ("unit",))), tuple(params), self.span(p))
             if u is not None:
                 units.append(u)
@@ -177,7 +201,9 @@ class _Reader:
         if r.payload is not None:
             m = self._sub("quantity_text", r.payload.mass, path + ("payload", "mass"))
             if m is not None:
-                body.append(ast.Payload(m, self._vec(r.payload.at, path + ("payload", "at")), self.span(path + ("payload",))))
+                body.append(
+                    ast.Payload(m, self._vec(r.payload.at, path + ("payload", "at")), self.span(path + ("payload",)))
+                )
         for i, o in enumerate(r.obstacles):
             body.extend(self._obstacle(o, path + ("obstacles", i)))
         for name, value in r.targets.items():
@@ -220,7 +246,7 @@ def _respan(node, span: Span):
     """Fragments were parsed out of context: point all their spans at the YAML scalar."""
     import dataclasses
 
-    changes = {}
+    changes: dict[str, object] = {}
     for f in dataclasses.fields(node):
         v = getattr(node, f.name)
         if isinstance(v, Span):
