@@ -49,7 +49,7 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
         for rank, d in enumerate(o.designs, start=1):
             out[file_name(o.problem.name, rank)] = robot_file(o, rank, d)
     out["report.html"] = report_html(outcomes, renders or {})
-    # the marker of a directory modc wrote: `modc design` may replace it next time without --force
+    # what wrote this directory (write_tree's manifest is what lets a later run replace it)
     marker = {"generator": f"modc {__version__}", "command": "design",
               "designs": [o.problem.name for o in outcomes], "outputs": sorted([*out, REPORT])}
     out[REPORT] = json.dumps(marker, indent=2) + "\n"
