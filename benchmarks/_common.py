@@ -35,3 +35,20 @@ def pin_one_core() -> int | None:
         return cpus[-1]
     except (AttributeError, OSError):
         return None
+
+
+def report(doc: dict, table: str | None, json_arg: str | None) -> None:
+    """Print the table (stderr when the JSON goes to stdout) and write the JSON: `--json -` is
+    stdout, `--json FILE` a file, no --json no JSON."""
+    import json
+
+    text = json.dumps(doc, indent=2)
+    if json_arg == "-":
+        if table is not None:
+            print(table, file=sys.stderr)
+        print(text)
+        return
+    if table is not None:
+        print(table)
+    if json_arg:
+        Path(json_arg).write_text(text + "\n", encoding="utf-8")

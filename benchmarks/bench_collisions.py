@@ -26,14 +26,13 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUME
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import json  # noqa: E402
 import platform  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
+from _common import pin_one_core, report  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -123,11 +122,7 @@ def main(argv: list[str] | None = None) -> int:
               f"(naive anchor / fast: {ratios})", file=out)
     doc = {"benchmark": "collisions", "target_s": TARGET_S, "cpu": cpu, "python": platform.python_version(),
            "platform": platform.platform(), "rows": rows}
-    if args.json == "-":
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    elif args.json:
-        Path(args.json).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+    report(doc, None, args.json)
     return 0 if all(x["same_matrix"] for x in rows) else 1
 
 

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as _dt
-import json
 import os
 import platform
 import resource
@@ -39,7 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from _common import child_env, pin_one_core  # benchmarks/_common.py
+from _common import child_env, pin_one_core, report  # benchmarks/_common.py
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -192,14 +191,7 @@ def main(argv: list[str] | None = None) -> int:
                    "cached_cpu": cpu[names[1]] / cpu[names[2]], "lint_cpu": cpu[names[3]] / cpu[names[4]]},
         "goals": GOALS,
     }
-    table = render(doc)
-    if args.json == "-":
-        print(table, file=sys.stderr)
-        print(json.dumps(doc, indent=2))
-    else:
-        print(table)
-        if args.json:
-            Path(args.json).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+    report(doc, render(doc), args.json)
     return 0
 
 

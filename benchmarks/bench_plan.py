@@ -26,7 +26,6 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUME
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import json  # noqa: E402
 import platform  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
@@ -34,7 +33,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from _common import pin_one_core  # noqa: E402  (benchmarks/_common.py)
+from _common import pin_one_core, report  # noqa: E402  (benchmarks/_common.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -151,11 +150,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {r['case']:<20}{ph}", file=out)
     doc = {"benchmark": "plan", "cpu": cpu, "python": platform.python_version(), "platform": platform.platform(),
            "rows": rows}
-    if args.json == "-":
-        json.dump(doc, sys.stdout, indent=2)
-        sys.stdout.write("\n")
-    elif args.json:
-        Path(args.json).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+    report(doc, None, args.json)
     return 0
 
 

@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import gc
-import json
 import os
 import platform
 import statistics
@@ -32,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from _common import child_env  # benchmarks/_common.py
+from _common import child_env, report  # benchmarks/_common.py
 
 ROOT = Path(__file__).resolve().parent.parent
 if (ROOT / "modc" / "__init__.py").is_file() and str(ROOT) not in sys.path[:1]:
@@ -237,14 +236,7 @@ def main(argv: list[str] | None = None) -> int:
         },
         "target_ratio": TARGET_RATIO,
     }
-    table = render(doc)
-    if args.json == "-":
-        print(table, file=sys.stderr)
-        print(json.dumps(doc, indent=2))
-    else:
-        print(table)
-        if args.json:
-            Path(args.json).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+    report(doc, render(doc), args.json)
     return 0
 
 

@@ -29,30 +29,12 @@ def run(design: Design, ctx: Context) -> Design:
                 continue
             v = lib.variants[r.units[joints[lim.joint] - 1].variant]
             hlo, hhi = math.radians(v.lower_deg), math.radians(v.upper_deg)
+            bounds = {"joint": lim.joint, "low": _deg(lim.lower), "high": _deg(lim.upper), "hlow": _deg(hlo),
+                      "hhigh": _deg(hhi)}
             if lim.upper <= hlo or lim.lower >= hhi:
-                ctx.report(
-                    codes.LIMIT_DISJOINT.at(
-                        lim.span,
-                        joint=lim.joint,
-                        low=_deg(lim.lower),
-                        high=_deg(lim.upper),
-                        hlow=_deg(hlo),
-                        hhigh=_deg(hhi),
-                    ),
-                    r,
-                )
+                ctx.report(codes.LIMIT_DISJOINT.at(lim.span, **bounds), r)
             elif lim.lower < hlo - 1e-12 or lim.upper > hhi + 1e-12:
-                ctx.report(
-                    codes.LIMIT_EXCEEDS_HARDWARE.at(
-                        lim.span,
-                        joint=lim.joint,
-                        low=_deg(lim.lower),
-                        high=_deg(lim.upper),
-                        hlow=_deg(hlo),
-                        hhigh=_deg(hhi),
-                    ),
-                    r,
-                )
+                ctx.report(codes.LIMIT_EXCEEDS_HARDWARE.at(lim.span, **bounds), r)
         for pose in r.poses:
             if len(pose.q) != r.dof:
                 ctx.report(codes.POSE_ARITY.at(pose.span, name=pose.name, got=len(pose.q), robot=r.name, dof=r.dof), r)
