@@ -312,3 +312,17 @@ def test_report_html_shows_the_top_design(tmp_path, capsys):
     pngs = re.findall(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"', html)
     assert len(pngs) == 1 and base64.b64decode(pngs[0]).startswith(b"\x89PNG")
     assert "<svg" in html and "small_1.mod" in html and "<script" not in html
+
+
+def test_compiling_a_design_problem_points_to_modc_design(tmp_path, capsys):
+    """`modc FILE -o OUT` on a file with only design blocks writes no robot, and says which command
+    answers the file instead."""
+    from modc.cli import main
+
+    src = Path(__file__).resolve().parent.parent / "examples" / "farm_cell.mod"
+    try:
+        main([str(src), "-o", str(tmp_path / "out")])
+    except SystemExit as e:
+        assert e.code in (0, None)
+    err = capsys.readouterr().err
+    assert "no robot" in err and f"modc design {src} -o DIR" in err

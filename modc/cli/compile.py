@@ -95,7 +95,9 @@ def compile_cmd(
             _err(f"  wrote {out.rstrip('/')}/{rel}")
     if not quiet:
         robots = ", ".join(f"{r.file_stem} ({r.sequence})" for r in checked.design.robots)
-        _err(f"modc: {len(files)} files written to {out}: {robots}")
+        _err(f"modc: {len(files)} files written to {out}: {robots or 'no robot'}")
+        if checked.design.problems and not checked.design.robots:  # a design problem compiles to nothing
+            _err(f"modc: {file} holds design problems, no robot: `modc design {file} -o DIR` finds arms for them")
 
 
 def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface) -> dict:
