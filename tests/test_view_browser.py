@@ -13,6 +13,7 @@ import json
 import shutil
 import subprocess
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -20,7 +21,7 @@ import numpy as np
 import pytest
 
 from modc.view.page import Page, Source
-from modc.view.server import start
+from modc.view.server import run, start
 
 ROOT = Path(__file__).resolve().parent.parent
 FARM = ROOT / "examples" / "farm.mod"
@@ -83,6 +84,20 @@ def _wait(cond, timeout: float, what: str, every: float = 0.2):
             return v
         time.sleep(every)
     raise AssertionError(f"timed out waiting for {what}")
+
+
+@contextlib.contextmanager
+def running(page):
+    """The page's server with its update loop (as `modc view` runs it); stopped after."""
+    server, view = start(page, port=0)
+    stop = threading.Event()
+    loop = threading.Thread(target=run, args=(view, stop), daemon=True)
+    loop.start()
+    try:
+        yield server, view
+    finally:
+        stop.set()
+        loop.join(timeout=10)
 
 
 @contextlib.contextmanager
@@ -188,21 +203,15 @@ setInterval(() => {  // every 20 ms: when each change has reached the page
 
 
 def test_saving_the_file_updates_the_page_within_a_second(browser, tmp_path):
-    import threading
 
-    from modc.view.server import run
 
     f = tmp_path / "farm.mod"
     text = FARM.read_text(encoding="utf-8")
     f.write_text(text, encoding="utf-8")
     page = Page([Source(f)])
-    server, view = start(page, port=0)
-    stop = threading.Event()
-    loop = threading.Thread(target=run, args=(view, stop), daemon=True)
-    loop.start()
     sliders = SLIDERS
     body = "document.body.innerText"
-    try:
+    with running(page) as (server, view):
         browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
         _wait(lambda: browser.js(sliders) == 3, 60, "3 joint sliders")
 
@@ -233,9 +242,6 @@ def test_saving_the_file_updates_the_page_within_a_second(browser, tmp_path):
         print(f"save -> sent: diagnostics {sent_error:.2f} s, new arm {sent_arm:.2f} s; "
               f"save -> in the page: diagnostics {shown_error:.2f} s, new arm {shown_arm:.2f} s")
         assert sent_error < 1.0 and sent_arm < 1.0, (sent_error, sent_arm)
-    finally:
-        stop.set()
-        loop.join(timeout=10)
 
 
 def _settle(browser, server) -> None:
@@ -258,11 +264,9 @@ def _click(browser, label: str) -> None:
 
 def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
     import math
-    import threading
 
     from modc.sim.trajectory import Trajectory
     from modc.view.page import Ranking
-    from modc.view.server import run
 
     d = tmp_path / "designs"
     d.mkdir()
@@ -272,11 +276,7 @@ def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
     ranking = {"designs": [{"rank": 1, "file": "a.mod"}, {"rank": 2, "file": "b.mod"}]}
     (d / "ranking.json").write_text(json.dumps(ranking), encoding="utf-8")
     page = Page.for_ranking(Ranking(d / "ranking.json"))
-    server, view = start(page, port=0)
-    stop = threading.Event()
-    loop = threading.Thread(target=run, args=(view, stop), daemon=True)
-    loop.start()
-    try:
+    with running(page) as (server, view):
         browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
         _wait(lambda: browser.js(SLIDERS) == 3, 60, "design 1's 3 sliders")
         _settle(browser, server)
@@ -288,24 +288,14 @@ def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
         assert "design 2 of 2" in browser.js("document.body.textContent")
         _click(browser, "◀ previous design")
         _wait(lambda: browser.js(SLIDERS) == 3 and page.index == 0, 60, "design 1 again")
-    finally:
-        stop.set()
-        loop.join(timeout=10)
 
     q = ((0.0, 0.0, 0.0), (0.3, 0.2, 0.1), (0.6, 0.4, 0.2))
     traj = Trajectory(("joint_1", "joint_2", "joint_3"), (0.0, 0.5, 1.0), q)
     page = Page([Source(FARM, traj=traj)])
-    server, view = start(page, port=0)
-    stop = threading.Event()
-    loop = threading.Thread(target=run, args=(view, stop), daemon=True)
-    loop.start()
-    try:
+    with running(page) as (server, view):
         browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
         _wait(lambda: browser.js(SLIDERS) == 4, 60, "3 joint sliders and the time slider")
         _settle(browser, server)
         _wait(lambda: page.t > 0 or _click(browser, "play"), 60, "playback to start")
         _wait(lambda: not page.playing, 60, "playback to run to the end")
         assert page.t == 1.0 and page.q == pytest.approx((0.6, 0.4, 0.2))
-    finally:
-        stop.set()
-        loop.join(timeout=10)
