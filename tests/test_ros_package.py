@@ -339,17 +339,22 @@ def test_kinematics_group_is_the_srdf_group(packages):
         assert kin[chain_groups[0]]["position_only_ik"] is (robot.dof < 6)
 
 
+def parse_every_file(files: dict) -> None:
+    """Every text output parses as what its name says: XML, YAML or Python."""
+    for rel, text in files.items():
+        if isinstance(text, bytes):
+            continue
+        if rel.endswith((".xml", ".xacro", ".launch", ".urdf", ".srdf")):
+            ET.fromstring(text)
+        if rel.endswith((".yaml", ".rviz")) or rel == ".setup_assistant":
+            yaml.safe_load(text)
+        if rel.endswith(".py"):
+            compile(text, rel, "exec")
+
+
 def test_xml_and_yaml_files_parse(packages):
     for _, files, _ in packages.values():
-        for rel, text in files.items():
-            if isinstance(text, bytes):
-                continue
-            if rel.endswith((".xml", ".xacro", ".launch", ".urdf", ".srdf")):
-                ET.fromstring(text)
-            if rel.endswith((".yaml", ".rviz")) or rel == ".setup_assistant":
-                yaml.safe_load(text)
-            if rel.endswith(".py"):
-                compile(text, rel, "exec")
+        parse_every_file(files)
 
 
 def test_a_file_with_two_robots_is_one_package():
@@ -369,17 +374,11 @@ robot Wrist2 { chain L1 - L4(pivot=-90deg, port=90deg) - L1
 def test_awkward_file_names_stay_inert(tmp_path):
     """The file name reaches comments and package.xml's description only: valid XML, and nothing
     roslaunch substitutes (fake_controllers.yaml is loaded with subst_value)."""
-    src = tmp_path / "a&b <c> $(env HOME) ${x}.mod"  # "--" in comments: the URDF backend's (sec-names)
+    src = tmp_path / "a&b <c> $(env HOME) ${x} -->.mod"
     src.write_text("robot r { chain H1 - L4(port=45deg) - L1 }\n")
     for distro in ("jazzy", "noetic"):
         _, files = compile_files(src, ros_distro=distro, collision_samples=0)
-        for rel, text in files.items():
-            if rel.endswith((".xml", ".xacro", ".launch", ".urdf", ".srdf")):
-                ET.fromstring(text)
-            if rel.endswith((".yaml", ".rviz")) or rel == ".setup_assistant":
-                yaml.safe_load(text)
-            if rel.endswith(".py"):
-                compile(text, rel, "exec")
+        parse_every_file(files)
         if distro == "noetic":
             assert "$(env" not in files["config/fake_controllers.yaml"]
         assert ET.fromstring(files["package.xml"]).find("description").text.count("a&b <c>") == 1
