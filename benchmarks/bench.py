@@ -122,7 +122,7 @@ def _machine() -> dict:
     versions = {}
     from importlib import metadata
 
-    for dist in ("modc", "lark", "pydantic", "pydantic-core", "typer", "PyYAML", "Jinja2", "numpy"):
+    for dist in ("modc", "lark", "pydantic", "pydantic-core", "click", "PyYAML", "Jinja2", "numpy"):
         try:
             versions[dist] = metadata.version(dist)
         except metadata.PackageNotFoundError:

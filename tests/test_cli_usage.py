@@ -115,7 +115,7 @@ def test_pyproject_light_and_full():
     tomllib = pytest.importorskip("tomllib")
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
     core = {d.split(">")[0].split("<")[0].split("=")[0].strip() for d in project["dependencies"]}
-    assert core == {"lark", "pydantic", "jinja2", "numpy", "pyyaml", "typer", "rich", "pygls"}
+    assert core == {"lark", "pydantic", "jinja2", "numpy", "pyyaml", "click", "rich", "pygls"}
     full = {d.split(">")[0].split("<")[0].strip() for d in project["optional-dependencies"]["full"]}
     assert {"pin", "pybullet", "ompl", "pillow", "mujoco", "viser", "cma", "dask", "distributed"} <= full
     for doc in ("README.md", ".ci/run"):  # the documented setup still installs everything

@@ -260,7 +260,7 @@ def test_mujoco_catches_tampered_kinematics_and_inertials(tmp_path):
 
 
 def test_cli_engine_option(tmp_path):
-    from typer.testing import CliRunner
+    from click.testing import CliRunner
 
     from modc.cli import app
 

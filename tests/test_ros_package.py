@@ -172,7 +172,7 @@ def test_ik_solver_option():
 
 
 def test_cli_reads_the_environment_below_its_options(tmp_path, monkeypatch):
-    from typer.testing import CliRunner
+    from click.testing import CliRunner
 
     from modc.cli.app import app
 

@@ -7,30 +7,12 @@ libraries (numpy, jinja2, trimesh, pinocchio, pybullet…) are imported inside c
 from __future__ import annotations
 
 import sys
-from typing import Annotated
-
-import typer
-
-from .. import __version__
 
 # each module registers its commands; import order is the order `modc --help` lists them in
 from . import analysis, compile, design_cmd, info, lint, motion, view  # noqa: F401, I001
 from .app import app
 
-
-def _version(value: bool):
-    if value:
-        print(f"modc {__version__}")
-        raise typer.Exit()
-
-
-@app.callback()
-def _root(
-    version: Annotated[
-        bool, typer.Option("--version", callback=_version, is_eager=True, help="print the version")
-    ] = False,
-):
-    pass
+__all__ = ["app", "main"]
 
 
 def main(argv: list[str] | None = None) -> None:

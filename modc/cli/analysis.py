@@ -2,18 +2,19 @@
 from __future__ import annotations
 
 import sys
-from typing import Annotated, NoReturn
+from typing import NoReturn
 
-import typer
+import click
 
 from .app import (
     EXIT_ERRORS,
     EXIT_OK,
     EXIT_USAGE,
-    LibraryOpt,
     _err,
     _print_diagnostics,
     app,
+    argument,
+    library_option,
     usage_errors,
 )
 
@@ -30,20 +31,14 @@ def _mass(text: str) -> float | None:
 
 
 @app.command("check")
-def check_cmd(
-    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
-    payload: Annotated[
-        str | None, typer.Option(help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")
-    ] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="print the torque table as JSON")] = False,
-    traj: Annotated[
-        str | None,
-        typer.Option(
-            "--traj", help="also the torques along this trajectory (inverse dynamics), e.g. from `modc plan --json`"
-        ),
-    ] = None,
-    library: LibraryOpt = None,
-):
+@argument("file", help=".mod file (or its YAML form)")
+@click.option("--payload", help="payload at tool0 replacing the file's, e.g. 0.5kg or 500g")
+@click.option("--json", "json_out", is_flag=True, help="print the torque table as JSON")
+@click.option(
+    "--traj", help="also the torques along this trajectory (inverse dynamics), e.g. from `modc plan --json`"
+)
+@library_option
+def check_cmd(file: str, payload: str | None, json_out: bool, traj: str | None, library: str | None) -> None:
     """Torque feasibility: the worst static gravity torque of every joint over its range, against
     the actuator's nominal and peak torque, and with --traj the peak torques along a motion.
     Exit 1 if a joint can exceed its peak torque."""
@@ -58,12 +53,12 @@ def check_cmd(
         mass = _mass(payload)
         if mass is None:
             _print_diagnostics([codes.BAD_PAYLOAD.at(Span.point("<command line>"), value=payload)], {})
-            raise typer.Exit(EXIT_USAGE)
+            raise SystemExit(EXIT_USAGE)
     try:
         checked = check_file(file, library, analyses=COMPILE_ANALYSES, payload_override=mass)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     robots = [r for r in checked.design.robots if r.torque is not None]
     along = _along(traj, checked.design, robots, mass) if traj is not None and checked.ok else {}
     if json_out:
@@ -105,7 +100,7 @@ def check_cmd(
     for j in over:
         _err(f"modc check: {j.name} ({j.variant}) needs {j.tau:.3g} N·m at t = {j.t:.3f} s of {traj}, "
              f"above its peak {j.tau_max:g} N·m")
-    raise typer.Exit(EXIT_OK if checked.ok and not over else EXIT_ERRORS)
+    raise SystemExit(EXIT_OK if checked.ok and not over else EXIT_ERRORS)
 
 
 def _along(traj_path: str, design, robots, mass) -> dict:
@@ -118,7 +113,7 @@ def _along(traj_path: str, design, robots, mass) -> dict:
 
     def invalid(lines) -> NoReturn:
         _print_diagnostics([codes.TRAJ_INVALID.at(Span.point(traj_path), detail=line) for line in lines], {})
-        raise typer.Exit(EXIT_ERRORS)
+        raise SystemExit(EXIT_ERRORS)
 
     with usage_errors("check"):
         traj, errors = load(traj_path)
@@ -138,17 +133,12 @@ def _along(traj_path: str, design, robots, mass) -> dict:
 
 
 @app.command("dh2mod")
-def dh2mod_cmd(
-    table: Annotated[str, typer.Argument(help="CSV with header a,alpha,d,theta (metres, radians), one row per joint")],
-    json_out: Annotated[
-        bool, typer.Option("--json", help="print requested vs realised DH as JSON instead of .mod text")
-    ] = False,
-    fit_links: Annotated[
-        bool, typer.Option("--fit-links", help="print link modules at the lengths that realise each a exactly")
-    ] = False,
-    name: Annotated[str | None, typer.Option(help="robot name (default: from the file name)")] = None,
-    library: LibraryOpt = None,
-):
+@argument("table", help="CSV with header a,alpha,d,theta (metres, radians), one row per joint")
+@click.option("--json", "json_out", is_flag=True, help="print requested vs realised DH as JSON instead of .mod text")
+@click.option("--fit-links", is_flag=True, help="print link modules at the lengths that realise each a exactly")
+@click.option("--name", help="robot name (default: from the file name)")
+@library_option
+def dh2mod_cmd(table: str, json_out: bool, fit_links: bool, name: str | None, library: str | None) -> None:
     """Convert a standard DH table into a module chain (paper section 4.2); .mod text on stdout."""
     from ..compiler import InputError, SourceError, read_source
     from ..dh.convert_file import convert_table
@@ -157,23 +147,22 @@ def dh2mod_cmd(
         text = read_source(table)
     except SourceError as e:  # an error in the table (not UTF-8, too large): exit 1
         _print_diagnostics([e.diagnostic], {table: e.text} if e.text is not None else {})
-        raise typer.Exit(EXIT_ERRORS) from None
+        raise SystemExit(EXIT_ERRORS) from None
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     out, diags, ok = convert_table(text, table, name=name, fit_links=fit_links, library=library, as_json=json_out)
     _print_diagnostics(diags, {table: text})
     if not ok:
-        raise typer.Exit(EXIT_ERRORS)
+        raise SystemExit(EXIT_ERRORS)
     sys.stdout.write(out)
 
 
 @app.command("dh")
-def dh_cmd(
-    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
-    json_out: Annotated[bool, typer.Option("--json", help="JSON instead of a table")] = False,
-    library: LibraryOpt = None,
-):
+@argument("file", help=".mod file (or its YAML form)")
+@click.option("--json", "json_out", is_flag=True, help="JSON instead of a table")
+@library_option
+def dh_cmd(file: str, json_out: bool, library: str | None) -> None:
     """Show the realised standard DH table of every robot (and the requested one, for dh tables)."""
     import json
 
@@ -184,10 +173,10 @@ def dh_cmd(
         checked = check_file(file, library)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     if not checked.ok:
         _print_diagnostics(checked.diagnostics, checked.sources)
-        raise typer.Exit(EXIT_ERRORS)
+        raise SystemExit(EXIT_ERRORS)
     robots = checked.design.robots
     if json_out:
         doc = {"robots": [{"name": r.name, "sequence": r.sequence, "joints": compare(r)} for r in robots]}

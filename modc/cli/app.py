@@ -1,26 +1,91 @@
-"""The Typer app and what every command shares: output, exit codes, common options."""
+"""The click group and what every command shares: output, exit codes, common options."""
 
 from __future__ import annotations
 
 import difflib
 import sys
-from collections.abc import Iterator
+from collections.abc import Sequence
 from contextlib import contextmanager
-from enum import Enum
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
-import typer
+import click
 
-app = typer.Typer(
-    add_completion=False,
+from .. import __version__
+
+
+def _metavar(option: click.Option) -> str:
+    """A plain metavar: the choices, N for a number, else the option's name (OUT, ROBOT)."""
+    if isinstance(option.type, click.Choice):
+        return "|".join(map(str, option.type.choices))
+    if isinstance(option.type, click.types.IntParamType | click.types.FloatParamType):
+        return "N"
+    return (option.name or "value").upper()
+
+
+class Argument(click.Argument):
+    """A positional argument with a help line, listed under "Arguments" (click before 8.5 has none)."""
+
+    def __init__(self, param_decls: Sequence[str], help: str = "", **attrs: Any) -> None:
+        super().__init__(param_decls, **attrs)
+        self.help = help
+
+
+class Command(click.Command):
+    """Plain help: an "Arguments" section, and a metavar for every option instead of click's
+    TEXT/INTEGER/[a|b] type names."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for param in self.params:
+            if isinstance(param, click.Option) and not param.is_flag and param.metavar is None:
+                param.metavar = _metavar(param)
+
+    def format_help(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        self.format_usage(ctx, formatter)
+        self.format_help_text(ctx, formatter)
+        arguments = [p for p in self.params if isinstance(p, Argument)]
+        rows = [(a.human_readable_name, (a.help or "") + ("  [required]" if a.required else "")) for a in arguments]
+        if rows:
+            with formatter.section("Arguments"):
+                formatter.write_dl(rows)
+        self.format_options(ctx, formatter)
+        self.format_epilog(ctx, formatter)
+
+
+class Group(click.Group):
+    """`modc`: every module of modc.cli registers its commands here; `modc --help` lists them in
+    that order, not alphabetically."""
+
+    command_class = Command
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(self.commands)
+
+
+def _version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    if value and not ctx.resilient_parsing:
+        print(f"modc {__version__}")
+        ctx.exit()
+
+
+app = Group(
+    "modc",
     no_args_is_help=True,
-    rich_markup_mode=None,
     context_settings={"show_default": True},
+    params=[
+        click.Option(["--version"], is_flag=True, expose_value=False, is_eager=True, callback=_version,
+                     help="print the version")
+    ],
     help="modc: compile .mod files describing MOIRs Mark-2 modular arms into URDF and friends.\n\n"
     "\b\n`modc FILE -o OUT` is `modc compile FILE -o OUT`: check FILE (.mod or its YAML form)\n"
     "and write URDF, meshes, xacro, SRDF and a ROS package into OUT.",
 )
+
+
+def argument(name: str, help: str, **attrs: Any):
+    """A positional argument of a command, with its help line."""
+    return click.argument(name, cls=Argument, help=help, **attrs)
 
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
@@ -43,29 +108,19 @@ def _print_diagnostics(diags, sources) -> None:
         _err(render_text(shown, sources))
 
 
-class TorqueLevel(str, Enum):
-    error = "error"
-    warning = "warning"
-    off = "off"
+library_option = click.option(
+    "--library",
+    metavar="NAME|FILE",
+    help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file",
+)
 
 
-LibraryOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--library",
-        metavar="NAME|FILE",
-        help="module library: a built-in name (mark2, mark2-strict) or a YAML file; overrides `library` in the file",
-    ),
-]
-
-
-def _expand(paths: list[str], prog: str = "modc") -> list[str]:
+def _expand(paths: Sequence[str], prog: str = "modc") -> list[str]:
     """Files as given; directories searched for *.mod; glob patterns (also '**') expanded here,
     so quoted patterns work in CI shells. Sorted and de-duplicated, for stable output. A directory
     without .mod files or a pattern matching no file ends the command (exit 2): a mistyped CI
     glob must not pass as "0 files, no errors"."""
     import glob
-    from pathlib import Path
 
     out: list[str] = []
     for p in paths:
@@ -79,7 +134,7 @@ def _expand(paths: list[str], prog: str = "modc") -> list[str]:
             found, what = [p], ""
         if not found:
             _err(f"{prog}: {p}: the {what}")
-            raise typer.Exit(EXIT_USAGE)
+            raise SystemExit(EXIT_USAGE)
         out += found
     return list(dict.fromkeys(out))
 
@@ -96,15 +151,15 @@ def usage_errors(prog: str, usage: tuple[type[Exception], ...] = (), writing: st
         yield
     except (InputError, RobotChoiceError) as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     except usage as e:
         _err(f"modc {prog}: {e}")
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     except OSError as e:
         if writing is None:
             raise
         _err(f"modc {prog}: cannot write {writing}: {e.strerror or e}")
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
 
 
 # --- the command line as a whole: routing, help, missing extras -------------------------------------
@@ -137,7 +192,7 @@ def missing_extra(e: ModuleNotFoundError, command: str) -> str | None:
 
 
 def route(args: list[str], commands: list[str]) -> list[str] | str:
-    """The arguments for the Typer app, or an error line. A first word that is no command is a
+    """The arguments for the click group, or an error line. A first word that is no command is a
     file to compile (`modc FILE -o OUT`) when it looks like one (it exists, or has a source suffix
     or a path separator); any other word is a mistyped command."""
     if not args or args[0].startswith("-") or args[0] in commands:
@@ -151,49 +206,14 @@ def route(args: list[str], commands: list[str]) -> list[str] | str:
     return f"modc: no command or file '{word}': {suggestion}"
 
 
-def _metavar(param: Any) -> str:
-    """A plain metavar: the choices, N for a number, else the parameter's name (FILE, OUT)."""
-    desc = param.type_descriptor  # Typer describes parameter types itself (it vendors click)
-    if desc.choices:
-        return "|".join(str(getattr(c, "value", c)) for c in desc.choices)
-    if desc.annotation in (int, float):
-        return "N"
-    return (param.name or "value").upper()
-
-
-def _plain_help(command: Any) -> None:
-    """Help without Typer's `<str>` types and `{file}` braces: every parameter gets a metavar."""
-    for param in command.params:
-        if getattr(param, "is_flag", False) or param.name == "help":
-            continue
-        if param.metavar is None:
-            param.metavar = _metavar(param)
-        if param.param_type_name == "argument":
-            name = param.metavar + ("..." if param.nargs != 1 else "")
-            usage = name if param.required else f"[{name}]"
-            param.display_type_rich = lambda ctx: None
-            param._usage_display_name = lambda usage=usage: usage
-    for sub in getattr(command, "commands", {}).values():
-        _plain_help(sub)
-
-
-def _commands() -> Iterator[str]:
-    for c in app.registered_commands:
-        name = c.name or (c.callback.__name__ if c.callback else None)
-        if name:
-            yield name
-
-
 def run(argv: list[str]) -> None:
-    """The `modc` entry point: route, then run the Typer app as a click command."""
-    routed = route(argv, list(_commands()))
+    """The `modc` entry point: route, then run the click group."""
+    routed = route(argv, list(app.commands))
     if isinstance(routed, str):
         _err(routed)
         raise SystemExit(EXIT_USAGE)
-    command = typer.main.get_command(app)
-    _plain_help(command)
     try:
-        command.main(args=routed, prog_name="modc")
+        app.main(args=routed, prog_name="modc")
     except ModuleNotFoundError as e:
         line = missing_extra(e, routed[0] if routed else "")
         if line is None:

@@ -1,73 +1,77 @@
 """`modc FILE -o OUT`: check, build every backend, write OUT atomically."""
 from __future__ import annotations
 
-from typing import Annotated
-
-import typer
+import click
 
 from .app import (
     EXIT_ERRORS,
     EXIT_USAGE,
-    LibraryOpt,
-    TorqueLevel,
     Verbosity,
     _err,
     _print_diagnostics,
     app,
+    argument,
+    library_option,
     usage_errors,
 )
 
-OnlyOpt = Annotated[str | None, typer.Option(help="comma-separated backends to run (default: all; `modc backends`)")]
-SamplesOpt = Annotated[int, typer.Option(min=0, help="random poses for the SRDF collision matrix (MoveIt's default)")]
-SeedOpt = Annotated[int, typer.Option(min=0, help="seed of those poses: same file and seed, same SRDF on any machine")]
-TorqueOpt = Annotated[TorqueLevel | None,
-                      typer.Option(help="how a joint that cannot hold the arm at peak torque is reported")]
-# ROS package options (README "Use in ROS 2 / ROS 1"; precedence in modc.backends.ros_target.distro_for)
-RosOpt = Annotated[int | None, typer.Option(
-    "--ros", help="ROS package for ROS 1 (noetic) or ROS 2 (jazzy); default: $ROS_DISTRO, $ROS_VERSION, else 2")]
-DistroOpt = Annotated[str | None, typer.Option(help="target distro: noetic, humble or jazzy (overrides --ros)")]
-IkOpt = Annotated[str | None, typer.Option(help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's)")]
-PackageOpt = Annotated[str | None, typer.Option(help="ROS package name (default: <robot>_moveit_config)")]
-InterfaceOpt = Annotated[str | None, typer.Option(help="ros2_control command interface: position (default) or effort")]
-
 
 @app.command("compile")
+@argument("file", help=".mod file (or its YAML form)")
+@click.option("-o", "--out", required=True, help="output directory (replaced atomically on success)")
+@library_option
+@click.option("--only", help="comma-separated backends to run (default: all; `modc backends`)")
+@click.option("--force/--no-force", default=False,
+              help="replace OUT whatever it holds (deletes files modc did not write)")
+@click.option("--collision-samples", type=click.IntRange(min=0), default=10_000,
+              help="random poses for the SRDF collision matrix (MoveIt's default)")
+@click.option("--seed", type=click.IntRange(min=0), default=0,
+              help="seed of those poses: same file and seed, same SRDF on any machine")
+@click.option("--smoke", is_flag=True, help="also run `modc sim` (PyBullet) before writing OUT")
+@click.option("--torque", type=click.Choice(["error", "warning", "off"]),
+              help="how a joint that cannot hold the arm at peak torque is reported")
+# ROS package options (README "Use in ROS 2 / ROS 1"; precedence in modc.backends.ros_target.distro_for)
+@click.option("--ros", type=int,
+              help="ROS package for ROS 1 (noetic) or ROS 2 (jazzy); default: $ROS_DISTRO, $ROS_VERSION, else 2")
+@click.option("--ros-distro", help="target distro: noetic, humble or jazzy (overrides --ros)")
+@click.option("--ik-solver", help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's)")
+@click.option("--ros-package", help="ROS package name (default: <robot>_moveit_config)")
+@click.option("--command-interface", help="ros2_control command interface: position (default) or effort")
+@click.option("-q", "--quiet", is_flag=True, help="print errors only")
+@click.option("-v", "--verbose", is_flag=True, help="list the files written")
 def compile_cmd(
-    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form)")],
-    out: Annotated[str, typer.Option("-o", "--out", help="output directory (replaced atomically on success)")],
-    library: LibraryOpt = None,
-    only: OnlyOpt = None,
-    force: Annotated[
-        bool, typer.Option(help="replace OUT whatever it holds (deletes files modc did not write)")
-    ] = False,
-    collision_samples: SamplesOpt = 10_000,
-    seed: SeedOpt = 0,
-    smoke: Annotated[bool, typer.Option("--smoke", help="also run `modc sim` (PyBullet) before writing OUT")] = False,
-    torque: TorqueOpt = None,
-    ros: RosOpt = None,
-    ros_distro: DistroOpt = None,
-    ik_solver: IkOpt = None,
-    ros_package: PackageOpt = None,
-    command_interface: InterfaceOpt = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
-    verbose: Annotated[bool, typer.Option("--verbose", "-v", help="list the files written")] = False,
-):
+    file: str,
+    out: str,
+    library: str | None,
+    only: str | None,
+    force: bool,
+    collision_samples: int,
+    seed: int,
+    smoke: bool,
+    torque: str | None,
+    ros: int | None,
+    ros_distro: str | None,
+    ik_solver: str | None,
+    ros_package: str | None,
+    command_interface: str | None,
+    quiet: bool,
+    verbose: bool,
+) -> None:
     """Check FILE and write URDF, meshes and a report into OUT."""
     from ..compiler import COMPILE_ANALYSES, InputError, build, check_file, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
     try:
-        severity = (torque or TorqueLevel.error).value
-        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=severity)
+        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=torque or "error")
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not checked.ok:
         from ..diagnostics.render import summary
 
         _err(f"modc: {summary(checked.diagnostics)}; nothing written to {out}")
-        raise typer.Exit(EXIT_ERRORS)
+        raise SystemExit(EXIT_ERRORS)
     selected = None
     if only:
         from ..backends import load_all
@@ -76,7 +80,7 @@ def compile_cmd(
         unknown = [s for s in selected if s not in load_all()]
         if unknown:
             _err(f"modc: unknown backend(s) {', '.join(unknown)}; available: {', '.join(load_all())}")
-            raise typer.Exit(EXIT_USAGE)
+            raise SystemExit(EXIT_USAGE)
     if smoke:  # before anything is written: a failed smoke test leaves OUT as it was
         from ..sim.smoke import run_sim
 
@@ -85,7 +89,7 @@ def compile_cmd(
             _err(line)
         if not ok:
             _err(f"modc: smoke test failed; nothing written to {out}")
-            raise typer.Exit(EXIT_ERRORS)
+            raise SystemExit(EXIT_ERRORS)
     ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
     files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     with usage_errors("compile", writing=out):
@@ -115,5 +119,5 @@ def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, com
             resolve(Build(checked.design, **options))
     except RosOptionError as e:
         _err(f"modc: {e}")
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     return options

@@ -3,11 +3,10 @@ from __future__ import annotations
 
 import sys
 from contextlib import contextmanager, nullcontext
-from typing import Annotated
 
-import typer
+import click
 
-from .app import EXIT_ERRORS, EXIT_USAGE, LibraryOpt, _err, _print_diagnostics, app, usage_errors
+from .app import EXIT_ERRORS, EXIT_USAGE, _err, _print_diagnostics, app, argument, library_option, usage_errors
 
 RENDERED = 3  # pictures of the top designs in report.html
 
@@ -73,19 +72,30 @@ def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
 
 
 @app.command("design")
+@argument("file", help=".mod file with `design NAME { … }` blocks")
+@click.option("-o", "--out", required=True, help="output directory: ranking.json, .mod files, report.html")
+@click.option("--max-units", type=click.IntRange(min=1), help="largest chain, over `units`")
+@click.option("--top", type=click.IntRange(min=1), default=5, help="designs to keep")
+@click.option("--seed", type=click.IntRange(min=0), default=0, help="same file and seed, same ranking")
+@click.option("--workers", type=click.IntRange(min=1), default=1, help="local worker processes")
+@click.option("--scheduler", help="run on a Dask cluster: tcp://host:8786")
+@click.option("--json", "json_out", is_flag=True, help="print ranking.json on stdout")
+@click.option("--render/--no-render", default=True, help="pictures of the top designs")
+@library_option
+@click.option("--force/--no-force", default=False, help="replace DIR even if modc did not create it")
 def design_cmd(
-    file: Annotated[str, typer.Argument(help=".mod file with `design NAME { … }` blocks")],
-    out: Annotated[str, typer.Option("-o", "--out", help="output directory: ranking.json, .mod files, report.html")],
-    max_units: Annotated[int | None, typer.Option("--max-units", min=1, help="largest chain, over `units`")] = None,
-    top: Annotated[int, typer.Option("--top", min=1, help="designs to keep")] = 5,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="same file and seed, same ranking")] = 0,
-    workers: Annotated[int, typer.Option("--workers", min=1, help="local worker processes")] = 1,
-    scheduler: Annotated[str | None, typer.Option("--scheduler", help="run on a Dask cluster: tcp://host:8786")] = None,
-    json_out: Annotated[bool, typer.Option("--json", help="print ranking.json on stdout")] = False,
-    render: Annotated[bool, typer.Option("--render/--no-render", help="pictures of the top designs")] = True,
-    library: LibraryOpt = None,
-    force: Annotated[bool, typer.Option(help="replace DIR even if modc did not create it")] = False,
-):
+    file: str,
+    out: str,
+    max_units: int | None,
+    top: int,
+    seed: int,
+    workers: int,
+    scheduler: str | None,
+    json_out: bool,
+    render: bool,
+    library: str | None,
+    force: bool,
+) -> None:
     """Find the best module chains for the cells and targets of FILE's design blocks."""
     import json
 
@@ -99,14 +109,14 @@ def design_cmd(
         checked = check_file(file, library)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
-        raise typer.Exit(EXIT_USAGE) from None
+        raise SystemExit(EXIT_USAGE) from None
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not checked.ok:
-        raise typer.Exit(EXIT_ERRORS)
+        raise SystemExit(EXIT_ERRORS)
     problems = checked.design.problems
     if not problems:
         _err(f"modc design: {file} has no `design NAME {{ … }}` block")
-        raise typer.Exit(EXIT_USAGE)
+        raise SystemExit(EXIT_USAGE)
     outcomes, failed = [], []
     tty = sys.stderr.isatty()
     with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor:
@@ -122,7 +132,7 @@ def design_cmd(
     if failed:
         _print_diagnostics(failed, checked.sources)
         _err(f"modc design: no design found; nothing written to {out}")
-        raise typer.Exit(EXIT_ERRORS)
+        raise SystemExit(EXIT_ERRORS)
     tree = design_files(outcomes)
     if render:
         names = [f for f in tree if f.endswith(".mod")]

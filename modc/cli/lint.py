@@ -2,48 +2,37 @@
 
 from __future__ import annotations
 
-from enum import Enum
-from typing import Annotated
-
-import typer
+import click
 
 from .. import __version__
 from .app import (
     EXIT_ERRORS,
     EXIT_OK,
     EXIT_USAGE,
-    LibraryOpt,
     Verbosity,
     _err,
     _expand,
     _print_diagnostics,
     app,
+    argument,
+    library_option,
 )
 
 
-class LintFormat(str, Enum):
-    text = "text"
-    json = "json"
-    github = "github"
-    sarif = "sarif"
-
-
 @app.command("lint")
-def lint_cmd(
-    files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
-    format: Annotated[LintFormat, typer.Option("--format", "-f", help="output format")] = LintFormat.text,
-    library: LibraryOpt = None,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="print errors only")] = False,
-    sarif_root: Annotated[
-        str,
-        typer.Option(
-            "--sarif-root",
-            metavar="DIR",
-            help="with --format sarif: the repository root that paths are "
-            "relative to (files outside it get absolute file: URIs)",
-        ),
-    ] = ".",
-):
+@argument("files", nargs=-1, required=True, help=".mod files or directories")
+@click.option("-f", "--format", type=click.Choice(["text", "json", "github", "sarif"]), default="text",
+              help="output format")
+@library_option
+@click.option("-q", "--quiet", is_flag=True, help="print errors only")
+@click.option(
+    "--sarif-root",
+    metavar="DIR",
+    default=".",
+    help="with --format sarif: the repository root that paths are relative to (files outside it get absolute "
+    "file: URIs)",
+)
+def lint_cmd(files: tuple[str, ...], format: str, library: str | None, quiet: bool, sarif_root: str) -> None:
     """Check files without writing anything."""
     from ..compiler import InputError, check_file
     from ..diagnostics.render import render_github, render_json, render_sarif, summary
@@ -61,29 +50,26 @@ def lint_cmd(
         diags += c.diagnostics
         sources.update(c.sources)
     shown = [d for d in diags if not (quiet and not d.is_error)]
-    if format is LintFormat.json:
+    if format == "json":
         print(render_json(shown))
-    elif format is LintFormat.github:
+    elif format == "github":
         if shown:
             print(render_github(shown))
-    elif format is LintFormat.sarif:
+    elif format == "sarif":
         print(render_sarif(shown, __version__, root=sarif_root, sources=sources))
     else:
         _print_diagnostics(diags, sources)
         if not quiet:
             _err(f"modc lint: {len(paths)} file{'s' * (len(paths) != 1)}, {summary(diags)}")
     if io_error:
-        raise typer.Exit(EXIT_USAGE)
-    raise typer.Exit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
+        raise SystemExit(EXIT_USAGE)
+    raise SystemExit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
 
 
 @app.command("fmt")
-def fmt_cmd(
-    files: Annotated[list[str], typer.Argument(help=".mod files or directories")],
-    check: Annotated[
-        bool, typer.Option("--check", help="write nothing; list the files that would change and exit 1 if any")
-    ] = False,
-):
+@argument("files", nargs=-1, required=True, help=".mod files or directories")
+@click.option("--check", is_flag=True, help="write nothing; list the files that would change and exit 1 if any")
+def fmt_cmd(files: tuple[str, ...], check: bool) -> None:
     """Rewrite .mod files in the canonical layout (comments kept, meaning unchanged)."""
     from ..compiler import YAML_SUFFIXES, InputError, SourceError, read_source
     from ..syntax.format import FormatterBug, format_text, rewrite_file
@@ -129,5 +115,5 @@ def fmt_cmd(
         print(path)
     _print_diagnostics(diags, sources)
     if io_error:
-        raise typer.Exit(EXIT_USAGE)
-    raise typer.Exit(EXIT_ERRORS if diags or (check and changed) else EXIT_OK)
+        raise SystemExit(EXIT_USAGE)
+    raise SystemExit(EXIT_ERRORS if diags or (check and changed) else EXIT_OK)

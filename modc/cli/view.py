@@ -1,11 +1,9 @@
 """`modc view`: a live 3D view of the arm in the browser."""
 from __future__ import annotations
 
-from typing import Annotated
+import click
 
-import typer
-
-from .app import EXIT_OK, LibraryOpt, _err, app, usage_errors
+from .app import _err, app, argument, library_option, usage_errors
 
 
 def _open_browser(url: str) -> bool:
@@ -21,14 +19,13 @@ def _open_browser(url: str) -> bool:
 
 
 @app.command("view")
-def view_cmd(
-    file: Annotated[str, typer.Argument(help=".mod file (or its YAML form), or the ranking.json of `modc design`")],
-    port: Annotated[int, typer.Option(min=0, max=65535, help="local port of the page (0: any free one)")] = 8080,
-    no_browser: Annotated[bool, typer.Option("--no-browser", help="only print the page's address")] = False,
-    traj: Annotated[str | None, typer.Option("--traj", help="trajectory JSON to play (`modc plan --json`)")] = None,
-    robot: Annotated[str | None, typer.Option(help="the robot to show (files with several robots)")] = None,
-    library: LibraryOpt = None,
-):
+@argument("file", help=".mod file (or its YAML form), or the ranking.json of `modc design`")
+@click.option("--port", type=click.IntRange(0, 65535), default=8080, help="local port of the page (0: any free one)")
+@click.option("--no-browser", is_flag=True, help="only print the page's address")
+@click.option("--traj", help="trajectory JSON to play (`modc plan --json`)")
+@click.option("--robot", help="the robot to show (files with several robots)")
+@library_option
+def view_cmd(file: str, port: int, no_browser: bool, traj: str | None, robot: str | None, library: str | None) -> None:
     """Live 3D view in the browser: the arm in its cell with its targets, a slider per joint, the
     named poses, tool0 and each joint's gravity torque against its actuator, trajectory playback.
     Saving the file updates the page; an error shows its diagnostics and keeps the last good arm.
@@ -54,4 +51,3 @@ def view_cmd(
         _err("modc view: no display to open a browser on; open the address above yourself")
     run(view)
     print("modc view: stopped")
-    raise typer.Exit(EXIT_OK)
