@@ -161,3 +161,39 @@ def test_help_has_plain_metavars_and_defaults(command):
         assert "[default: text]" in text and "--format text|json|github|sarif" in text and "FILES..." in text
     if command == "compile":
         assert "--out OUT" in text and "[default: 10000" in text
+
+
+def test_every_command_lists_its_arguments_and_options_plainly():
+    """Help of every registered command, as click renders it: each argument under "Arguments"
+    with its help, each option with a metavar of its own (no TEXT/INTEGER/[a|b] type names)."""
+    import click
+    from click.testing import CliRunner
+
+    from modc.cli import app
+
+    runner = CliRunner()
+    root = runner.invoke(app, ["--help"])
+    assert root.exit_code == 0, root.output
+    listed = [line.split()[0] for line in root.output.split("Commands:\n")[1].splitlines() if line.startswith("  ")]
+    assert listed == list(app.commands) and listed != sorted(listed)  # registration order, not click's sort
+    for name, command in app.commands.items():
+        r = runner.invoke(app, [name, "--help"])
+        assert r.exit_code == 0, r.output
+        text = r.output
+        assert not any(w in text.split() for w in ("TEXT", "INTEGER", "FLOAT", "BOOLEAN")), text
+        for param in command.params:
+            if isinstance(param, click.Argument):
+                assert param.help and f"\n  {param.name.upper()}  {param.help.split()[0]}" in text, (name, text)
+            elif isinstance(param, click.Option) and param.name != "help":
+                shown = ", ".join(param.opts) if param.is_flag else f"{', '.join(param.opts)} {param.metavar}"
+                assert f"  {shown}" in text, (name, shown, text)
+                assert param.metavar is None or "[" not in param.metavar, (name, param.metavar)
+
+
+def test_version_and_bare_modc():
+    from modc import __version__
+
+    r = modc("--version")
+    assert r.returncode == 0 and r.stdout == f"modc {__version__}\n"
+    r = modc()
+    assert r.returncode == 2 and "Usage: modc [OPTIONS] COMMAND" in r.stderr and "Commands:" in r.stderr

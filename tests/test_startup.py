@@ -44,6 +44,7 @@ def test_lint_imports_no_heavy_library(tmp_path):
     assert code in (0, None)
     assert not modules & set(HEAVY), modules & set(HEAVY)
     assert "numpy" not in modules and "jinja2" not in modules  # lint checks text; it renders and computes nothing
+    assert "typer" not in modules  # its pydantic-based parameter handling cost every command ~40 ms
 
 
 def test_compile_imports_no_trimesh_and_a_cached_compile_no_pinocchio(tmp_path):
