@@ -18,7 +18,7 @@ def _metavar(option: click.Option) -> str:
     """A plain metavar: the choices, N for a number, else the option's name (OUT, ROBOT)."""
     if isinstance(option.type, click.Choice):
         return "|".join(map(str, option.type.choices))
-    if isinstance(option.type, click.types.IntParamType | click.types.FloatParamType):
+    if option.type in (click.INT, click.FLOAT) or isinstance(option.type, click.IntRange | click.FloatRange):
         return "N"
     return (option.name or "value").upper()
 
