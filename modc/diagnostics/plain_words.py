@@ -7,6 +7,7 @@ a failed check through this one table, with the error's own bounds ("at least 1"
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from typing import Any
 
 _FIXED = {
@@ -40,7 +41,7 @@ _BOUNDS = {
 }
 
 
-def plain_words(err: dict[str, Any]) -> str:
+def plain_words(err: Mapping[str, Any]) -> str:
     """One pydantic error (an item of ValidationError.errors()) as a short phrase."""
     kind = err.get("type", "")
     if kind in _FIXED:
