@@ -16,6 +16,9 @@ anchor in the same run.
      anchor           xacro FILE.urdf.xacro -o OUT.urdf: the xacro command expanding the same arm's
                       own .urdf.xacro (the one modc emits)
      cold lint        python -m modc lint FILE    anchor: python -c pass
+   and, with --floors, what any lint in a fresh process pays whatever modc's own code does, each
+   against the same `python -c pass`: the libraries it is built on (pydantic's BaseModel, lark,
+   the CLI library), modc's modules imported without work, and check_file(FILE) with no CLI.
 2. In-process (a 6-DoF arm, examples/example_b.mod), median over batches of the process's CPU
    time per call (wall time alongside):
      describe + model        the arm's Description and its pinocchio Model
@@ -28,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import datetime as _dt
+import importlib.util
 import os
 import platform
 import resource
@@ -65,7 +69,21 @@ def prepare(src: Path, tmp: Path) -> Path:
     return tmp / "prepared" / "urdf" / f"{robot.file_stem}.urdf.xacro"
 
 
-def bench_processes(src: Path, xacro_file: Path, runs: int, tmp: Path) -> dict:
+def floor_cases(src: Path, env: dict) -> dict:
+    """Start-up costs that a cold lint cannot avoid with modc's present libraries."""
+    py = sys.executable
+    cli = "click" if importlib.util.find_spec("click") and not importlib.util.find_spec("typer") else "typer"
+    return {
+        "floor: import pydantic.BaseModel": (env, [py, "-c", "from pydantic import BaseModel"]),
+        "floor: import lark": (env, [py, "-c", "import lark"]),
+        f"floor: import {cli}": (env, [py, "-c", f"import {cli}"]),
+        "floor: import modc.compiler (no work)": (env, [py, "-c", "import modc.compiler"]),
+        "floor: check_file(FILE), no CLI": (env, [py, "-c", f"from modc.compiler import check_file; "
+                                                          f"check_file({str(src)!r})"]),
+    }
+
+
+def bench_processes(src: Path, xacro_file: Path, runs: int, tmp: Path, floors: bool = False) -> dict:
     env = child_env(pycache=tmp / "pycache")
     env.pop("MODC_NO_CACHE", None)
     env["MODC_CACHE_DIR"] = str(tmp / "cache")
@@ -80,6 +98,8 @@ def bench_processes(src: Path, xacro_file: Path, runs: int, tmp: Path) -> dict:
         "modc lint FILE": (env, [*modc, "lint", str(src)]),
         "python -c pass": (env, [sys.executable, "-c", "pass"]),
     }
+    if floors:
+        cases.update(floor_cases(src, env))
     codes = {}
     for name, (e, cmd) in cases.items():  # warm-up: bytecode, the cache for "cached", the OS's file cache
         codes[name] = subprocess.run(cmd, env=e, capture_output=True, cwd=tmp).returncode
@@ -144,6 +164,10 @@ def render(doc: dict) -> str:
         x, c, goal = r[key], r[f"{key}_cpu"], GOALS[key]
         return f"wall {x:5.2f}x, cpu {c:5.2f}x (goal <= {goal:g}x: {'ok' if c <= goal else 'MISS'})"
 
+    anchor = p["python -c pass"]["cpu"]["median"]
+    for k, s in p.items():
+        if k.startswith("floor:"):
+            lines.append(f"   {k:<{w}} = {s['cpu']['median'] / anchor:5.2f}x python -c pass (cpu)")
     lines += [f"   first compile / xacro:      {verdict('first')}",
               f"   cached compile / xacro:     {verdict('cached')}",
               f"   cold lint / python -c pass: {verdict('lint')}", "",
@@ -168,6 +192,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", nargs="?", const="-", metavar="PATH", help="JSON to stdout (table to stderr) or to PATH")
     ap.add_argument("--processes-only", action="store_true",
                     help="only part 1 (e.g. to measure an older checkout, which has no fast path)")
+    ap.add_argument("--floors", action="store_true",
+                    help="also time the imports a cold lint cannot avoid (pydantic, lark, the CLI library, "
+                    "modc's modules) and check_file without the CLI")
     args = ap.parse_args(argv)
     runs = args.runs or (5 if args.quick else 11)
     batches, per_batch = (5, 50) if args.quick else (15, 100)
@@ -176,7 +203,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="modc-bench-compile-") as t:
         tmp = Path(t)
         xacro_file = prepare(src, tmp)
-        processes = bench_processes(src, xacro_file, runs, tmp)
+        processes = bench_processes(src, xacro_file, runs, tmp, args.floors)
     ip = {} if args.processes_only else bench_in_process(batches, per_batch)
     med = {k: v["median"] for k, v in processes.items()}
     cpu = {k: v["cpu"]["median"] for k, v in processes.items()}

@@ -72,7 +72,9 @@ def test_user_library_file_is_used(tmp_path):
 
 
 @pytest.mark.parametrize("mutation, fragment", [
-    (("mass: 0.57", "mass: -1"), "greater than 0"),
+    (("mass: 0.57", "mass: -1"), "mass: must be greater than 0"),
+    (("epsilon: 3", "epsilon: 0"), "epsilon: must be at least 1"),
+    (("max_dof: 6", 'max_dof: "six"'), "max_dof: expected a whole number"),
     (("first_variant: H", "first_variant: X"), "variant 'X'"),
     (("lower_deg: -170", "lower_deg: 200"), "lower_deg"),
 ])
@@ -82,3 +84,4 @@ def test_invalid_library_is_a_diagnostic(tmp_path, mutation, fragment):
     c = check_text('robot r { library "bad.yaml" chain H1 - L1 }', str(tmp_path / "r.mod"))
     assert [d.code for d in c.diagnostics] == ["library-invalid"]
     assert fragment in c.diagnostics[0].message
+    assert "Input should" not in c.diagnostics[0].message  # the author's words, not pydantic's

@@ -15,6 +15,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validat
 
 from .. import names
 from ..diagnostics import Span
+from ..diagnostics.plain_words import plain_words
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
@@ -281,7 +282,7 @@ def _load_path(path: str, mtime: float) -> Library:
     except ValidationError as e:
         first = e.errors()[0]
         loc = ".".join(str(p) for p in first["loc"] if p != "[key]")
-        message = first["msg"].removeprefix("Value error, ")
+        message = plain_words(first)
         raise LibraryError(f"{loc}: {message}" if loc else message, _where(text, path, first["loc"]), text) from None
 
 

@@ -1,9 +1,8 @@
 """Read the YAML form into the same AST as .mod text, keeping YAML line/column spans."""
 from __future__ import annotations
 
-import re
-
 from ..diagnostics import Diagnostic, Span, codes
+from ..diagnostics.plain_words import plain_words
 from . import ast
 from .parser import too_large
 
@@ -258,24 +257,6 @@ def _respan(node, span: Span):
     return dataclasses.replace(node, **changes)
 
 
-# pydantic's error types in the YAML form's words (its own messages name Python classes).
-_PLAIN = {
-    "model_type": "expected a mapping (key: value lines)", "dict_type": "expected a mapping (key: value lines)",
-    "model_attributes_type": "expected a mapping (key: value lines)",
-    "list_type": "expected a list", "tuple_type": "expected a list",
-    "string_type": "expected text", "missing": "required but missing", "extra_forbidden": "unknown key",
-    "float_type": "expected a number", "float_parsing": "expected a number", "int_type": "expected a whole number",
-    "int_parsing": "expected a whole number", "bool_type": "expected true or false",
-    "bool_parsing": "expected true or false",
-}
-
-
-def _plain_words(err) -> str:
-    if err["type"] in _PLAIN:
-        return _PLAIN[err["type"]]
-    return re.sub(r" or (an )?instance of \w+", "", err["msg"])
-
-
 def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
     import yaml
     from pydantic import ValidationError
@@ -319,7 +300,7 @@ def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
                 continue
             seen.add(key)
             reader = _Reader(file, spans, diags)
-            diags.append(codes.YAML_SCHEMA.at(reader.span(loc), detail=f"{_dotted(loc)}: {_plain_words(err)}"))
+            diags.append(codes.YAML_SCHEMA.at(reader.span(loc), detail=f"{_dotted(loc)}: {plain_words(err)}"))
         return ast.File(file, ()), diags
     reader = _Reader(file, spans, diags)
     robots = tuple(reader.robot(r, ("robots", i)) for i, r in enumerate(doc.robots))

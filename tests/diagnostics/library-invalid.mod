@@ -3,4 +3,4 @@ robot farm { library "libraries/broken-epsilon.yaml"
     chain H1 - L4(port=45deg) - L1
 }
 # the diagnostic points into the library file; its message is long, so the expectation sits here
-# expect-in libraries/broken-epsilon.yaml:15: error[library-invalid] module library 'libraries/broken-epsilon.yaml' is invalid: variants.H.actuator.epsilon: Input should be greater than or equal to 1
+# expect-in libraries/broken-epsilon.yaml:15: error[library-invalid] module library 'libraries/broken-epsilon.yaml' is invalid: variants.H.actuator.epsilon: must be at least 1
