@@ -18,7 +18,8 @@ anchor in the same run.
      cold lint        python -m modc lint FILE    anchor: python -c pass
    and, with --floors, what any lint in a fresh process pays whatever modc's own code does, each
    against the same `python -c pass`: the libraries it is built on (pydantic's BaseModel, lark,
-   the CLI library), modc's modules imported without work, and check_file(FILE) with no CLI.
+   the CLI library), the CLI library plus parsing FILE into the AST (no model, no pydantic: what
+   any lint does first), modc's modules imported without work, and check_file(FILE) with no CLI.
 2. In-process (a 6-DoF arm, examples/example_b.mod), median over batches of the process's CPU
    time per call (wall time alongside):
      describe + model        the arm's Description and its pinocchio Model
@@ -75,6 +76,8 @@ def floor_cases(src: Path, env: dict) -> dict:
         "floor: import pydantic.BaseModel": (env, [py, "-c", "from pydantic import BaseModel"]),
         "floor: import lark": (env, [py, "-c", "import lark"]),
         "floor: import click (the CLI library)": (env, [py, "-c", "import click"]),
+        "floor: import click + parse(FILE), no model": (env, [py, "-c", "import click; from modc.syntax import parse; "
+                                                                 f"parse(open({str(src)!r}).read())"]),
         "floor: import modc.compiler (no work)": (env, [py, "-c", "import modc.compiler"]),
         "floor: check_file(FILE), no CLI": (env, [py, "-c", f"from modc.compiler import check_file; "
                                                           f"check_file({str(src)!r})"]),
