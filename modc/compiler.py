@@ -127,37 +127,9 @@ def build(checked: Checked, only: list[str] | None = None, **options) -> dict[st
 
 def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False,
                inputs: Sequence[str | os.PathLike] = ()) -> None:
-    """Write files into a fresh directory next to OUT and exchange it with OUT atomically (see
-    modc.files): OUT is either the old tree or the complete new one, never half-written or
-    missing. OUT may be replaced when it is missing, empty, or exactly what modc wrote there
-    (its manifest lists every file, unchanged); otherwise only with force, which replaces it
-    whatever it holds. Never (even with force): OUT a plain file, the current directory or
-    one of its ancestors, or a directory holding one of `inputs`."""
-    from .files import ForeignOutput, replace_tree
+    """Write files into a fresh directory next to OUT and exchange it with OUT atomically, when
+    the one output rule allows it: modc.outputs.write_tree (never an input, a folder holding
+    one, the working directory; a foreign OUT only with force)."""
+    from .outputs import write_tree as write
 
-    out = Path(out)
-    where = Span.point(str(out))
-    if out.exists() and not out.is_dir():
-        raise InputError(codes.OUTPUT_NOT_MODC.at(where, path=str(out), found="it is not a directory"))
-    target = Path(os.path.abspath(out))
-    cwd = Path(os.getcwd())
-    if any(t == c or t in c.parents for t in (target, target.resolve()) for c in (cwd, cwd.resolve())):
-        what = "the current directory or one of its parents"
-        raise InputError(codes.OUTPUT_UNSAFE.at(where, path=str(out), what=what))
-    for src in inputs:
-        if target.resolve() in Path(os.path.abspath(src)).resolve().parents:
-            what = f"the directory holding the input {src}"
-            raise InputError(codes.OUTPUT_UNSAFE.at(where, path=str(out), what=what))
-    try:
-        if not force and out.is_symlink():
-            _refuse_foreign(out, ["(OUT itself is a symbolic link)"])
-        replace_tree(files, target, force)
-    except ForeignOutput as e:
-        _refuse_foreign(out, e.entries)
-
-
-def _refuse_foreign(out: Path, entries: list[str]) -> None:
-    if not entries:
-        return
-    shown = ", ".join(entries[:5]) + (f" and {len(entries) - 5} more" if len(entries) > 5 else "")
-    raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(str(out)), path=str(out), found=f"it holds {shown}"))
+    write(files, out, force, inputs)

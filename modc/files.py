@@ -1,14 +1,17 @@
 """Output trees: held in memory ({relative path: text or bytes}, as backends produce them), and
-put on disk so that nothing of the user's is lost and OUT is never half-written.
+put on disk so that nothing of the user's is lost and OUT is never half-written. (Which OUT a
+command may write at all — never an input, a folder holding one, the working directory — is
+modc.outputs' rule; this module is the mechanics.)
 
 Every tree modc writes holds MANIFEST: each file's relative path and SHA-256. A directory is
 modc's output only if everything in it is listed there, unchanged; that is what may be replaced
-without --force. The new tree is written into a sibling directory named `.OUT.modc-new-XXXX`
-and exchanged with OUT in one renameat2(RENAME_EXCHANGE) call, so at every instant OUT is the
+without --force. The new tree is written into `.OUT.modc-new-XXXX/tree`, a sibling of OUT, and
+exchanged with OUT in one renameat2(RENAME_EXCHANGE) call, so at every instant OUT is the
 complete old tree or the complete new one; the old tree, now under the sibling's name, is then
-removed. Siblings named `.OUT.modc-new-*` / `.OUT.modc-old-*` are left only by a killed run and
-are removed by the next run for the same OUT (under an flock on the parent directory, so two
-concurrent runs never remove each other's work).
+removed. Each sibling holds TEMP_MARKER, written before anything else goes in: a run killed midway
+leaves a sibling the next run for the same OUT removes (under an flock on the parent directory,
+so two concurrent runs never remove each other's work) — recognised by that marker, never by
+its name alone: a folder of the user's named like one is left alone.
 """
 from __future__ import annotations
 
@@ -19,12 +22,13 @@ import os
 import re
 import shutil
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 REPORT = "report.json"  # written by the report backend into every output tree
 MANIFEST = ".modc-manifest.json"  # written by write_tree into every output tree: what modc wrote there
 MANIFEST_LIMIT = 16_000_000  # bytes: a manifest larger than this is not one modc wrote
+TEMP_MARKER = ".modc-temporary"  # inside every sibling directory modc makes, and only there
 _SIBLING = "modc-new", "modc-old"
 
 
@@ -104,8 +108,36 @@ def _sibling_pattern(name: str) -> re.Pattern[str]:
     return re.compile(rf"\.{re.escape(name)}\.(?:{'|'.join(_SIBLING)})-[A-Za-z0-9_]+")
 
 
-def remove_leftovers(out: Path) -> list[Path]:
-    """Remove the siblings a killed run left next to out (only directories with modc's names)."""
+def _marker_text(out_name: str) -> str:
+    return json.dumps({"modc-temporary": 1, "for": out_name}) + "\n"
+
+
+def _marked(path: Path, out_name: str) -> bool:
+    """path is a sibling modc made for OUT named out_name: a real directory holding modc's marker
+    (a regular file, not a link) that names that OUT."""
+    marker = path / TEMP_MARKER
+    try:
+        if path.is_symlink() or not path.is_dir() or marker.is_symlink() or not marker.is_file():
+            return False
+        if marker.stat().st_size > 4096:
+            return False
+        # a prefix: a run killed while writing the marker (microseconds) leaves part of it
+        return _marker_text(out_name).startswith(marker.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+
+
+def _sibling(out: Path, kind: str) -> Path:
+    """A fresh marked sibling directory of out (kind: "modc-new" or "modc-old")."""
+    path = Path(tempfile.mkdtemp(prefix=f".{out.name}.{kind}-", dir=out.parent))
+    # a run killed before this line leaves an empty folder without marker: never removed, nothing lost
+    (path / TEMP_MARKER).write_text(_marker_text(out.name), encoding="utf-8")
+    return path
+
+
+def remove_leftovers(out: Path, keep: Callable[[Path], bool] = lambda p: False) -> list[Path]:
+    """Remove the siblings a killed run left next to out: directories with modc's names AND its
+    marker inside, except those keep() says hold something to keep (an input of the command)."""
     removed: list[Path] = []
     pattern = _sibling_pattern(out.name)
     try:
@@ -114,7 +146,7 @@ def remove_leftovers(out: Path) -> list[Path]:
         return removed
     for name in names:
         path = out.parent / name
-        if pattern.fullmatch(name) and path.is_dir() and not path.is_symlink():
+        if pattern.fullmatch(name) and _marked(path, out.name) and not keep(path):
             shutil.rmtree(path, ignore_errors=True)
             removed.append(path)
     return removed
@@ -165,41 +197,47 @@ def _lock(directory: Path) -> int:
     return fd
 
 
-def replace_tree(files: Mapping[str, str | bytes], out: Path, force: bool) -> None:
+def replace_tree(files: Mapping[str, str | bytes], out: Path, force: bool,
+                 keep: Callable[[Path], bool] = lambda p: False) -> None:
     """Put files (and their manifest) at out. The caller has decided that out may be replaced
-    (it is missing, empty, modc's own output, or force is set); this re-checks that under the
-    lock and raises ForeignOutput otherwise."""
+    (it is missing, empty, modc's own output, or force is set; never an input: modc.outputs);
+    this re-checks foreign files under the lock and raises ForeignOutput. keep: leftovers that
+    hold something to keep (see remove_leftovers)."""
     parent = out.parent
     parent.mkdir(parents=True, exist_ok=True)
     fd = _lock(parent)
     try:
-        remove_leftovers(out)
+        remove_leftovers(out, keep)
         if not force and out.is_dir() and not out.is_symlink():
             bad = foreign_entries(out)
             if bad:
                 raise ForeignOutput(bad)
-        new = Path(tempfile.mkdtemp(prefix=f".{out.name}.{_SIBLING[0]}-", dir=parent))
+        wrapper = _sibling(out, _SIBLING[0])
+        new = wrapper / "tree"
         try:
-            # the manifest first: a run killed while writing leaves a sibling whose every file is listed
+            new.mkdir()
+            # the manifest first: a run killed while writing leaves a tree whose every file is listed
             (new / MANIFEST).write_text(manifest_text(files), encoding="utf-8")
             write_files(files, new)
             os.chmod(new, 0o777 & ~_umask())
             if not os.path.lexists(out):
                 os.rename(new, out)
-                return
-            if exchange(new, out):
-                old = new  # the old tree now sits under the sibling's name
-            else:  # no RENAME_EXCHANGE (old kernel, some network file systems): two renames
-                old = Path(tempfile.mkdtemp(prefix=f".{out.name}.{_SIBLING[1]}-", dir=parent))
+            elif not exchange(new, out):  # no RENAME_EXCHANGE (old kernel, some network file systems)
+                old = _sibling(out, _SIBLING[1])
                 os.rename(out, old / "tree")
-                os.rename(new, out)
+                try:
+                    os.rename(new, out)
+                except BaseException:
+                    os.rename(old / "tree", out)  # the old tree back in place: OUT is never left missing
+                    shutil.rmtree(old, ignore_errors=True)
+                    raise
+                shutil.rmtree(wrapper, ignore_errors=True)
+                wrapper = old
         except BaseException:
-            shutil.rmtree(new, ignore_errors=True)
+            shutil.rmtree(wrapper, ignore_errors=True)
             raise
-        if old.is_symlink() or not old.is_dir():
-            old.unlink()  # out was a link or a file (--force): remove the link, never its target
-        else:
-            shutil.rmtree(old, ignore_errors=True)
+        # the old tree (or link, or nothing) is now wrapper/tree: rmtree never follows a link in it
+        shutil.rmtree(wrapper, ignore_errors=True)
     finally:
         os.close(fd)
 

@@ -491,9 +491,9 @@ def test_output_not_modc(tmp_path):
     # a plain file where the output directory should go
     plain = tmp_path / "out"
     plain.write_text("x", encoding="utf-8")
-    with pytest.raises(InputError) as e:
+    with pytest.raises(InputError) as e:  # a file is never replaced by a folder, even with --force
         write_tree(files, plain)
-    assert e.value.diagnostic.code == "output-not-modc"
+    assert e.value.diagnostic.code == "output-unsafe"
     assert plain.read_text(encoding="utf-8") == "x"
     # an empty directory and a directory modc wrote are fine; --force replaces a foreign one
     empty = tmp_path / "empty"

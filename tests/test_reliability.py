@@ -129,17 +129,38 @@ def test_unwritable_out_is_a_clean_exit_2(tmp_path):
 
 
 def test_leftovers_of_a_killed_run_are_removed_and_nothing_else(tmp_path):
+    """A leftover is recognised by the marker modc writes inside it, never by its name alone."""
+    from modc.files import TEMP_MARKER, _marker_text
+
     out = tmp_path / "out"
     write_tree({"a.txt": "1"}, out)
-    for name in (".out.modc-new-abc123", ".out.modc-old-x_y"):
+    for name in (".out.modc-new-abc123", ".out.modc-old-x_y"):  # what a killed run leaves
         (tmp_path / name).mkdir()
-        (tmp_path / name / "f").write_text("partial")
+        (tmp_path / name / TEMP_MARKER).write_text(_marker_text("out"))
+        (tmp_path / name / "tree").mkdir()
+        (tmp_path / name / "tree" / "f").write_text("partial")
     for name in (".out.modc-new-keep", ".other.modc-new-abc", "out.modc-new-abc"):
         (tmp_path / name).write_text("not a directory" if name.endswith("keep") else "")
     (tmp_path / ".other.modc-new-dir").mkdir()
+    # the user's own folders named like leftovers: no marker, or a marker for another OUT, or a link
+    for name in (".out.modc-new-mine", ".out.modc-old-thesis", ".out.modc-new-other"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "notes.txt").write_text("precious")
+    (tmp_path / ".out.modc-new-other" / TEMP_MARKER).write_text(_marker_text("elsewhere"))
+    (tmp_path / ".out.modc-old-link").symlink_to(tmp_path / ".out.modc-new-mine")
     write_tree({"a.txt": "2"}, out)
-    assert listing(tmp_path) == [".other.modc-new-abc", ".other.modc-new-dir", ".out.modc-new-keep", "out",
-                                 "out.modc-new-abc"]
+    assert listing(tmp_path) == [".other.modc-new-abc", ".other.modc-new-dir", ".out.modc-new-keep",
+                                 ".out.modc-new-mine", ".out.modc-new-other", ".out.modc-old-link",
+                                 ".out.modc-old-thesis", "out", "out.modc-new-abc"]
+    for name in (".out.modc-new-mine", ".out.modc-old-thesis", ".out.modc-new-other"):
+        assert (tmp_path / name / "notes.txt").read_text() == "precious"
+    assert tree(out) == {"a.txt": b"2", MANIFEST: tree(out)[MANIFEST]}, "the marker never enters OUT"
+
+
+def siblings(d: Path) -> list[str]:
+    """d's entries but empty folders: a run killed between creating its sibling and marking it
+    (microseconds) leaves an empty unmarked folder, which modc leaves alone like any user folder."""
+    return [n for n in listing(d) if not ((d / n).is_dir() and n.startswith(".") and not any((d / n).iterdir()))]
 
 
 # --- SIGKILL at random moments ---------------------------------------------------------------------
@@ -151,6 +172,7 @@ out, n = sys.argv[1], int(sys.argv[2])
 trees = [{f"d{i % 7}/f{i}.txt": f"{tag} {i}\n" * 200 for i in range(n)} for tag in ("A", "B")]
 for k in range(10**6):
     write_tree(trees[k % 2], out)
+    print(k, flush=True)  # tells the test that tree k is complete: it kills on events, not on a clock
 """
 
 
@@ -173,15 +195,20 @@ def test_sigkill_at_random_moments_leaves_old_or_new_tree(tmp_path):
     rng = random.Random(10)
     seen = set()
     for _ in range(15):
-        p = subprocess.Popen([sys.executable, "-c", WORKER, str(out), str(n)], env=env)
-        time.sleep(0.4 + rng.random() * 0.8)  # past the start-up (~0.3 s) into the write loop
+        p = subprocess.Popen([sys.executable, "-c", WORKER, str(out), str(n)], env=env, stdout=subprocess.PIPE,
+                             text=True)
+        assert p.stdout is not None
+        for _ in range(rng.choice((1, 2))):  # one or two complete writes (A, then B), whatever the load
+            assert p.stdout.readline()
+        time.sleep(rng.random() * 0.1)  # then somewhere into the next write
         p.send_signal(signal.SIGKILL)
         p.wait()
+        p.stdout.close()
         state = _state(out, n)
         assert state in "AB", state
         seen.add(state)
         write_tree({f"d{i % 7}/f{i}.txt": f"{state} {i}\n" * 200 for i in range(n)}, out)
-        assert listing(tmp_path) == ["out"]
+        assert siblings(tmp_path) == ["out"]
     assert seen == {"A", "B"}, "the kills should land in both phases of the loop"
 
 
@@ -200,7 +227,7 @@ def test_sigkill_of_the_compiler_itself(tmp_path):
         assert tree(out) == before
     r = subprocess.run([sys.executable, "-m", "modc", str(QUICK), "-o", str(out)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
-    assert tree(out) == before and listing(tmp_path) == ["out"]
+    assert tree(out) == before and siblings(tmp_path) == ["out"]
 
 
 # --- crash sites: diagnostics within seconds, bounded memory ------------------------------------

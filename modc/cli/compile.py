@@ -58,7 +58,8 @@ def compile_cmd(
     verbose: bool,
 ) -> None:
     """Check FILE and write URDF, meshes and a report into OUT."""
-    from ..compiler import COMPILE_ANALYSES, InputError, build, check_file, write_tree
+    from ..compiler import COMPILE_ANALYSES, InputError, build, check_file
+    from ..outputs import check_output_dir, inputs_of, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
     try:
@@ -72,6 +73,9 @@ def compile_cmd(
 
         _err(f"modc: {summary(checked.diagnostics)}; nothing written to {out}")
         raise SystemExit(EXIT_ERRORS)
+    inputs = inputs_of(file, library, checked)
+    with usage_errors("compile", writing=out):  # before any work: a refused OUT costs nothing
+        check_output_dir(out, inputs, force)
     selected = None
     if only:
         from ..backends import load_all
@@ -93,7 +97,7 @@ def compile_cmd(
     ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
     files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     with usage_errors("compile", writing=out):
-        write_tree(files, out, force=force, inputs=[file])
+        write_tree(files, out, force=force, inputs=inputs)
     if verbose:
         for rel in files:
             _err(f"  wrote {out.rstrip('/')}/{rel}")

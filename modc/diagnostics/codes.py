@@ -287,7 +287,7 @@ OUTPUT_NOT_MODC = _register("output-not-modc", E, "an output directory that modc
     "modc replaces only a directory it wrote (listed, unchanged, in its .modc-manifest.json); choose a new or "
     "empty directory, or pass --force to replace it and everything in it")
 OUTPUT_UNSAFE = _register("output-unsafe", E, "an output directory modc never replaces, even with --force",
-    "'{path}' is {what}; replacing it would delete it", "write the output into a new directory, e.g. -o build/out")
+    "'{path}' is {what}; replacing it would delete it", "{hint}")
 UNSUPPORTED_INPUT = _register("unsupported-input", E, "an input file type modc cannot read",
     "'{path}' is neither .mod nor .yaml/.yml", "pass a .mod file or its YAML form")
 

@@ -1,0 +1,204 @@
+"""The one output-safety rule, for every command that writes (compile, design, render, play
+--record, the caches; fmt rewrites only its inputs, see modc.syntax.format.rewrite_file).
+
+A command knows its inputs (the source file, every library file it uses, a trajectory file).
+Whatever the options, --force included, modc never replaces or deletes:
+  - an input, also when OUT reaches it through a symbolic link or a `..` path;
+  - a folder that holds an input anywhere inside it;
+  - the working directory or one of its parents;
+  - a plain file where an output folder is asked for (-o names the folder modc creates).
+Paths are compared both as written (made absolute, `..` folded) and as the file system resolves
+them (symbolic links followed), and existing files by identity (device and inode), so a second
+name for the same file is still that file. Refusals are `output-unsafe` diagnostics: the path
+and what it is, never file content; the same with and without --force.
+"""
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+
+from .diagnostics import Span, codes
+
+PathLike = str | os.PathLike
+DIR_HINT = "write the output into a new directory, e.g. -o build/out"
+_protected: list[str] = []  # the inputs of the running command (for the caches)
+
+
+def _forms(path: PathLike) -> set[str]:
+    """The path as written (absolute, `..` folded) and as resolved (links followed)."""
+    p = os.fspath(path)
+    return {os.path.abspath(p), os.path.realpath(p)}
+
+
+def _same(a: PathLike, b: PathLike) -> bool:
+    if _forms(a) & _forms(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return False
+
+
+def _ancestors(path: PathLike) -> list[str]:
+    """path itself and every folder above it, in both of its forms."""
+    out: list[str] = []
+    for form in _forms(path):
+        p = Path(form)
+        out += [str(p), *map(str, p.parents)]
+    return out
+
+
+def holds(directory: PathLike, path: PathLike) -> bool:
+    """directory is path, or a folder path lies in (by name or by identity)."""
+    mine = _forms(directory)
+    try:
+        st = os.stat(directory)
+    except (OSError, ValueError):
+        st = None
+    for a in _ancestors(path):
+        if a in mine:
+            return True
+        if st is not None:
+            try:
+                sa = os.stat(a)
+            except (OSError, ValueError):
+                continue
+            if (sa.st_dev, sa.st_ino) == (st.st_dev, st.st_ino):
+                return True
+    return False
+
+
+def inputs_of(file: PathLike, library: str | None = None, checked=None, more: Iterable[PathLike] = ()) -> list[str]:
+    """Every input file of a command: FILE, the --library file, each library file FILE's robots
+    and design blocks use (from checked, a modc.compiler.Checked; found by checking FILE when not
+    given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out."""
+    from .model import library as lib
+
+    found = [os.fspath(file), *map(os.fspath, more)]
+    if library and library not in lib.BUILTIN:
+        found.append(library)
+    if checked is None:
+        from .compiler import InputError, check_file
+
+        try:
+            checked = check_file(file, library)
+        except (InputError, OSError, ValueError):  # the command itself reports an unreadable file
+            checked = None
+    if checked is not None:
+        robots = [*checked.design.robots, *(p.cell for p in checked.design.problems)]
+        for r in robots:
+            ref = library or r.library_ref
+            if ref in lib.BUILTIN:
+                continue
+            where = Path(r.library_dir) if r.library_dir and not library else None
+            path = lib.resolve(ref, where)
+            if path is not None:
+                found.append(str(path))
+    return list(dict.fromkeys(found))
+
+
+def _unsafe(out: PathLike, what: str, hint: str):
+    from .compiler import InputError
+
+    shown = os.fspath(out)
+    return InputError(codes.OUTPUT_UNSAFE.at(Span.point(shown), path=shown, what=what, hint=hint))
+
+
+def _never_replaced(out: PathLike, inputs: Sequence[PathLike]) -> str | None:
+    """What out is when it may never be replaced, deleted or written through; else None."""
+    for src in inputs:
+        if _same(out, src):
+            return f"the input {os.fspath(src)}"
+    for src in inputs:
+        if holds(out, src):
+            return f"a directory holding the input {os.fspath(src)}"
+    try:
+        cwd = os.getcwd()
+    except OSError:  # the working directory was removed: nothing there to protect
+        return None
+    if holds(out, cwd):
+        return "the current directory or one of its parents"
+    return None
+
+
+def check_output_dir(out: PathLike, inputs: Sequence[PathLike] = (), force: bool = False) -> None:
+    """Raise modc.compiler.InputError with the diagnostic writing a tree to OUT would give
+    (output-unsafe, output-not-modc), before any work is done; return when OUT may be written.
+    The same check runs again in write_tree, which is what makes it hold."""
+    from .files import foreign_entries
+
+    path = Path(out)
+    why = _never_replaced(path, inputs)
+    if why is not None:
+        raise _unsafe(out, why, DIR_HINT)
+    if path.exists() and not path.is_dir():
+        # never replaced by a folder, even with --force: -o names the folder to create, not a file
+        raise _unsafe(out, "a file, not a directory", f"-o names the directory modc creates; {DIR_HINT}")
+    if not force:
+        if path.is_symlink():
+            _refuse_foreign(out, ["(OUT itself is a symbolic link)"])
+        if path.is_dir():
+            _refuse_foreign(out, foreign_entries(path))
+
+
+def _refuse_foreign(out: PathLike, entries: list[str]) -> None:
+    from .compiler import InputError
+
+    if not entries:
+        return
+    shown = ", ".join(entries[:5]) + (f" and {len(entries) - 5} more" if len(entries) > 5 else "")
+    where = os.fspath(out)
+    raise InputError(codes.OUTPUT_NOT_MODC.at(Span.point(where), path=where, found=f"it holds {shown}"))
+
+
+def check_output_file(out: PathLike, inputs: Sequence[PathLike] = (), option: str = "-o",
+                      example: str = "out.png") -> None:
+    """The rule for a command writing one file (render -o, play --record): raise InputError
+    (output-unsafe) when OUT is an input, reaches one through a link, or is a directory."""
+    hint = f"write to a new file, e.g. {option} {example}"
+    why = _never_replaced(out, inputs)
+    if why is not None:
+        raise _unsafe(out, why, hint)
+    if os.path.isdir(out):
+        raise _unsafe(out, "a directory", hint)
+
+
+def write_tree(files: Mapping[str, str | bytes], out: PathLike, force: bool = False,
+               inputs: Sequence[PathLike] = ()) -> None:
+    """Check OUT (check_output_dir), then write files there atomically (modc.files.replace_tree):
+    OUT is either the old tree or the complete new one, never half-written or missing."""
+    from .files import ForeignOutput, replace_tree
+
+    check_output_dir(out, inputs, force)
+    protect(inputs)
+    target = Path(os.path.abspath(out))
+    try:
+        replace_tree(files, target, force, keep=lambda p: any(holds(p, src) for src in inputs))
+    except ForeignOutput as e:
+        _refuse_foreign(out, e.entries)
+
+
+# --- the caches --------------------------------------------------------------------------------
+
+
+def protect(inputs: Iterable[PathLike]) -> None:
+    """Declare the running command's inputs: a cache directory that is one or holds one is not
+    written to (modc.cache)."""
+    _protected.extend(os.fspath(p) for p in inputs if os.fspath(p) not in _protected)
+
+
+_warned: set[str] = set()
+
+
+def cache_dir_ok(directory: PathLike) -> bool:
+    """False (once saying why on stderr) when the cache directory is, or holds, an input."""
+    for src in _protected:
+        if holds(directory, src):
+            key = os.fspath(directory)
+            if key not in _warned:
+                _warned.add(key)
+                sys.stderr.write(f"modc: not caching in {key}: it holds the input {src}\n")
+            return False
+    return True
