@@ -1,12 +1,21 @@
 """A content-addressed disk cache for results that are pure functions of their inputs
 (meshes of a part, the collision matrix of an emitted URDF). Keys hash every input, so a hit
 is byte-for-byte what a fresh computation would give; a read-only or missing home just
-means no cache."""
+means no cache.
+
+The cache writes only inside its directory (ROOT/KIND/NAME, no link leading out of it) and
+never into a directory that is, or holds, an input of the running command (modc.outputs'
+rule): then there is simply no cache, and a note says why once."""
 from __future__ import annotations
 
 import hashlib
 import os
+import re
+import tempfile
 from pathlib import Path
+
+READ_LIMIT = 256 << 20  # bytes: a cache entry larger than this is not one modc wrote
+_PART = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 
 
 def root() -> Path:
@@ -24,24 +33,58 @@ def key(*parts: str | bytes) -> str:
     return h.hexdigest()[:32]
 
 
-def get(kind: str, name: str) -> bytes | None:
-    if os.environ.get("MODC_NO_CACHE"):
+def directory(kind: str, create: bool = True) -> Path | None:
+    """ROOT/KIND, made if needed, when the cache may be used there; else None (no cache): caching
+    off, a root that is or holds an input, a KIND that is a link or leads out of the root."""
+    if os.environ.get("MODC_NO_CACHE") or not _PART.fullmatch(kind):
         return None
-    path = root() / kind / name
+    from .outputs import cache_dir_ok
+
+    base = root()
+    if not cache_dir_ok(base):
+        return None
+    path = base / kind
     try:
-        return path.read_bytes()
-    except OSError:
+        if create:
+            path.mkdir(parents=True, exist_ok=True)
+        if path.is_symlink() or not path.is_dir():
+            return None
+        real_base = os.path.realpath(base)
+        if os.path.dirname(os.path.realpath(path)) != real_base:
+            return None
+    except (OSError, ValueError):
         return None
+    return path
+
+
+def get(kind: str, name: str) -> bytes | None:
+    from .files import read_bounded
+
+    where = directory(kind, create=False)
+    if where is None or not _PART.fullmatch(name):
+        return None
+    try:
+        # a regular file only: a FIFO or a device planted in the cache never blocks or floods a run
+        data, size = read_bounded(where / name, READ_LIMIT)
+    except (OSError, ValueError):
+        return None
+    return data if size <= READ_LIMIT else None
 
 
 def put(kind: str, name: str, data: bytes) -> None:
-    if os.environ.get("MODC_NO_CACHE"):
+    where = directory(kind)
+    if where is None or not _PART.fullmatch(name):
         return
-    path = root() / kind / name
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-        tmp.write_bytes(data)
-        os.replace(tmp, path)
+        # a fresh temporary file (O_EXCL: never a planted link), then one rename, which replaces a
+        # link named like the entry and never what it points to
+        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=where)
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+            os.replace(tmp, where / name)
+        except BaseException:
+            os.unlink(tmp)
+            raise
     except OSError:
         pass

@@ -76,7 +76,7 @@ def inputs_of(file: PathLike, library: str | None = None, checked=None, more: It
     given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out."""
     from .model import library as lib
 
-    found = [os.fspath(file), *map(os.fspath, more)]
+    found = [os.fspath(file), *(os.fspath(m) for m in more)]
     if library and library not in lib.BUILTIN:
         found.append(library)
     if checked is None:
@@ -129,6 +129,7 @@ def check_output_dir(out: PathLike, inputs: Sequence[PathLike] = (), force: bool
     The same check runs again in write_tree, which is what makes it hold."""
     from .files import foreign_entries
 
+    protect(inputs)
     path = Path(out)
     why = _never_replaced(path, inputs)
     if why is not None:
@@ -157,6 +158,7 @@ def check_output_file(out: PathLike, inputs: Sequence[PathLike] = (), option: st
                       example: str = "out.png") -> None:
     """The rule for a command writing one file (render -o, play --record): raise InputError
     (output-unsafe) when OUT is an input, reaches one through a link, or is a directory."""
+    protect(inputs)
     hint = f"write to a new file, e.g. {option} {example}"
     why = _never_replaced(out, inputs)
     if why is not None:
@@ -172,7 +174,6 @@ def write_tree(files: Mapping[str, str | bytes], out: PathLike, force: bool = Fa
     from .files import ForeignOutput, replace_tree
 
     check_output_dir(out, inputs, force)
-    protect(inputs)
     target = Path(os.path.abspath(out))
     try:
         replace_tree(files, target, force, keep=lambda p: any(holds(p, src) for src in inputs))

@@ -43,14 +43,10 @@ def _bytecode_cache(jinja2):
     costs a compile more than rendering them (jinja keys each by its source's checksum)."""
     import os
 
-    from ..cache import root
+    from ..cache import directory as cache_directory
 
-    if os.environ.get("MODC_NO_CACHE"):
-        return None
-    directory = root() / "jinja"
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-    except OSError:
+    directory = cache_directory("jinja")  # None: no cache (off, or its folder holds an input)
+    if directory is None:
         return None
     if not os.access(directory, os.W_OK):  # jinja would fail writing, and a read-only home means no cache
         return None

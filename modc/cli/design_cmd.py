@@ -99,11 +99,12 @@ def design_cmd(
     """Find the best module chains for the cells and targets of FILE's design blocks."""
     import json
 
-    from ..compiler import InputError, check_file, write_tree
+    from ..compiler import InputError, check_file
     from ..design import run as search
     from ..design.write import files as design_files
     from ..design.write import ranking, summary_line
     from ..diagnostics import codes
+    from ..outputs import check_output_dir, inputs_of, write_tree
 
     try:
         checked = check_file(file, library)
@@ -117,6 +118,9 @@ def design_cmd(
     if not problems:
         _err(f"modc design: {file} has no `design NAME {{ … }}` block")
         raise SystemExit(EXIT_USAGE)
+    inputs = inputs_of(file, library, checked)
+    with usage_errors("design", writing=out):  # before the search: a refused DIR costs no minutes
+        check_output_dir(out, inputs, force)
     outcomes, failed = [], []
     tty = sys.stderr.isatty()
     with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor:
@@ -139,7 +143,7 @@ def design_cmd(
         picks = [n for o in outcomes for n in names if n.startswith(f"{o.problem.name}_")][:RENDERED * len(outcomes)]
         tree = design_files(outcomes, _renders(tree, picks))
     with usage_errors("design", writing=out):
-        write_tree(tree, out, force=force)
+        write_tree(tree, out, force=force, inputs=inputs)
     if json_out:
         print(json.dumps(ranking(outcomes), indent=2))
     for o in outcomes:

@@ -72,7 +72,9 @@ def lint_cmd(files: tuple[str, ...], format: str, library: str | None, quiet: bo
 def fmt_cmd(files: tuple[str, ...], check: bool) -> None:
     """Rewrite .mod files in the canonical layout (comments kept, meaning unchanged)."""
     from ..compiler import YAML_SUFFIXES, InputError, SourceError, read_source
-    from ..syntax.format import FormatterBug, format_text, rewrite_file
+    from ..files import read_bounded
+    from ..syntax.format import ChangedOnDisk, FormatterBug, format_text, rewrite_file
+    from ..syntax.parser import MAX_BYTES
 
     diags, sources, io_error, changed = [], {}, False, []
     for path in _expand(files, "modc fmt"):
@@ -80,6 +82,11 @@ def fmt_cmd(files: tuple[str, ...], check: bool) -> None:
             _err(f"modc fmt: {path}: only .mod files are formatted")
             io_error = True
             continue
+        try:
+            # the bytes first: the rewrite happens only if the file still holds them (a save meanwhile wins)
+            raw: bytes | None = read_bounded(path, MAX_BYTES)[0]
+        except OSError:
+            raw = None  # read_source says why
         try:
             text = read_source(path)
         except SourceError as e:  # an error in the file: reported like a syntax error
@@ -101,13 +108,18 @@ def fmt_cmd(files: tuple[str, ...], check: bool) -> None:
             diags += errors
             sources[path] = text
             continue
-        with open(path, "rb") as f:  # a BOM or CRLF line ends count as a change
-            if f.read() == out.encode("utf-8"):
-                continue
+        if raw == out.encode("utf-8"):  # (a BOM or CRLF line ends count as a change)
+            continue
         changed.append(path)
         if not check:
             try:
-                rewrite_file(path, out)
+                if raw is None:  # unreadable a moment ago, readable now: someone is writing it
+                    raise ChangedOnDisk(path)
+                rewrite_file(path, out, raw)
+            except ChangedOnDisk:
+                _err(f"modc fmt: {path}: changed on disk while being formatted; left as saved (run modc fmt again)")
+                io_error = True
+                continue
             except OSError as e:
                 _err(f"modc fmt: {path}: {e.strerror or e}")
                 io_error = True

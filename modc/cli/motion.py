@@ -74,6 +74,9 @@ def render_cmd(
         _err(f"modc render: --colors {colors}: expected 2 to 256")
         raise SystemExit(EXIT_USAGE)
     with usage_errors("render", (UsageError,), writing=out):
+        from ..outputs import check_output_file, inputs_of
+
+        check_output_file(out, inputs_of(file, library), "-o", "arm.png")
         ok, lines, checked = render(file, out, pose=pose, robot=robot, library=library, width=width, height=height,
                                     azimuth=azimuth, elevation=elevation, colors=colors)
     _print_diagnostics(checked.diagnostics, checked.sources)
@@ -96,6 +99,10 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
     from ..sim.scene import UsageError
 
     with usage_errors("play", (UsageError,), writing=record):
+        if record is not None:
+            from ..outputs import check_output_file, inputs_of
+
+            check_output_file(record, inputs_of(file, library, more=[traj]), "--record", "motion.gif")
         ok, lines, checked = play(
             file, traj, record=record, robot=robot, library=library, gui=False if headless else None
         )

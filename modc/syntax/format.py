@@ -326,16 +326,29 @@ def format_text(text: str, path: str = "<string>") -> tuple[str | None, list[Dia
     return out, []
 
 
-def rewrite_file(path: str, text: str) -> None:
-    """Replace the file's contents with text atomically: write a temporary file next to it (same
-    directory, same permission bits), then rename it over the original. A symlink is followed,
-    so the file it points to is rewritten and the link stays."""
+class ChangedOnDisk(Exception):
+    """The file changed between modc's read and its write: left as it was saved."""
+
+
+def rewrite_file(path: str, text: str, expected: bytes | None = None) -> None:
+    """Replace the file's contents with text atomically, unless they are no longer `expected`
+    (what was read and formatted; by default what the file holds when this starts). A temporary
+    file is written next to it (same directory, same permission bits), the file compared with
+    `expected` once more, then the temporary file renamed over it. A save by an editor between
+    modc's read and that comparison is never lost: the file is left as saved and ChangedOnDisk
+    raised. (A save in the microseconds between the comparison and the rename could still be
+    replaced; no portable call closes that gap.) A symlink is followed, so the file it points
+    to is rewritten and the link stays."""
     import os
     import stat
     import tempfile
 
+    from ..files import read_bounded
+
     real = os.path.realpath(path)
     mode = stat.S_IMODE(os.stat(real).st_mode)
+    if expected is None:
+        expected = read_bounded(real, 1 << 30)[0]
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(real) + ".", suffix=".fmt", dir=os.path.dirname(real))
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
@@ -343,6 +356,9 @@ def rewrite_file(path: str, text: str) -> None:
             f.flush()
             os.fsync(f.fileno())
         os.chmod(tmp, mode)
+        now, size = read_bounded(real, len(expected))
+        if size != len(expected) or now != expected:
+            raise ChangedOnDisk(path)
         os.replace(tmp, real)
     except BaseException:
         try:
