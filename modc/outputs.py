@@ -73,7 +73,8 @@ def holds(directory: PathLike, path: PathLike) -> bool:
 def inputs_of(file: PathLike, library: str | None = None, checked=None, more: Iterable[PathLike] = ()) -> list[str]:
     """Every input file of a command: FILE, the --library file, each library file FILE's robots
     and design blocks use (from checked, a modc.compiler.Checked; found by checking FILE when not
-    given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out."""
+    given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out.
+    They are protected from the caches (protect) from this call on."""
     from .model import library as lib
 
     found = [os.fspath(file), *(os.fspath(m) for m in more)]
@@ -96,7 +97,9 @@ def inputs_of(file: PathLike, library: str | None = None, checked=None, more: It
             path = lib.resolve(ref, where)
             if path is not None:
                 found.append(str(path))
-    return list(dict.fromkeys(found))
+    found = list(dict.fromkeys(found))
+    protect(found)
+    return found
 
 
 def _unsafe(out: PathLike, what: str, hint: str):
@@ -200,6 +203,6 @@ def cache_dir_ok(directory: PathLike) -> bool:
             key = os.fspath(directory)
             if key not in _warned:
                 _warned.add(key)
-                sys.stderr.write(f"modc: not caching in {key}: it holds the input {src}\n")
+                sys.stderr.write(f"modc: not caching in {key}: it is or holds the input {src}\n")
             return False
     return True

@@ -62,6 +62,7 @@ def compile_cmd(
     from ..outputs import check_output_dir, inputs_of, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
+    inputs = inputs_of(file, library)  # first: the analyses' caches must know them (modc.outputs)
     try:
         checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=torque or "error")
     except InputError as e:
@@ -73,7 +74,6 @@ def compile_cmd(
 
         _err(f"modc: {summary(checked.diagnostics)}; nothing written to {out}")
         raise SystemExit(EXIT_ERRORS)
-    inputs = inputs_of(file, library, checked)
     with usage_errors("compile", writing=out):  # before any work: a refused OUT costs nothing
         check_output_dir(out, inputs, force)
     selected = None
