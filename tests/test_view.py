@@ -2,19 +2,22 @@
 re-checking the file on save, paging a ranking) and the command line around the server."""
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+import logging
 import math
 import os
 import signal
 import socket
 import subprocess
 import sys
-import time
 import urllib.request
 from pathlib import Path
 
 import numpy as np
 import pytest
+from websockets.exceptions import ConnectionClosed
 
 from modc.compiler import check_file
 from modc.dynamics.model import Dynamics
@@ -256,7 +259,7 @@ def test_server_serves_the_client_locally():
 
     server, view = start(Page([Source(FARM)]), port=0)
     try:
-        html = urllib.request.urlopen(f"http://127.0.0.1:{server.get_port()}/", timeout=10).read().decode()
+        html = urllib.request.urlopen(view.url, timeout=30).read().decode()
         assert "<html" in html.lower() and "viser" in html.lower()
         view.step(0.05)
         assert set(view._links) >= {"base_link", "link_1", "link_2", "link_3", "tool0"}
@@ -298,23 +301,53 @@ def test_unknown_robot_and_bad_ranking_exit_2(tmp_path):
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the no-display rule is Linux's")
 def test_ctrl_c_stops_cleanly():
-    """Without a display (as in CI) no browser is tried; Ctrl-C ends the server with exit 0."""
+    """Without a display (as in CI) no browser is tried; Ctrl-C ends the server with exit 0, at
+    any moment after the address is printed."""
     port = _free_port()
     env = {k: v for k, v in _env().items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     p = subprocess.Popen([sys.executable, "-m", "modc", "view", str(FARM), "--port", str(port)],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         line = p.stdout.readline()
-        assert f"http://127.0.0.1:{port}/" in line
-        assert urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10).status == 200
-        time.sleep(0.3)
-        p.send_signal(signal.SIGINT)
-        out, err = p.communicate(timeout=30)
+        assert f"http://127.0.0.1:{port}/?token=" in line
+        url = line.split()[2]
+        p.send_signal(signal.SIGINT)  # right after the address, before or while the page serves
+        out, err = p.communicate(timeout=60)
     finally:
         if p.poll() is None:
             p.kill()
     assert p.returncode == 0, err
-    assert "Traceback" not in err and "stopped" in out and "no display to open a browser on" in err
+    assert "Traceback" not in err and "stopped" in out and "Aborted" not in err
+    assert url.startswith(f"http://127.0.0.1:{port}/?token=")
+
+
+# Runs `modc view` with the page's build held until the test sends Ctrl-C: the build announces
+# itself on stdout (the event the test waits on) and then waits.
+HOLD_THE_BUILD = """
+import sys, threading
+import modc.view.server as s
+def held(self, *args, **kwargs):
+    print("building the page", flush=True)
+    threading.Event().wait()
+s.View.__init__ = held
+sys.argv = ["modc", "view", sys.argv[1], "--no-browser", "--port", "0"]
+from modc.cli import main
+main()
+"""
+
+
+def test_ctrl_c_while_starting_aborts():
+    p = subprocess.Popen([sys.executable, "-c", HOLD_THE_BUILD, str(FARM)], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env=_env())
+    try:
+        assert p.stdout.readline() == "building the page\n"
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    assert p.returncode == 1, err
+    assert err.strip() == "Aborted!" and out == "", (out, err)
 
 
 def test_torque_table_colours_each_joint_by_level(tmp_path):
@@ -345,5 +378,98 @@ def test_user_text_reaches_the_page_escaped(tmp_path):
         _write(ranking.parent / "d1.mod", GOOD.replace("robot arm {", "robot arm { <b>"))
         view.step(0.05)
         assert "&lt;b&gt;" in view._errors.content and "<b>" not in view._errors.content.split("</b>", 1)[1]
+    finally:
+        server.stop()
+
+
+# --- who may open the page: this run's token, and on the websocket the page's own origin ---------
+
+def _ws(port: int, origin: str | None, cookie: str | None = None, query: str = ""):
+    import viser
+    from websockets.sync.client import connect
+
+    headers = {"Cookie": cookie} if cookie else {}
+    return connect(f"ws://127.0.0.1:{port}/{query}", origin=origin, additional_headers=headers, open_timeout=30,
+                   subprotocols=[f"viser-v{viser.__version__}"])
+
+
+def test_the_page_needs_its_token_and_the_websocket_its_origin():
+    from urllib.error import HTTPError
+
+    from websockets.exceptions import InvalidStatus
+
+    from modc.view.server import start
+
+    server, view = start(Page([Source(FARM)]), port=0)
+    port = server.get_port()
+    token = view.url.split("?token=", 1)[1]
+    origin = f"http://127.0.0.1:{port}"
+    try:
+        assert view.url == f"{origin}/?token={token}" and len(token) >= 32
+        for url in (f"{origin}/", f"{origin}/?token={token[:-1]}", f"{origin}/index.html", f"{origin}/?token="):
+            with pytest.raises(HTTPError) as e:
+                urllib.request.urlopen(url, timeout=30)
+            assert e.value.code == 403
+        with urllib.request.urlopen(view.url, timeout=30) as r:
+            assert r.status == 200 and "<html" in r.read().decode().lower()
+            cookie = r.headers["Set-Cookie"].split(";")[0]
+        assert cookie == f"modc-view-{port}={token}" and "HttpOnly" in r.headers["Set-Cookie"]
+        assert urllib.request.urlopen(urllib.request.Request(f"{origin}/", headers={"Cookie": cookie}),
+                                      timeout=30).status == 200
+
+        refused = [(None, cookie), ("http://evil.example", cookie), (f"http://localhost:{port}", cookie),
+                   (f"http://127.0.0.1:{port + 1}", cookie), (origin, None), (origin, f"modc-view-{port}=wrong"),
+                   (origin, f"modc-view-{port + 1}={token}")]
+        for o, c in refused:
+            with pytest.raises(InvalidStatus) as e:
+                _ws(port, o, c)
+            assert e.value.response.status_code == 403, (o, c)
+        for c, query in ((cookie, ""), (None, f"?token={token}")):
+            with _ws(port, origin, c, query) as ws:
+                assert len(ws.recv(timeout=30)) > 1000  # the scene
+    finally:
+        server.stop()
+
+
+def test_the_guard_is_in_viser_s_request_path():
+    """modc view wraps the one serve() call viser makes; if a new viser stops making it, the
+    server must refuse to start rather than serve an unguarded page."""
+    import websockets.asyncio.server as wss
+
+    from modc.view.guard import Guard, guarding
+
+    original = wss.serve
+    import viser
+
+    with guarding(Guard()) as used, contextlib.redirect_stdout(io.StringIO()):
+        server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        assert used == [True], "viser no longer calls websockets.asyncio.server.serve: modc view cannot guard it"
+        assert wss.serve is original
+    finally:
+        with contextlib.redirect_stdout(io.StringIO()):
+            server.stop()
+
+
+def test_a_malformed_message_is_one_line_per_connection(caplog):
+    from modc.view.server import start
+
+    server, view = start(Page([Source(FARM)]), port=0)
+    port = server.get_port()
+    token = view.url.split("?token=", 1)[1]
+    try:
+        with caplog.at_level(logging.INFO, logger="websockets.server"):
+            for garbage in (b"\xc1\xff\x00garbage", "text, not msgpack"):
+                with _ws(port, f"http://127.0.0.1:{port}", query=f"?token={token}") as ws:
+                    ws.recv(timeout=30)
+                    ws.send(garbage)
+                    for _ in range(1000):  # drained until viser closes the connection
+                        try:
+                            ws.recv(timeout=30)
+                        except ConnectionClosed:
+                            break
+        failed = [r for r in caplog.records if "malformed message" in r.getMessage()]
+        assert len(failed) == 2 and all(r.exc_info is None and "\n" not in r.getMessage() for r in failed)
+        assert not [r for r in caplog.records if r.exc_info], "a traceback was logged"
     finally:
         server.stop()

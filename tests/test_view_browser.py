@@ -149,7 +149,7 @@ def changed(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def test_page_shows_the_arm_and_a_slider_moves_it(browser, tmp_path):
     page = Page([Source(FARM)])
     server, view = start(page, port=0)
-    url = f"http://127.0.0.1:{server.get_port()}/"
+    url = view.url
     try:
         browser.call("Network.enable")
         browser.call("Page.enable")
@@ -188,7 +188,8 @@ def test_page_shows_the_arm_and_a_slider_moves_it(browser, tmp_path):
 
         # everything the page loaded came from this process
         urls = {e["params"]["request"]["url"] for e in browser.events if e.get("method") == "Network.requestWillBeSent"}
-        local = (url, url.replace("http", "ws"), "data:", "blob:")
+        origin = f"127.0.0.1:{server.get_port()}"
+        local = (f"http://{origin}/", f"ws://{origin}", "data:", "blob:")
         assert urls and all(u.startswith(local) for u in urls), sorted(u for u in urls if not u.startswith(local))
     finally:
         server.stop()
@@ -212,7 +213,7 @@ def test_saving_the_file_updates_the_page_within_a_second(browser, tmp_path):
     sliders = SLIDERS
     body = "document.body.innerText"
     with running(page) as (server, view):
-        browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
+        browser.call("Page.navigate", url=view.url)
         _wait(lambda: browser.js(sliders) == 3, 60, "3 joint sliders")
 
         # Two figures per save: when the server has sent the change (what modc controls; must be
@@ -277,7 +278,7 @@ def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
     (d / "ranking.json").write_text(json.dumps(ranking), encoding="utf-8")
     page = Page.for_ranking(Ranking(d / "ranking.json"))
     with running(page) as (server, view):
-        browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
+        browser.call("Page.navigate", url=view.url)
         _wait(lambda: browser.js(SLIDERS) == 3, 60, "design 1's 3 sliders")
         _settle(browser, server)
         _wait(lambda: _click(browser, "ready") or page.q[0] == pytest.approx(math.radians(30)), 60, "the ready pose")
@@ -293,7 +294,7 @@ def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
     traj = Trajectory(("joint_1", "joint_2", "joint_3"), (0.0, 0.5, 1.0), q)
     page = Page([Source(FARM, traj=traj)])
     with running(page) as (server, view):
-        browser.call("Page.navigate", url=f"http://127.0.0.1:{server.get_port()}/")
+        browser.call("Page.navigate", url=view.url)
         _wait(lambda: browser.js(SLIDERS) == 4, 60, "3 joint sliders and the time slider")
         _settle(browser, server)
         _wait(lambda: page.t > 0 or _click(browser, "play"), 60, "playback to start")

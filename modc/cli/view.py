@@ -31,8 +31,9 @@ def view_cmd(file: str, port: int, no_browser: bool, traj: str | None, robot: st
     Saving the file updates the page; an error shows its diagnostics and keeps the last good arm.
     Ctrl-C stops it."""
     from ..view.page import Page, Ranking, Source, ViewError, read_trajectory
-    from ..view.server import ServeError, run, start
+    from ..view.server import ServeError, run, start, stop_server
 
+    # Ctrl-C before the address is printed is click's "Aborted!" (exit 1); after it, a clean stop (exit 0).
     with usage_errors("view", (ViewError, ServeError)):
         if file.endswith(".json"):
             if traj is not None:
@@ -45,9 +46,12 @@ def view_cmd(file: str, port: int, no_browser: bool, traj: str | None, robot: st
         if page.source.diagnostics:
             _err(page.source.diagnostics)
         server, view = start(page, port=port)
-    url = f"http://127.0.0.1:{server.get_port()}/"
-    print(f"modc view: {url}  (Ctrl-C stops)", flush=True)
-    if not no_browser and not _open_browser(url):
-        _err("modc view: no display to open a browser on; open the address above yourself")
-    run(view)
+    try:
+        # the token in the address is the page's key: only who has it (this terminal, the browser opened here) gets in
+        print(f"modc view: {view.url}  (Ctrl-C stops)", flush=True)
+        if not no_browser and not _open_browser(view.url):
+            _err("modc view: no display to open a browser on; open the address above yourself")
+        run(view)  # returns on Ctrl-C, the server stopped
+    except KeyboardInterrupt:  # Ctrl-C between the address and the serving loop
+        stop_server(server)
     print("modc view: stopped")

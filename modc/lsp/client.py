@@ -18,6 +18,8 @@ import threading
 import time
 from collections import deque
 
+WAIT = 120.0  # s: a guard against a hung server, not a speed bound (a busy machine answers late)
+
 
 class ServerGone(Exception):
     pass
@@ -102,7 +104,7 @@ class Client:
         self.send(msg)
         return rid
 
-    def response(self, rid, timeout: float = 10.0) -> dict:
+    def response(self, rid, timeout: float = WAIT) -> dict:
         deadline = time.monotonic() + timeout
         with self._cond:
             while rid not in self.responses:
@@ -114,11 +116,11 @@ class Client:
                 self._cond.wait(left)
             return self.responses.pop(rid)[1]
 
-    def request(self, method: str, params=None, timeout: float = 10.0) -> dict:
+    def request(self, method: str, params=None, timeout: float = WAIT) -> dict:
         """The whole response message ({"result": …} or {"error": …})."""
         return self.response(self.request_async(method, params), timeout)
 
-    def result(self, method: str, params=None, timeout: float = 10.0):
+    def result(self, method: str, params=None, timeout: float = WAIT):
         msg = self.request(method, params, timeout)
         if "error" in msg:
             raise RuntimeError(f"{method}: {msg['error']}")
@@ -130,7 +132,7 @@ class Client:
             msg["params"] = params
         return self.send(msg)
 
-    def wait_notification(self, method: str, pred=lambda params: True, timeout: float = 10.0) -> tuple[float, dict]:
+    def wait_notification(self, method: str, pred=lambda params: True, timeout: float = WAIT) -> tuple[float, dict]:
         """The first (arrival time, params) of a notification that matches, removed from the queue."""
         deadline = time.monotonic() + timeout
         with self._cond:
@@ -176,7 +178,7 @@ class Client:
             "textDocument/didChange", {"textDocument": {"uri": uri, "version": version}, "contentChanges": [change]}
         )
 
-    def diagnostics(self, uri: str, version: int | None = None, timeout: float = 10.0) -> list[dict]:
+    def diagnostics(self, uri: str, version: int | None = None, timeout: float = WAIT) -> list[dict]:
         def match(p):
             return p["uri"] == uri and (version is None or p.get("version") == version)
 
@@ -187,7 +189,7 @@ class Client:
             method, {"textDocument": {"uri": uri}, "position": {"line": line, "character": character}, **extra}
         )
 
-    def shutdown(self, timeout: float = 10.0) -> int:
+    def shutdown(self, timeout: float = WAIT) -> int:
         """shutdown, exit; the server's exit code."""
         self.result("shutdown", timeout=timeout)
         self.notify("exit")

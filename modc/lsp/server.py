@@ -244,9 +244,10 @@ def formatting(ls: ModcServer, params: types.DocumentFormattingParams):
 
 def serve() -> None:
     """Run the server on stdin/stdout until the client says exit (or closes the pipe)."""
-    logging.basicConfig(level=logging.WARNING, format="modc lsp: %(message)s")
+    from .logs import configure
     from .transport import FramedReader
 
+    configure()  # bounded: a client sending garbage cannot fill the disk with tracebacks
     stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # a stray print() anywhere must never corrupt the protocol stream
     # only well-formed frames reach pygls (it reads through readline() and read(n), all FramedReader has)

@@ -55,6 +55,7 @@ class View:
     def __init__(self, server, page: Page):
         self.server = server
         self.page = page
+        self.url = ""  # the page's address with its token, set by start()
         self.lock = threading.RLock()
         self._generation = (-1, -1)  # (design index, arm generation) on show
         self._diagnostics: str | None = None
@@ -259,21 +260,38 @@ def check_port(host: str, port: int) -> None:
 
 
 def start(page: Page, host: str = "127.0.0.1", port: int = 8080):
-    """A running viser server showing the page; returns (server, view). port 0: any free port."""
+    """A running viser server showing the page, open only to this run's token (guard.py);
+    returns (server, view), the page's address with its token in view.url. port 0: any free port."""
     try:
         import viser
     except ImportError:
         raise ServeError("modc view needs the viser package: pip install viser") from None
+    from .guard import Guard, guarding, quiet_malformed_messages
 
     if port:
         check_port(host, port)
-    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner; modc prints the address itself
+    guard = Guard(host)
+    quiet_malformed_messages()
+    with guarding(guard) as used, contextlib.redirect_stdout(io.StringIO()):  # viser's banner: modc prints the address
         server = viser.ViserServer(host=host, port=port, label="modc view", verbose=False)
-    server.gui.configure_theme(show_share_button=False, control_width="large")  # the share link would leave the machine
-    if port and server.get_port() != port:  # taken between the check and the bind
+    try:
+        if not used:  # a viser that no longer serves through websockets' serve(): never serve unguarded
+            raise ServeError("this viser version serves requests modc view cannot guard; install viser 1.1")
+        if port and server.get_port() != port:  # taken between the check and the bind
+            raise ServeError(f"port {port} on {host} is busy; choose another with --port")
+        # no share button: the share link would leave the machine
+        server.gui.configure_theme(show_share_button=False, control_width="large")
+        view = View(server, page)
+    except BaseException:  # Ctrl-C while the page is built included: no server left behind
+        stop_server(server)
+        raise
+    view.url = guard.url(server.get_port())
+    return server, view
+
+
+def stop_server(server) -> None:
+    with contextlib.redirect_stdout(io.StringIO()):  # viser's "Server stopped"
         server.stop()
-        raise ServeError(f"port {port} on {host} is busy; choose another with --port")
-    return server, View(server, page)
 
 
 def run(view: View, stop: threading.Event | None = None) -> None:
@@ -288,5 +306,4 @@ def run(view: View, stop: threading.Event | None = None) -> None:
     except KeyboardInterrupt:
         pass
     finally:
-        with contextlib.redirect_stdout(io.StringIO()):
-            view.server.stop()
+        stop_server(view.server)
