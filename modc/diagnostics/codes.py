@@ -236,6 +236,8 @@ TARGET_IN_COLLISION = _register("target-in-collision", E, "a target the arm reac
     "target '{target}' is reachable only in collision: {contacts}", "{hint}")
 NO_PATH = _register("no-path", E, "no collision-free motion to a target was found",
     "no collision-free path from '{pose}' to target '{target}' found ({detail})", "{hint}")
+TARGET_OUT_OF_REACH = _register("target-out-of-reach", W, "a target no joint angles can bring tool0 to",
+    "target '{target}' is out of reach: it is {distance} m from joint_1, and tool0 is always {bound}", "{hint}")
 
 # --- names, poses, limits, environment ---------------------------------------------------------
 DUPLICATE_ROBOT = _register("duplicate-robot", E, "two robots with one name in a file",

@@ -9,6 +9,7 @@ from . import (
     check_names,
     check_poses,
     check_problems,
+    check_reach,
     check_torque,
     check_twists,
     convert_dh,
@@ -25,6 +26,7 @@ PASSES = (
     check_twists,
     check_poses,
     check_environment,
+    check_reach,
     check_torque,
     check_problems,
 )

@@ -50,7 +50,7 @@ class Plan:
     q: tuple[tuple[float, ...], ...]
     waypoints: tuple[tuple[float, ...], ...]  # the polyline the motion follows (stops at each)
     tool_error: float  # m, |tool0(q_final) - target|
-    min_clearance: float | None  # m, smallest distance of a checked pair over the output points
+    min_clearance: float | None  # m, smallest distance of a checked pair over the output points; None: no pair
     margin: float  # m, the clearance the planner kept
     seed: int
     velocity_limits: tuple[float, ...]  # rad/s
@@ -85,6 +85,8 @@ class Plan:
         if self.min_clearance is not None:
             out.append(f"  clearance       >= {self.margin * 1000:.1f} mm along the whole motion (certified), "
                        f"{self.min_clearance * 1000:.1f} mm at the closest output point")
+        else:
+            out.append("  clearance       nothing to check: no obstacle, and no pair of links the SRDF leaves checked")
         s = self.stats
         if s:
             out.append(f"  planning        {s.get('time', 0.0):.2f} s, {s.get('checks', 0)} collision checks, "
@@ -360,12 +362,13 @@ def _timed(job: _Job, checker, solver, path, with_robot_name: bool) -> Plan:
     t_rows = tuple(round(float(t), 9) for t in ts)
     final = np.array(q_rows[-1])
     tool_error = float(np.linalg.norm(solver.position(final) - np.asarray(tgt.xyz)))
-    clear = min(checker.clearance(np.array(q))[0] for q in q_rows)
+    clear = min(checker.clearance(np.array(q))[0] for q in q_rows)  # inf: no pair to check
     return Plan(
         robot=robot.name, target=tgt.name, start=job.start, target_xyz=tuple(tgt.xyz),
         joint_names=tuple(f"joint_{i}" for i in range(1, robot.dof + 1)), t=t_rows, q=q_rows,
         waypoints=tuple(tuple(float(v) for v in p) for p in path), tool_error=tool_error,
-        min_clearance=float(clear), margin=checker.margin, seed=job.seed, velocity_limits=tuple(float(v) for v in vmax),
+        min_clearance=float(clear) if math.isfinite(clear) else None, margin=checker.margin, seed=job.seed,
+        velocity_limits=tuple(float(v) for v in vmax),
         with_robot_name=with_robot_name)
 
 

@@ -199,7 +199,7 @@ class CollisionChecker:
         """Smallest distance over the checked pairs at q (m; a negative value means in collision,
         not necessarily the deepest penetration), and that pair. Pairs are visited in order of a
         lower bound (the distance between their world axis-aligned boxes) and the search stops
-        once the bound exceeds the best distance."""
+        once the bound exceeds the best distance. (inf, None) when no pair is checked."""
         pin = self.pin
         pin.updateGeometryPlacements(self.model, self.data, self.gm, self.gd, np.asarray(q, float))
         lo = np.empty((len(self.owner), 3))
@@ -208,8 +208,10 @@ class CollisionChecker:
             M = self.gd.oMg[k]
             w = corners @ np.asarray(M.rotation).T + np.asarray(M.translation)
             lo[k], hi[k] = w.min(axis=0), w.max(axis=0)
-        first = np.array([p[0] for p in self.pairs])
-        second = np.array([p[1] for p in self.pairs])
+        if not self.pairs:  # nothing to check (e.g. one module, no obstacles): no closest pair
+            return math.inf, None
+        first = np.array([p[0] for p in self.pairs], dtype=int)
+        second = np.array([p[1] for p in self.pairs], dtype=int)
         gap = np.maximum(0.0, np.maximum(lo[second] - hi[first], lo[first] - hi[second]))
         bound = np.sqrt((gap ** 2).sum(axis=1))
         best, which = math.inf, None

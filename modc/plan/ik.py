@@ -97,6 +97,7 @@ class PositionIK:
     def jacobian(self, q) -> np.ndarray:
         pin = self.pin
         J = pin.computeFrameJacobian(self.model, self.data, q, self.frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        J = np.asarray(J).reshape(6, self.model.nv)  # pinocchio hands a one-joint arm's 6 x 1 back as a flat (6,)
         if self.rotation is None:
             return np.array(J[:3])
         return np.vstack([np.array(J[:3]), ROTATION_WEIGHT * np.array(J[3:])])
