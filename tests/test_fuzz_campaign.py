@@ -38,28 +38,41 @@ def _module():
     return mod
 
 
-def test_crashes_and_hangs_are_recorded(tmp_path, monkeypatch):
+def _findings(mod, state: Path, monkeypatch, planted, *limits: str) -> list[dict]:
     import modc.compiler
 
-    mod = _module()
+    monkeypatch.setattr(modc.compiler, "check_text", planted)
+    monkeypatch.setattr(mod, "KINDS", ("yaml",))
+    n = str(planted.n)
+    rc = mod.main(["--state", str(state), "--batch", n, "--inputs", n, "--compiles", "0", "--memory", "0", *limits])
+    assert rc == 1
+    return [json.loads(line) for line in (state / "findings.jsonl").read_text().splitlines()]
+
+
+def test_crashes_and_cpu_hangs_are_recorded(tmp_path, monkeypatch):
+    """A spinning input is a hang by its CPU time; the wall-clock limit is far away, so that a
+    loaded machine (which stretches 0.3 s of CPU time over seconds) cannot make it the reason."""
     calls = {"n": 0}
 
     def broken(text, path="<string>", *a, **kw):
         calls["n"] += 1
         if calls["n"] == 1:
             raise ZeroDivisionError("planted")
-        if calls["n"] == 2:
-            while True:  # spins: CPU time
-                pass
-        time.sleep(5)  # blocks: wall-clock time
+        while True:  # spins: CPU time
+            pass
 
-    monkeypatch.setattr(modc.compiler, "check_text", broken)
-    monkeypatch.setattr(mod, "KINDS", ("yaml",))
-    rc = mod.main(["--state", str(tmp_path), "--batch", "3", "--inputs", "3", "--compiles", "0",
-                   "--timeout", "0.3", "--wall", "1", "--memory", "0"])
-    assert rc == 1
-    found = [json.loads(line) for line in (tmp_path / "findings.jsonl").read_text().splitlines()]
-    assert [(f["type"], f["detail"]) for f in found[1:]] == [("hang", "over 0.3 s of CPU time"),
-                                                             ("hang", "over 1.0 s of wall-clock time")]
+    broken.n = 2
+    found = _findings(_module(), tmp_path, monkeypatch, broken, "--timeout", "0.3", "--wall", "600")
+    assert [(f["type"], f["detail"]) for f in found[1:]] == [("hang", "over 0.3 s of CPU time")]
     assert found[0]["type"] == "traceback"
     assert found[0]["detail"].startswith("ZeroDivisionError") and "planted" in found[0]["traceback"]
+
+
+def test_a_blocked_input_is_a_wall_clock_hang(tmp_path, monkeypatch):
+    """An input that blocks (a FIFO, a lock) uses no CPU time: the wall-clock limit catches it."""
+    def blocks(text, path="<string>", *a, **kw):
+        time.sleep(600)  # uses no CPU time, so the CPU limit can never fire first
+
+    blocks.n = 1
+    found = _findings(_module(), tmp_path, monkeypatch, blocks, "--timeout", "0.3", "--wall", "1")
+    assert [(f["type"], f["detail"]) for f in found] == [("hang", "over 1.0 s of wall-clock time")]
