@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import resource
 import shutil
 import signal
@@ -41,10 +42,19 @@ import traceback
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "scripts")]
+NUMERIC_OUTPUTS = (".urdf", ".xml", ".srdf", ".xacro", ".yaml", ".json")
 
 BATCH = 100
-KINDS = ("grammar", "valid", "text", "bytes", "yaml", "csv", "hostile")
+KINDS = ("grammar", "valid", "text", "bytes", "yaml", "csv", "hostile",  # issue 10
+         "design", "library", "traj", "ranking", "cli", "plan", "ws")  # issue 21: scripts/fuzz_surfaces.py
+NEW_KINDS = KINDS[7:]
+COMPILING = ("valid", "grammar", "text", "hostile", "library")  # kinds whose inputs may be compiled in full
+FINDING_TYPES = {"traceback": "tracebacks", "hang": "hangs", "escape": "escapes", "nonfinite": "nonfinite",
+                 "resource": "resources"}
+
+
+import fuzz_surfaces  # noqa: E402  (from scripts/, on the path above)
 
 
 class Hang(BaseException):  # not an Exception: modc code catching Exception must not swallow it
@@ -125,7 +135,10 @@ def _strategies():
             + f"robots:\n  - name: a\n    chain: *a{k}\n")),
         st.binary(max_size=64).map(lambda b: ("bytes", b"robot a {\n    chain H1 - L1  # " + b + b"\n}\n")),
     )
+    import fuzz_surfaces
+
     return {
+        **fuzz_surfaces.strategies(),
         "hostile": hostile,
         "grammar": F.mod_file(),
         "valid": S.valid_chains(),
@@ -155,10 +168,13 @@ def draw_batch(strategy, n: int, seed: int) -> list:
 
 # --- running one input ------------------------------------------------------------------------------
 
-def check_one(kind: str, item, work: Path):
-    """Check one input the way the product does; returns the text when it should be compiled."""
+def check_one(kind: str, item, work: Path, ctx: dict | None = None):
+    """Check one input the way the product does; returns the text when it should be compiled.
+    ctx holds what lives across inputs (the view server of the "ws" kind) and the limits."""
     from modc.compiler import check_file, check_text
 
+    if kind in NEW_KINDS:
+        return _check_new(kind, item, work, {} if ctx is None else ctx)
     if kind == "hostile":
         kind, item = {"mod": "grammar", "yaml": "yaml", "bytes": "bytes"}[item[0]], item[1]
     if kind == "csv":
@@ -186,9 +202,30 @@ def check_one(kind: str, item, work: Path):
     return item if c.ok else None
 
 
-def compile_one(text: str, samples: int) -> str | None:
-    """Compile in full into OUT in a fresh directory (also the working directory); a finding text
-    when anything appears beside OUT."""
+def _check_new(kind: str, item, work: Path, ctx: dict):
+    import fuzz_surfaces as S
+
+    sub = work / kind
+    shutil.rmtree(sub, ignore_errors=True)
+    sub.mkdir()
+    if kind == "ws":
+        if "ws" not in ctx:
+            ctx["ws"] = S.ViewServer(work)
+        ctx["ws"].send(item)
+        return None
+    if kind == "cli":
+        S.run_cli(item, sub, wall=ctx.get("wall", 60.0) * 0.9, cpu=ctx.get("timeout", 5.0) * 6)
+        return None
+    return {"design": S.run_design, "library": S.run_library, "traj": S.run_traj, "ranking": S.run_ranking,
+            "plan": S.run_plan}[kind](item, sub)
+
+
+NONFINITE_OUT = re.compile(r"(?<![\w.])[-+]?(inf|nan|infinity)(?![\w.])", re.IGNORECASE)
+
+
+def compile_one(text: str, samples: int) -> dict | None:
+    """Compile in full into OUT in a fresh directory (also the working directory); a finding when
+    anything appears beside OUT, or an output (URDF, MJCF, SRDF, YAML) holds inf or nan."""
     from modc.compiler import build, check_text, write_tree
     from modc.files import MANIFEST
 
@@ -204,11 +241,28 @@ def compile_one(text: str, samples: int) -> str | None:
         beside = sorted(p.name for p in root.iterdir() if p.name != "out")
         inside = sorted(p.relative_to(root / "out").as_posix() for p in (root / "out").rglob("*") if p.is_file())
         if beside or inside != sorted([*files, MANIFEST]):
-            return f"files outside OUT or not listed: beside={beside[:5]} inside={inside[:5]}"
+            return {"type": "escape",
+                    "detail": f"files outside OUT or not listed: beside={beside[:5]} inside={inside[:5]}"}
+        for rel, content in sorted(files.items()):
+            m = NONFINITE_OUT.search(content) if isinstance(content, str) and rel.endswith(NUMERIC_OUTPUTS) else None
+            if m:
+                line = content[content.rfind("\n", 0, m.start()) + 1:content.find("\n", m.end())].strip()
+                return {"type": "nonfinite", "detail": f"'{m.group(0)}' in {rel.rsplit('/', 1)[-1]}",
+                        "line": line[:300]}
         return None
     finally:
         os.chdir(here)
         shutil.rmtree(root, ignore_errors=True)
+
+
+def _shown(item) -> str:
+    """The input of a finding as text: hostile and file items are (form, input), cli (argv, value)."""
+    if isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], list):
+        return json.dumps(item)
+    payload = item[1] if isinstance(item, tuple) else item
+    if isinstance(payload, dict):
+        return json.dumps(payload, default=repr)
+    return payload if isinstance(payload, str) else payload.decode("latin-1")
 
 
 def _signature(e: BaseException) -> str:
@@ -221,12 +275,17 @@ def run(args) -> int:
     state_dir = Path(args.state)
     state_dir.mkdir(parents=True, exist_ok=True)
     state_path, findings_path = state_dir / "state.json", state_dir / "findings.jsonl"
-    state = {"seed": args.seed, "batch": 0, "inputs": 0, "compiles": 0, "findings": 0, "tracebacks": 0, "hangs": 0,
-             "escapes": 0, "by_kind": {k: 0 for k in KINDS}, "seconds": 0.0}
+    kinds = tuple(args.kinds.split(",")) if args.kinds else KINDS
+    unknown = [k for k in kinds if k not in KINDS]
+    if unknown:
+        sys.exit(f"--kinds: no generator {', '.join(unknown)} (there are: {', '.join(KINDS)})")
+    state = {"seed": args.seed, "kinds": list(kinds), "batch": 0, "inputs": 0, "compiles": 0, "findings": 0,
+             **{v: 0 for v in FINDING_TYPES.values()}, "by_kind": {k: 0 for k in kinds}, "seconds": 0.0}
     if state_path.exists():
         state = json.loads(state_path.read_text())
-        if state["seed"] != args.seed:
-            sys.exit(f"{state_path} is a campaign with seed {state['seed']}; use another --state")
+        if state["seed"] != args.seed or state.get("kinds", list(kinds)) != list(kinds):
+            sys.exit(f"{state_path} is a campaign with seed {state['seed']} and kinds {state.get('kinds')}; "
+                     "use another --state")
     os.environ.setdefault("MODC_CACHE_DIR", str(state_dir / "cache"))
     if args.memory:
         resource.setrlimit(resource.RLIMIT_AS, (args.memory * 2**20, resource.RLIM_INFINITY))
@@ -234,12 +293,13 @@ def run(args) -> int:
     signal.signal(signal.SIGPROF, _alarm)
     gens = _strategies()
     work = Path(tempfile.mkdtemp(prefix="modc-fuzz-work-"))
+    ctx: dict = {"wall": args.wall, "timeout": args.timeout}
     started = time.monotonic()
     try:
         while state["inputs"] < args.inputs or state["compiles"] < args.compiles:
             k = state["batch"]
-            kind = KINDS[k % len(KINDS)]
-            if state["inputs"] >= args.inputs and kind not in ("valid", "grammar", "text", "hostile"):
+            kind = kinds[k % len(kinds)]
+            if state["inputs"] >= args.inputs and kind not in COMPILING:
                 state["batch"] += 1  # only compiles are still wanted: skip kinds that never compile
                 continue
             batch = draw_batch(gens[kind], args.batch, args.seed * 1_000_003 + k)
@@ -249,17 +309,17 @@ def run(args) -> int:
                 try:
                     signal.setitimer(signal.ITIMER_PROF, args.timeout)
                     signal.setitimer(signal.ITIMER_REAL, args.wall)
-                    text = check_one(kind, item, work)
+                    text = check_one(kind, item, work, ctx)
                     if text is not None and state["compiles"] < args.compiles:
                         signal.setitimer(signal.ITIMER_PROF, args.timeout * 6)  # a full compile does more
                         signal.setitimer(signal.ITIMER_REAL, args.wall * 6)
-                        escape = compile_one(text, args.collision_samples)
+                        finding = compile_one(text, args.collision_samples)
                         state["compiles"] += 1
-                        if escape:
-                            finding = {"type": "escape", "detail": escape}
                 except Hang as e:
                     limit = args.wall if e.args[0] == "wall-clock" else args.timeout
                     finding = {"type": "hang", "detail": f"over {limit} s of {e.args[0]} time"}
+                except fuzz_surfaces.Finding as e:
+                    finding = {"type": e.kind, "detail": e.detail, "traceback": e.text}
                 except BaseException as e:  # noqa: BLE001  (a finding, whatever it is)
                     if isinstance(e, KeyboardInterrupt):
                         raise
@@ -272,9 +332,9 @@ def run(args) -> int:
                 state["by_kind"][kind] += 1
                 if finding:
                     state["findings"] += 1
-                    state[{"traceback": "tracebacks", "hang": "hangs", "escape": "escapes"}[str(finding["type"])]] += 1
-                    payload = item[1] if isinstance(item, tuple) else item  # hostile: (form, input)
-                    shown = payload if isinstance(payload, str) else payload.decode("latin-1")
+                    key = FINDING_TYPES[str(finding["type"])]
+                    state[key] = state.get(key, 0) + 1
+                    shown = _shown(item)
                     finding.update(kind=kind, batch=k, index=i, seconds=round(time.monotonic() - t0, 2),
                                    input=shown[:4000])
                     with open(findings_path, "a", encoding="utf-8") as f:
@@ -293,6 +353,8 @@ def run(args) -> int:
             if args.stop_after and state["batch"] >= args.stop_after:
                 break
     finally:
+        if "ws" in ctx:
+            ctx["ws"].close()
         shutil.rmtree(work, ignore_errors=True)
     print(json.dumps({k: v for k, v in state.items() if k != "seed"}))
     return 1 if state["findings"] else 0
@@ -311,6 +373,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--batch", type=int, default=BATCH, help="inputs drawn per batch (keep it for a resumed campaign)")
     p.add_argument("--stop-after", type=int, default=0, help="stop after this batch number (to test resuming)")
     p.add_argument("--progress", action="store_true")
+    p.add_argument("--kinds", default="", help=f"comma-separated generators (default: all of {','.join(KINDS)}; "
+                   f"only issue 21's: {','.join(NEW_KINDS)})")
     return run(p.parse_args(argv))
 
 

@@ -1,6 +1,8 @@
 """Shared test helpers: compile .mod text or files into a temporary output tree."""
 from __future__ import annotations
 
+import resource
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -48,6 +50,16 @@ def compiled_examples(tmp_path_factory) -> dict[str, Path]:
         compile_file(ex, d)
         out[ex.stem] = d
     return out
+
+
+def run_cpu(cmd: list[str], *, timeout: float = 600, **kw) -> tuple[subprocess.CompletedProcess, float]:
+    """subprocess.run(cmd, capture_output=True, text=True) and the CPU seconds the child (with its own
+    children) used. CPU time, unlike wall-clock time, does not grow with the rest of the machine's
+    load: a bound on it is a bound on the work done. `timeout` is a guard against hangs only."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, **kw)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r, (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
 
 
 def pytest_addoption(parser):

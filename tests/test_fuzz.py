@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import run_cpu
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
@@ -400,20 +401,20 @@ def test_lint_subprocess_on_mutated_files(tmp_path, fmt):
 
 # --- (d) oversized inputs ---------------------------------------------------------------------------
 
-LIMIT_S = 5.0  # a guard against hangs, not a benchmark
+# "Quickly" is a bound on the work done, so it is CPU time (of this process, or of a child), which
+# other load on the machine does not stretch; 10x what these take alone. Speed is benchmarks/' job.
+CPU_LIMIT_S = 5.0
 
 
 def test_ten_thousand_unit_chain_is_rejected_quickly():
     text = "robot snake {\n    chain " + " - ".join(["H1"] * 9_999 + ["L1"]) + "\n}\n"
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     c = assert_sane(text, "snake.mod")
-    elapsed = time.perf_counter() - t0
+    render_text(c.diagnostics, c.sources)
+    cpu = time.process_time() - t0
     assert [(d.code, d.span.line) for d in c.diagnostics] == [("too-many-units", 2)]
     assert "10000 units" in c.diagnostics[0].message
-    t0 = time.perf_counter()
-    render_text(c.diagnostics, c.sources)
-    elapsed += time.perf_counter() - t0
-    assert elapsed < LIMIT_S, f"{elapsed:.2f} s"
+    assert cpu < CPU_LIMIT_S, f"{cpu:.2f} s of CPU time"
 
 
 def test_oversized_dh_table_is_one_error():
@@ -426,7 +427,7 @@ def test_one_megabyte_file_is_rejected_quickly(tmp_path):
     unit = "robot a { chain H1 - L4(port=45deg) - L1 }\n"
     text = unit * (1_000_000 // len(unit) + 1)
     assert len(text) > 1_000_000
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     c = assert_sane(text, "big.mod")
     assert [d.code for d in c.diagnostics] == ["input-too-large"]
     # the same through the file reader, and one huge line (a minified or binary file)
@@ -435,8 +436,8 @@ def test_one_megabyte_file_is_rejected_quickly(tmp_path):
     c = check_file(p)
     assert [d.code for d in c.diagnostics] == ["input-too-large"]
     render_text(c.diagnostics, c.sources)
-    elapsed = time.perf_counter() - t0
-    assert elapsed < LIMIT_S, f"{elapsed:.2f} s"
+    cpu = time.process_time() - t0
+    assert cpu < CPU_LIMIT_S, f"{cpu:.2f} s of CPU time"
 
 
 def test_long_single_line_renders_a_window():
@@ -637,12 +638,11 @@ def test_yaml_alias_bomb_is_rejected_quickly(tmp_path):
     assert len(text) < 500
     bomb = tmp_path / "bomb.yaml"
     bomb.write_text(text, encoding="utf-8")
-    # in a subprocess, so that a hang costs LIMIT_S (+ start-up), not minutes
+    # in a subprocess, so that an expanding bomb costs its CPU time (+ start-up), not the test run;
+    # the timeout only guards against a hang
     code = ("import json, sys; from modc.compiler import check_file; "
             "print(json.dumps([d.code for d in check_file(sys.argv[1]).diagnostics]))")
-    try:
-        p = subprocess.run([sys.executable, "-c", code, str(bomb)], capture_output=True, text=True, timeout=LIMIT_S)
-    except subprocess.TimeoutExpired:
-        pytest.fail(f"checking a {len(text)}-byte YAML file took more than {LIMIT_S} s")
+    p, cpu = run_cpu([sys.executable, "-c", code, str(bomb)], timeout=600)
     assert p.returncode == 0, p.stderr
+    assert cpu < CPU_LIMIT_S, f"checking a {len(text)}-byte YAML file took {cpu:.2f} s of CPU time"
     assert json.loads(p.stdout) == ["yaml-schema"]  # aliases are refused before they expand

@@ -1,6 +1,14 @@
 """A short seeded slice of the fuzz campaign (scripts/fuzz_campaign.py), as CI runs it: every
 generator, fmt and full compiles; no tracebacks, hangs or files outside OUT; it resumes; and it
-does report a crash and a hang when there is one."""
+does report a crash and a hang when there is one.
+
+A bigger campaign (all generators; hours):
+    python scripts/fuzz_campaign.py --state /tmp/fuzz --seed 1 --inputs 20000 --compiles 500 --progress
+only issue 21's generators (design blocks, library files, trajectories, ranking.json, CLI option
+values, plan on random arms, the view server's websocket):
+    python scripts/fuzz_campaign.py --state /tmp/fuzz21 --seed 1 --inputs 2000 --compiles 100 --progress \
+        --kinds design,library,traj,ranking,cli,plan,ws
+"""
 from __future__ import annotations
 
 import importlib.util
@@ -10,13 +18,21 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 SCRIPT = ROOT / "scripts" / "fuzz_campaign.py"
 
 
+ISSUE_10 = "grammar,valid,text,bytes,yaml,csv,hostile"
+ISSUE_21 = "design,library,traj,ranking,cli,plan,ws"
+
+
 def campaign(state: Path, *extra: str) -> subprocess.CompletedProcess:
+    # the timeout guards against a hang only: the campaign's own limits are CPU time
     return subprocess.run([sys.executable, str(SCRIPT), "--state", str(state), "--seed", "7", "--batch", "15",
-                           "--inputs", "105", "--compiles", "3", *extra], capture_output=True, text=True, timeout=300)
+                           "--inputs", "105", "--compiles", "3", "--kinds", ISSUE_10, *extra], capture_output=True,
+                          text=True, timeout=1800)
 
 
 def test_a_seeded_slice_finds_nothing_and_resumes(tmp_path):
@@ -31,6 +47,18 @@ def test_a_seeded_slice_finds_nothing_and_resumes(tmp_path):
     assert not (tmp_path / "s" / "findings.jsonl").exists()
 
 
+@pytest.mark.slow
+def test_a_seeded_slice_of_the_new_generators_finds_nothing(tmp_path):
+    """Two inputs of each of issue 21's generators (one `modc view` server, CLI subprocesses)."""
+    r = subprocess.run([sys.executable, str(SCRIPT), "--state", str(tmp_path), "--seed", "7", "--batch", "2",
+                        "--inputs", "14", "--compiles", "1", "--kinds", ISSUE_21], capture_output=True, text=True,
+                       timeout=1800)
+    findings = tmp_path / "findings.jsonl"
+    assert r.returncode == 0, findings.read_text()[-4000:] if findings.exists() else r.stderr[-3000:]
+    state = json.loads(r.stdout)
+    assert state["by_kind"] == {k: 2 for k in ISSUE_21.split(",")} and state["findings"] == 0
+
+
 def _module():
     spec = importlib.util.spec_from_file_location("fuzz_campaign", SCRIPT)
     mod = importlib.util.module_from_spec(spec)
@@ -38,28 +66,61 @@ def _module():
     return mod
 
 
-def test_crashes_and_hangs_are_recorded(tmp_path, monkeypatch):
+def _findings(mod, state: Path, monkeypatch, planted, *limits: str) -> list[dict]:
     import modc.compiler
 
-    mod = _module()
+    monkeypatch.setattr(modc.compiler, "check_text", planted)
+    monkeypatch.setattr(mod, "KINDS", ("yaml",))
+    n = str(planted.n)
+    rc = mod.main(["--state", str(state), "--batch", n, "--inputs", n, "--compiles", "0", "--memory", "0", *limits])
+    assert rc == 1
+    return [json.loads(line) for line in (state / "findings.jsonl").read_text().splitlines()]
+
+
+def test_crashes_and_cpu_hangs_are_recorded(tmp_path, monkeypatch):
+    """A spinning input is a hang by its CPU time; the wall-clock limit is far away, so that a
+    loaded machine (which stretches 0.3 s of CPU time over seconds) cannot make it the reason."""
     calls = {"n": 0}
 
     def broken(text, path="<string>", *a, **kw):
         calls["n"] += 1
         if calls["n"] == 1:
             raise ZeroDivisionError("planted")
-        if calls["n"] == 2:
-            while True:  # spins: CPU time
-                pass
-        time.sleep(5)  # blocks: wall-clock time
+        while True:  # spins: CPU time
+            pass
 
-    monkeypatch.setattr(modc.compiler, "check_text", broken)
-    monkeypatch.setattr(mod, "KINDS", ("yaml",))
-    rc = mod.main(["--state", str(tmp_path), "--batch", "3", "--inputs", "3", "--compiles", "0",
-                   "--timeout", "0.3", "--wall", "1", "--memory", "0"])
-    assert rc == 1
-    found = [json.loads(line) for line in (tmp_path / "findings.jsonl").read_text().splitlines()]
-    assert [(f["type"], f["detail"]) for f in found[1:]] == [("hang", "over 0.3 s of CPU time"),
-                                                             ("hang", "over 1.0 s of wall-clock time")]
+    broken.n = 2
+    found = _findings(_module(), tmp_path, monkeypatch, broken, "--timeout", "0.3", "--wall", "600")
+    assert [(f["type"], f["detail"]) for f in found[1:]] == [("hang", "over 0.3 s of CPU time")]
     assert found[0]["type"] == "traceback"
     assert found[0]["detail"].startswith("ZeroDivisionError") and "planted" in found[0]["traceback"]
+
+
+def test_a_blocked_input_is_a_wall_clock_hang(tmp_path, monkeypatch):
+    """An input that blocks (a FIFO, a lock) uses no CPU time: the wall-clock limit catches it."""
+    def blocks(text, path="<string>", *a, **kw):
+        time.sleep(600)  # uses no CPU time, so the CPU limit can never fire first
+
+    blocks.n = 1
+    found = _findings(_module(), tmp_path, monkeypatch, blocks, "--timeout", "0.3", "--wall", "1")
+    assert [(f["type"], f["detail"]) for f in found] == [("hang", "over 1.0 s of wall-clock time")]
+
+
+def test_a_traceback_in_a_cli_subprocess_is_recorded(tmp_path, monkeypatch):
+    mod = _module()
+    monkeypatch.setattr(mod.fuzz_surfaces, "GUARDED_MAIN", "raise ZeroDivisionError('planted')")
+    rc = mod.main(["--state", str(tmp_path), "--batch", "1", "--inputs", "1", "--compiles", "0", "--memory", "0",
+                   "--kinds", "cli"])
+    assert rc == 1
+    [found] = [json.loads(line) for line in (tmp_path / "findings.jsonl").read_text().splitlines()]
+    assert found["type"] == "traceback" and "ZeroDivisionError: planted" in found["detail"], found
+
+
+def test_a_process_pool_over_the_cap_is_a_finding_not_a_fork(tmp_path):
+    """The guard the CLI generator runs modc under: a pool of more than WORKERS_CAP processes ends
+    the process before it forks any."""
+    mod = _module()
+    code = mod.fuzz_surfaces.GUARDED_MAIN.replace(
+        "from modc.cli import main", "from concurrent.futures import ProcessPoolExecutor; ProcessPoolExecutor(10**6)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert r.returncode == mod.fuzz_surfaces.UNCAPPED_EXIT and "1000000 workers" in r.stderr

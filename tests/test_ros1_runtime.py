@@ -137,13 +137,23 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def test_robot_state_publisher_has_no_root_inertia_warning(workspace):
+def publishes(master_uri: str, topic: str, node: str, proc: subprocess.Popen) -> bool:
+    """Whether the ROS master lists node as a publisher of topic (while proc, the node, still runs)."""
+    import xmlrpc.client
+
+    assert proc.poll() is None, "the publisher has ended"
+    _, _, (pubs, _, _) = xmlrpc.client.ServerProxy(master_uri).getSystemState("/modc_test")
+    return any(t == topic and node in nodes for t, nodes in pubs)
+
+
+def test_robot_state_publisher_has_no_root_inertia_warning(workspace, tmp_path):
     if not RSP.is_file():
         pytest.skip("robot_state_publisher is not installed (apt: ros-robot-state-publisher)")
     rosmaster, rosparam = tool("rosmaster"), tool("rosparam")
     _, pkgs, env = workspace
     port = free_port()
-    env = {**env, "ROS_MASTER_URI": f"http://127.0.0.1:{port}"}
+    master_uri = f"http://127.0.0.1:{port}"
+    env = {**env, "ROS_MASTER_URI": master_uri}
     master = subprocess.Popen([rosmaster, "--core", "-p", str(port)], env=env, stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL)
     try:
@@ -151,21 +161,29 @@ def test_robot_state_publisher_has_no_root_inertia_warning(workspace):
         stderr = {}
         for which in ("_ros.urdf", ".urdf"):
             urdf = d / f"urdf/{robot.file_stem}{which}"
-            for _ in range(50):  # the master needs a moment
-                if run([rosparam, "set", "/robot_description", "-t", str(urdf)], env).returncode == 0:
-                    break
-                time.sleep(0.1)
+            deadline = time.monotonic() + 240  # a guard against a master that never comes up
+            while run([rosparam, "set", "/robot_description", "-t", str(urdf)], env).returncode != 0:
+                assert time.monotonic() < deadline, "rosmaster did not come up"
+                time.sleep(0.1)  # the master needs a moment
+            log = tmp_path / f"rsp{which}.log"
+            with open(log, "w") as f:
+                node = f"rsp_{len(stderr)}"  # its own name: the master may still list the previous one
+                rsp = subprocess.Popen([str(RSP), f"__name:={node}"], stdout=f, stderr=subprocess.STDOUT, env=env)
             try:
-                r = subprocess.run([str(RSP)], capture_output=True, text=True, env=env, timeout=3, check=False)
-                out = r.stdout + r.stderr
-            except subprocess.TimeoutExpired as e:  # it runs until stopped: it loaded the description
-                out = (e.stdout or b"").decode() + (e.stderr or b"").decode()
-            stderr[which] = out
+                # it runs until stopped: wait for the event that it has built the KDL tree (it advertises
+                # /tf_static only after the tree is built and the warning printed), not for a time
+                while not publishes(master_uri, "/tf_static", f"/{node}", rsp):
+                    assert time.monotonic() < deadline, "robot_state_publisher never advertised /tf_static"
+                    time.sleep(0.1)
+            finally:
+                rsp.terminate()
+                rsp.wait(timeout=60)
+            stderr[which] = log.read_text()
         assert KDL_WARNING not in stderr["_ros.urdf"], stderr["_ros.urdf"]
         assert KDL_WARNING in stderr[".urdf"], "the check would not see the warning"
     finally:
         master.terminate()
-        master.wait(timeout=10)
+        master.wait(timeout=60)
 
 
 @pytest.mark.skipif(os.name != "posix", reason="POSIX only")
