@@ -17,7 +17,7 @@ import pytest
 from conftest import EXAMPLES, ROOT
 from test_sim import FOLD, HEAVY, WALL
 
-from modc.backends import mjcf
+from modc.backends import mjcf, mjcf_scene
 from modc.compiler import build, check_file, check_text
 from modc.files import write_files
 from modc.kinematics import Chain, transform
@@ -74,11 +74,15 @@ def test_every_example_loads_in_mujoco_with_its_structure(path, tmp_path):
         kp, kv = m.actuator_gainprm[:, 0], -m.actuator_biasprm[:, 2]
         assert np.allclose(kp, np.array(peaks) / mjcf.ERROR_AT_PEAK) and np.allclose(kv, kp * 0.05 / 2)
         assert m.site("tool0").bodyid[0] == m.body("tool0").id
-        # the cell: obstacles named as in the file, targets as sites, keyframes home first
-        assert sorted(m.geom(g).name for g in range(m.ngeom) if m.geom_bodyid[g] == 0) == sorted(
-            o.name for o in robot.obstacles)
+        # the robot file is the robot alone (it loads by itself); its scene adds the cell
+        assert not any(m.geom_bodyid == 0) and m.nsite == 1
+        sc = mujoco.MjModel.from_xml_path(str(root / "mjcf" / mjcf.scene_name(robot)))
+        world = sorted(sc.geom(g).name for g in range(sc.ngeom) if sc.geom_bodyid[g] == 0)
+        assert world == sorted([o.name for o in robot.obstacles] + [mjcf_scene.FLOOR])
         for t in robot.targets:
-            assert m.site(mjcf.TARGET_PREFIX + t.name).bodyid[0] == 0
+            assert sc.site(mjcf.TARGET_PREFIX + t.name).bodyid[0] == 0
+        assert sc.cam(mjcf_scene.CAMERA).id == 0 and sc.nlight >= 1 and sc.nbody == m.nbody
+        _visual_collision_split(m)
         keys = [m.key(k).name for k in range(m.nkey)]
         assert keys == ["home"] + [p.name for p in robot.poses if p.name != "home"]
         assert np.allclose(m.key_qpos[0], robot.home()) and np.allclose(m.key_ctrl[0], robot.home())
@@ -86,6 +90,48 @@ def test_every_example_loads_in_mujoco_with_its_structure(path, tmp_path):
         srdf = root / "config" / f"{robot.file_stem}.srdf"
         excluded = {frozenset((m.body(int(s) >> 16).name, m.body(int(s) & 0xFFFF).name)) for s in m.exclude_signature}
         assert excluded == srdf_disabled_pairs(srdf, include_never=True)
+
+
+def _visual_collision_split(m):
+    """Every mesh geom is visual only (contype = conaffinity = 0, group 2); every link with meshes
+    has collision geoms of its own (group 3), primitives, none of them a mesh."""
+    for g in range(m.ngeom):
+        if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:
+            assert m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0 and m.geom_group[g] == 2
+        elif m.geom_bodyid[g] != 0:
+            assert m.geom_contype[g] == 1 and m.geom_conaffinity[g] == 1 and m.geom_group[g] == 3
+            assert m.geom_type[g] in (int(mujoco.mjtGeom.mjGEOM_BOX), int(mujoco.mjtGeom.mjGEOM_CYLINDER))
+    for b in range(1, m.nbody):
+        geoms = m.geom_bodyid == b
+        if geoms.any():
+            assert (geoms & (m.geom_contype != 0)).any(), m.body(b).name
+
+
+def test_u_bracket_collides_as_its_plate_and_cheeks(tmp_path):
+    """A box between the cheeks of a twist unit's U-bracket touches nothing: with the mesh's
+    convex hull (before) it was inside a solid block."""
+    checked = check_text("robot r { chain H1 - L3 }", "u.mod")
+    root = compiled(tmp_path, checked)
+    (robot,) = checked.design.robots
+    m = load(root, robot)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    # base_link's twist unit: a plate (the lowest cylinder) and two cheeks (boxes) rising from it
+    base = [g for g in range(m.ngeom) if m.geom_bodyid[g] == m.body("base_link").id and m.geom_contype[g]]
+    cheeks = [g for g in base if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+    plate = min((g for g in base if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER), key=lambda g: d.geom_xpos[g][2])
+    assert len(cheeks) == 2
+    middle = (d.geom_xpos[cheeks[0]] + d.geom_xpos[cheeks[1]]) / 2.0  # inside the U, above the plate
+    spec = mujoco.MjSpec.from_file(str(root / "mjcf" / f"{robot.file_stem}.xml"))
+    spec.worldbody.add_body(name="probe", pos=middle.tolist()).add_geom(
+        type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0, 0])
+    m2 = spec.compile()
+    d2 = mujoco.MjData(m2)
+    mujoco.mj_forward(m2, d2)
+    probe = m2.ngeom - 1
+    assert m2.geom_bodyid[probe] == m2.body("probe").id
+    for g in [*cheeks, plate]:
+        assert mujoco.mj_geomDistance(m2, d2, g, probe, 1.0, None) > 0.0, m2.geom(g)
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
