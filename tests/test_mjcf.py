@@ -215,10 +215,11 @@ def test_mesh_references_are_relative_and_exist(tmp_path):
 
 def test_source_name_cannot_break_the_xml(tmp_path):
     checked = check_text("robot r { chain H1 - L3 }", "a & <b> --> ${x}.mod")
-    text = build(checked, ["mjcf"])["mjcf/mod2_r.xml"]
-    assert ET.fromstring(text).tag == "mujoco"
-    comments = re.findall(r"<!--(.*?)-->", text, flags=re.S)
-    assert comments and all("--" not in c and "${" not in c for c in comments)
+    files = build(checked, ["mjcf"])
+    for text in (files["mjcf/mod2_r.xml"], files["mjcf/scene_mod2_r.xml"]):
+        assert ET.fromstring(text).tag == "mujoco"
+        comments = re.findall(r"<!--(.*?)-->", text, flags=re.S)
+        assert comments and all("--" not in c and "${" not in c for c in comments)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -331,3 +332,40 @@ def test_home_keyframe_is_robot_home_within_narrowed_limits(tmp_path):
     assert m.key(0).name == "home"
     assert np.allclose(m.key_qpos[0], EXPECTED, atol=1e-11) and np.allclose(m.key_ctrl[0], EXPECTED, atol=1e-11)
     assert np.allclose(m.jnt_range[1], np.radians([10.0, 90.0]), atol=1e-11)
+
+
+def _library(tmp_path: Path, **replace) -> Path:
+    text = (ROOT / "libraries" / "mark2.yaml").read_text(encoding="utf-8")
+    for old, new in replace.items():
+        text = re.sub(old, lambda _m, new=new: new, text, count=1, flags=re.M)
+    return write(tmp_path, text, "lib.yaml")
+
+
+def test_a_number_mujoco_cannot_hold_is_a_diagnostic_not_inf(tmp_path):
+    """A peak torque near the float limit made kp = inf in the MJCF; now compile refuses, at the
+    robot's library statement, and writes nothing."""
+    from click.testing import CliRunner
+
+    from modc.cli import app
+
+    _library(tmp_path, **{r"torque_peak: 30\.5.*$": "torque_peak: 1e307"})
+    mod = write(tmp_path, 'robot a {\n  library "lib.yaml"\n  chain H1 - H4(pivot=-90deg) - L3(port=45deg)\n}\n')
+    res = CliRunner().invoke(app, ["compile", str(mod), "-o", str(tmp_path / "out")])
+    assert res.exit_code == 1, res.output
+    assert "error[not-finite]" in res.output and "kp = peak torque" in res.output and ":2:3:" in res.output
+    assert "inf" not in res.output.replace("infinite", "") and "Traceback" not in res.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_library_name_goes_through_the_comment_sanitiser(tmp_path):
+    _library(tmp_path, **{r"^name: mark2.*$": "name: evil--x-"})  # a valid label that would end an XML comment
+    mod = write(tmp_path, 'robot a {\n  library "lib.yaml"\n  chain H1 - L3\n}\n')
+    checked = check_file(mod)
+    assert checked.ok, [d.message for d in checked.diagnostics]
+    files = build(checked, ["mjcf"])
+    for rel in ("mjcf/mod2_a.xml", "mjcf/scene_mod2_a.xml"):
+        text = files[rel]
+        assert ET.fromstring(text).tag == "mujoco"
+        comments = re.findall(r"<!--(.*?)-->", text, flags=re.S)
+        assert comments and all("--" not in c and not c.endswith("-") for c in comments), rel
+    assert "(library evil- -x- )" in files["mjcf/mod2_a.xml"]
