@@ -79,3 +79,21 @@ def fit_camera(points, azimuth: float, elevation: float, aspect: float, fov: flo
     near = max(0.01, float((dist - (rel @ d).max()) * 0.5))
     return Camera(vec3(eye), vec3(target), vec3(up), fov, aspect,
                   near, span * 3.0 + 1.0, azimuth, elevation)
+
+
+def project(cam: Camera, points, width: int, height: int):
+    """Pixel coordinates (u right, v down; N x 2) of world points in a width x height picture
+    taken with this camera (a pinhole with the vertical field of view cam.fov)."""
+    import numpy as np
+
+    eye, target = np.asarray(cam.eye), np.asarray(cam.target)
+    fwd = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(fwd, cam.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    rel = np.atleast_2d(np.asarray(points, dtype=float)) - eye
+    depth = np.maximum(rel @ fwd, 1e-9)
+    ty = math.tan(math.radians(cam.fov) / 2.0)
+    x = (rel @ right) / depth / (ty * width / height)
+    y = (rel @ up) / depth / ty
+    return np.c_[(x + 1.0) / 2.0 * width, (1.0 - y) / 2.0 * height]

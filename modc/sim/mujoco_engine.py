@@ -38,6 +38,22 @@ FK_TOL = (1e-9, 1e-9)  # m, rotation-matrix entries
 ENGINE = "MuJoCo"
 
 
+def import_mujoco():
+    """mujoco, with an offscreen GL chosen before its first import when there is no display (its
+    GL platform is fixed when the module loads): EGL, which Debian's libegl1 provides."""
+    import os
+    import sys
+
+    if "mujoco" not in sys.modules and not os.environ.get("MUJOCO_GL"):
+        from .scene import display_available
+
+        if not display_available():
+            os.environ["MUJOCO_GL"] = "egl"
+    import mujoco
+
+    return mujoco
+
+
 @dataclass
 class MujocoScene(CollisionQueries):
     """A loaded MJCF: body names play the URDF links' part in contacts.py's adjacency rule."""
@@ -110,7 +126,7 @@ def scene_path(robot, xml: Path) -> Path:
 
 def load(robot, xml: Path) -> MujocoScene:
     """Load the robot's MJCF scene (ValueError when MuJoCo rejects it); xml: the robot file."""
-    import mujoco
+    mujoco = import_mujoco()
 
     m = mujoco.MjModel.from_xml_path(str(scene_path(robot, xml)))
     d = mujoco.MjData(m)
@@ -208,4 +224,4 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
         return [simulate_robot(r, xmls[r.name], allowed_from_srdf(out_dir, r), hold_time) for r in robots]
 
 
-__all__ = ["ENGINE", "FK_TOL", "MujocoScene", "load", "simulate", "simulate_robot"]
+__all__ = ["ENGINE", "FK_TOL", "MujocoScene", "import_mujoco", "load", "simulate", "simulate_robot"]
