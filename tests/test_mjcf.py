@@ -17,7 +17,7 @@ import pytest
 from conftest import EXAMPLES, ROOT
 from test_sim import FOLD, HEAVY, WALL
 
-from modc.backends import mjcf
+from modc.backends import mjcf, mjcf_scene
 from modc.compiler import build, check_file, check_text
 from modc.files import write_files
 from modc.kinematics import Chain, transform
@@ -74,11 +74,15 @@ def test_every_example_loads_in_mujoco_with_its_structure(path, tmp_path):
         kp, kv = m.actuator_gainprm[:, 0], -m.actuator_biasprm[:, 2]
         assert np.allclose(kp, np.array(peaks) / mjcf.ERROR_AT_PEAK) and np.allclose(kv, kp * 0.05 / 2)
         assert m.site("tool0").bodyid[0] == m.body("tool0").id
-        # the cell: obstacles named as in the file, targets as sites, keyframes home first
-        assert sorted(m.geom(g).name for g in range(m.ngeom) if m.geom_bodyid[g] == 0) == sorted(
-            o.name for o in robot.obstacles)
+        # the robot file is the robot alone (it loads by itself); its scene adds the cell
+        assert not any(m.geom_bodyid == 0) and m.nsite == 1
+        sc = mujoco.MjModel.from_xml_path(str(root / "mjcf" / mjcf.scene_name(robot)))
+        world = sorted(sc.geom(g).name for g in range(sc.ngeom) if sc.geom_bodyid[g] == 0)
+        assert world == sorted([o.name for o in robot.obstacles] + [mjcf_scene.FLOOR])
         for t in robot.targets:
-            assert m.site(mjcf.TARGET_PREFIX + t.name).bodyid[0] == 0
+            assert sc.site(mjcf.TARGET_PREFIX + t.name).bodyid[0] == 0
+        assert sc.cam(mjcf_scene.CAMERA).id == 0 and sc.nlight >= 1 and sc.nbody == m.nbody
+        _visual_collision_split(m)
         keys = [m.key(k).name for k in range(m.nkey)]
         assert keys == ["home"] + [p.name for p in robot.poses if p.name != "home"]
         assert np.allclose(m.key_qpos[0], robot.home()) and np.allclose(m.key_ctrl[0], robot.home())
@@ -86,6 +90,48 @@ def test_every_example_loads_in_mujoco_with_its_structure(path, tmp_path):
         srdf = root / "config" / f"{robot.file_stem}.srdf"
         excluded = {frozenset((m.body(int(s) >> 16).name, m.body(int(s) & 0xFFFF).name)) for s in m.exclude_signature}
         assert excluded == srdf_disabled_pairs(srdf, include_never=True)
+
+
+def _visual_collision_split(m):
+    """Every mesh geom is visual only (contype = conaffinity = 0, group 2); every link with meshes
+    has collision geoms of its own (group 3), primitives, none of them a mesh."""
+    for g in range(m.ngeom):
+        if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:
+            assert m.geom_contype[g] == 0 and m.geom_conaffinity[g] == 0 and m.geom_group[g] == 2
+        elif m.geom_bodyid[g] != 0:
+            assert m.geom_contype[g] == 1 and m.geom_conaffinity[g] == 1 and m.geom_group[g] == 3
+            assert m.geom_type[g] in (int(mujoco.mjtGeom.mjGEOM_BOX), int(mujoco.mjtGeom.mjGEOM_CYLINDER))
+    for b in range(1, m.nbody):
+        geoms = m.geom_bodyid == b
+        if geoms.any():
+            assert (geoms & (m.geom_contype != 0)).any(), m.body(b).name
+
+
+def test_u_bracket_collides_as_its_plate_and_cheeks(tmp_path):
+    """A box between the cheeks of a twist unit's U-bracket touches nothing: with the mesh's
+    convex hull (before) it was inside a solid block."""
+    checked = check_text("robot r { chain H1 - L3 }", "u.mod")
+    root = compiled(tmp_path, checked)
+    (robot,) = checked.design.robots
+    m = load(root, robot)
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    # base_link's twist unit: a plate (the lowest cylinder) and two cheeks (boxes) rising from it
+    base = [g for g in range(m.ngeom) if m.geom_bodyid[g] == m.body("base_link").id and m.geom_contype[g]]
+    cheeks = [g for g in base if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+    plate = min((g for g in base if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CYLINDER), key=lambda g: d.geom_xpos[g][2])
+    assert len(cheeks) == 2
+    middle = (d.geom_xpos[cheeks[0]] + d.geom_xpos[cheeks[1]]) / 2.0  # inside the U, above the plate
+    spec = mujoco.MjSpec.from_file(str(root / "mjcf" / f"{robot.file_stem}.xml"))
+    spec.worldbody.add_body(name="probe", pos=middle.tolist()).add_geom(
+        type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0, 0])
+    m2 = spec.compile()
+    d2 = mujoco.MjData(m2)
+    mujoco.mj_forward(m2, d2)
+    probe = m2.ngeom - 1
+    assert m2.geom_bodyid[probe] == m2.body("probe").id
+    for g in [*cheeks, plate]:
+        assert mujoco.mj_geomDistance(m2, d2, g, probe, 1.0, None) > 0.0, m2.geom(g)
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
@@ -169,10 +215,11 @@ def test_mesh_references_are_relative_and_exist(tmp_path):
 
 def test_source_name_cannot_break_the_xml(tmp_path):
     checked = check_text("robot r { chain H1 - L3 }", "a & <b> --> ${x}.mod")
-    text = build(checked, ["mjcf"])["mjcf/mod2_r.xml"]
-    assert ET.fromstring(text).tag == "mujoco"
-    comments = re.findall(r"<!--(.*?)-->", text, flags=re.S)
-    assert comments and all("--" not in c and "${" not in c for c in comments)
+    files = build(checked, ["mjcf"])
+    for text in (files["mjcf/mod2_r.xml"], files["mjcf/scene_mod2_r.xml"]):
+        assert ET.fromstring(text).tag == "mujoco"
+        comments = re.findall(r"<!--(.*?)-->", text, flags=re.S)
+        assert comments and all("--" not in c and "${" not in c for c in comments)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -285,3 +332,40 @@ def test_home_keyframe_is_robot_home_within_narrowed_limits(tmp_path):
     assert m.key(0).name == "home"
     assert np.allclose(m.key_qpos[0], EXPECTED, atol=1e-11) and np.allclose(m.key_ctrl[0], EXPECTED, atol=1e-11)
     assert np.allclose(m.jnt_range[1], np.radians([10.0, 90.0]), atol=1e-11)
+
+
+def _library(tmp_path: Path, **replace) -> Path:
+    text = (ROOT / "libraries" / "mark2.yaml").read_text(encoding="utf-8")
+    for old, new in replace.items():
+        text = re.sub(old, lambda _m, new=new: new, text, count=1, flags=re.M)
+    return write(tmp_path, text, "lib.yaml")
+
+
+def test_a_number_mujoco_cannot_hold_is_a_diagnostic_not_inf(tmp_path):
+    """A peak torque near the float limit made kp = inf in the MJCF; now compile refuses, at the
+    robot's library statement, and writes nothing."""
+    from click.testing import CliRunner
+
+    from modc.cli import app
+
+    _library(tmp_path, **{r"torque_peak: 30\.5.*$": "torque_peak: 1e307"})
+    mod = write(tmp_path, 'robot a {\n  library "lib.yaml"\n  chain H1 - H4(pivot=-90deg) - L3(port=45deg)\n}\n')
+    res = CliRunner().invoke(app, ["compile", str(mod), "-o", str(tmp_path / "out")])
+    assert res.exit_code == 1, res.output
+    assert "error[not-finite]" in res.output and "kp = peak torque" in res.output and ":2:3:" in res.output
+    assert "inf" not in res.output.replace("infinite", "") and "Traceback" not in res.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_library_name_goes_through_the_comment_sanitiser(tmp_path):
+    _library(tmp_path, **{r"^name: mark2.*$": "name: evil--x-"})  # a valid label that would end an XML comment
+    mod = write(tmp_path, 'robot a {\n  library "lib.yaml"\n  chain H1 - L3\n}\n')
+    checked = check_file(mod)
+    assert checked.ok, [d.message for d in checked.diagnostics]
+    files = build(checked, ["mjcf"])
+    for rel in ("mjcf/mod2_a.xml", "mjcf/scene_mod2_a.xml"):
+        text = files[rel]
+        assert ET.fromstring(text).tag == "mujoco"
+        comments = re.findall(r"<!--(.*?)-->", text, flags=re.S)
+        assert comments and all("--" not in c and not c.endswith("-") for c in comments), rel
+    assert "(library evil- -x- )" in files["mjcf/mod2_a.xml"]

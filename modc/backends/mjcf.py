@@ -1,18 +1,28 @@
-"""MJCF backend: mjcf/mod<n>_<name>.xml per robot (SPEC section 5), a MuJoCo model of the arm in
-its cell, made from the same description as the URDF (physical.assembly), never from URDF text.
+"""MJCF backend: mjcf/mod<n>_<name>.xml per robot (SPEC section 5), a MuJoCo model of the arm, and
+mjcf/scene_mod<n>_<name>.xml, the arm in its cell, both made from the same description as the URDF
+(physical.assembly), never from URDF text.
 
     bodies      base_link (welded to the world at `base`), link_1 … link_n with hinge joints
                 joint_1 … joint_n about z, then tool0 and payload welded on: one body per URDF
                 link, with the URDF's inertial (mass, centre of mass, full inertia tensor)
-    geoms       the parts' STL meshes (../meshes/, as the URDF), for sight and for contact:
-                the same collision geometry the SRDF's matrix was computed on (MuJoCo, like
-                PyBullet, collides their convex hulls)
+    defaults    MuJoCo Menagerie's layout: a class named after the file (childclass of base_link:
+                hinge axis z, no damping, ARMATURE) holding "visual" (mesh geoms, contype =
+                conaffinity = 0, group 2: seen, never touched), "collision" (group 3) and one
+                servo class per actuator variant ("servo_H": kp, kv, force limit)
+    visual      the parts' STL meshes (../meshes/, as the URDF), in their URDF material colours
+    collision   the primitives the meshes are made of (physical.parts: cylinders, boxes; a tube
+                as the solid cylinder it closes, its bore holds the actuator), each a convex
+                MuJoCo primitive: a U-shaped twist bracket collides as its plate and two cheeks,
+                not as the solid block of its mesh's convex hull
     tool0       a site at the origin of body tool0
-    cell        each obstacle a world geom named as in the file; each target a site
-                target_<name> (a target may be called tool0); both carried into the world
-                through `base`, like `modc sim`
+    scene       mjcf/scene_<stem>.xml includes this file and adds floor, light, skybox, a named
+                camera, the cell's obstacles and the targets (mjcf_scene.py); this file alone is
+                the robot, as Menagerie ships it, and loads by itself
     keyframes   home (Robot.home) first, then every other named pose; ctrl = qpos, so a
                 keyframe is held
+    numbers     every number written is finite: a library value that makes one infinite (a
+                peak torque near the float limit gives kp = inf) is a not-finite diagnostic at
+                the robot's `library` statement, and nothing is written
     contact     <exclude> for every pair the SRDF disables (physical.collisions, the same cached
                 computation the SRDF backend uses)
     actuators   one position servo per joint, force-limited to the actuator's peak torque
@@ -30,16 +40,18 @@ stable at the 1 ms step; neither changes a torque at rest.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .. import __version__
 from ..kinematics import matrix_rpy, transform
 from ..model import Robot
 from ..physical.assembly import Description
-from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
+from ..physical.parts import Primitive
 from ..physical.statics import G
 from . import Build, register
-from .format import num, vec
+from . import format as fmt
 from .srdf import collision_matrix
 from .templates import comment, render
 from .urdf import MATERIALS
@@ -49,6 +61,22 @@ ERROR_AT_PEAK = 0.005  # rad of position error at which a servo reaches the actu
 ARMATURE = 1e-3  # kg·m², reflected rotor inertia per joint (numerical regularisation, see above)
 TOOL_SITE_RADIUS = 0.005  # m
 TARGET_PREFIX = "target_"
+SCENE_PREFIX = "scene_"
+VISUAL_GROUP, COLLISION_GROUP = 2, 3  # Menagerie's: the viewer shows 0-2, hides 3
+
+
+class NotFinite(ValueError):
+    """A number that cannot be written into the MJCF (inf or nan)."""
+
+
+def num(x: float) -> str:
+    if not math.isfinite(float(x)):
+        raise NotFinite
+    return fmt.num(x)
+
+
+def vec(xs) -> str:
+    return " ".join(num(x) for x in xs)
 
 
 def derivative_time(robot: Robot) -> float:
@@ -67,10 +95,10 @@ def gains(robot: Robot, torque_peak: float) -> tuple[float, float]:
 
 def mesh_name(stem: str, scale_x: float) -> str:
     """Link bars share one unit-length STL; MuJoCo scales per mesh asset, so one asset per length."""
-    return stem if scale_x == 1.0 else f"{stem}_{num(scale_x * 1000.0)}mm"
+    return stem if scale_x == 1.0 else f"{stem}_{fmt.num(scale_x * 1000.0)}mm"
 
 
-def _placement(T) -> dict:
+def placement(T) -> dict:
     return {"pos": vec(T[:3, 3]), "euler": vec(matrix_rpy(T[:3, :3]))}
 
 
@@ -80,6 +108,18 @@ def _inertial(link) -> dict | None:
     inertia = link.inertial.inertia  # MuJoCo's order: ixx iyy izz ixy ixz iyz
     return {"pos": vec(link.inertial.com), "mass": num(link.inertial.mass),
             "fullinertia": vec(inertia[i, j] for i, j in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)))}
+
+
+def collision_geom(p: Primitive, T_link_part) -> dict:
+    """A part's primitive as a MuJoCo primitive in the link frame (cylinders along their z)."""
+    T = np.eye(4)
+    T[:3, :3] = np.asarray(p.rotation)
+    T[:3, 3] = p.center
+    T = np.asarray(T_link_part) @ T
+    if p.shape == "box":
+        return {"type": "box", "size": vec(v / 2.0 for v in p.dims), **placement(T)}
+    radius, height = (p.dims[1], p.dims[2]) if p.shape == "tube" else p.dims  # a tube closed: its bore is filled
+    return {"type": "cylinder", "size": vec((radius, height / 2.0)), **placement(T)}
 
 
 def _bodies(desc: Description, robot: Robot) -> list[dict]:
@@ -94,13 +134,14 @@ def _bodies(desc: Description, robot: Robot) -> list[dict]:
         hinge = None
         if joint is not None and joint.kind == "revolute":
             assert joint.limits is not None
-            hinge = {"name": joint.name, "range": vec((joint.limits.lower, joint.limits.upper)),
-                     "armature": num(ARMATURE)}
+            hinge = {"name": joint.name, "range": vec((joint.limits.lower, joint.limits.upper))}
         return {
-            "name": name, **_placement(T), "indent": "  " * (depth + 2), "joint": hinge,
+            "name": name, **placement(T), "indent": "  " * (depth + 2), "joint": hinge,
+            "childclass": robot.file_stem if depth == 0 else None,
             "inertial": _inertial(link),
             "geoms": [{"mesh": mesh_name(v.part.mesh, v.part.scale_x), "material": v.part.color,
-                       **_placement(v.T_link_part)} for v in link.visuals],
+                       **placement(v.T_link_part)} for v in link.visuals],
+            "collisions": [collision_geom(p, v.T_link_part) for v in link.visuals for p in v.part.primitives],
             "sites": [{"name": "tool0", "size": num(TOOL_SITE_RADIUS)}] if name == "tool0" else [],
             "children": [body(j.child, j.T_parent_child, j, depth + 1) for j in by_parent.get(name, [])],
         }
@@ -118,50 +159,83 @@ def _assets(desc: Description) -> list[dict]:
     return [seen[k] for k in sorted(seen)]
 
 
-def _cell(robot: Robot) -> tuple[list[dict], list[dict]]:
-    """Obstacles (world geoms) and targets (world sites), given in base_link, placed in the world."""
-    T_world_base = transform(robot.base.xyz, robot.base.rpy)
-    geoms = []
-    for ob in robot.obstacles:
-        T = T_world_base @ transform(ob.origin.xyz, ob.origin.rpy)
-        size = {"box": lambda s: [v / 2.0 for v in s], "sphere": lambda s: [s[0]],
-                "cylinder": lambda s: [s[0], s[1] / 2.0]}[ob.shape](ob.size)
-        geoms.append({"name": ob.name, "type": ob.shape, "size": vec(size), **_placement(T)})
-    sites = [{"name": TARGET_PREFIX + t.name, "pos": vec((T_world_base @ np.array([*t.xyz, 1.0]))[:3]),
-              "size": num(TARGET_RADIUS)} for t in robot.targets]
-    return geoms, sites
+def _servos(robot: Robot, joints) -> tuple[list[dict], list[dict]]:
+    """(servo classes, one per actuator variant; actuators, one per joint). A joint whose peak
+    torque differs from its variant's class carries its own gains."""
+    classes: dict[str, dict] = {}
+    actuators = []
+    for j in joints:
+        assert j.limits is not None
+        gain = _gains_text(robot, j)
+        cls = classes.setdefault(j.variant, {"name": f"servo_{j.variant}", **gain})
+        own = {k: v for k, v in gain.items() if cls[k] != v}
+        actuators.append({"name": j.name, "joint": j.name, "class": cls["name"], "own": own,
+                          "ctrlrange": vec((j.limits.lower, j.limits.upper))})
+    return list(classes.values()), actuators
+
+
+def _gains_text(robot: Robot, j) -> dict:
+    kp, kv = gains(robot, j.limits.effort)
+    try:
+        return {"kp": num(kp), "kv": num(kv), "forcerange": vec((-j.limits.effort, j.limits.effort))}
+    except NotFinite:
+        raise NotFinite(f"the MuJoCo servo gain of {j.name} (kp = peak torque {j.limits.effort:.3g} N·m / "
+                        f"{ERROR_AT_PEAK:g} rad, kv = kp · d/p)") from None
 
 
 def context(build: Build, robot: Robot) -> dict:
     desc = build.description(robot)
     joints = [j for j in desc.joints if j.kind == "revolute"]
-    actuators = []
-    for j in joints:
-        assert j.limits is not None
-        kp, kv = gains(robot, j.limits.effort)
-        actuators.append({"name": j.name, "joint": j.name, "kp": num(kp), "kv": num(kv),
-                          "forcerange": vec((-j.limits.effort, j.limits.effort)),
-                          "ctrlrange": vec((j.limits.lower, j.limits.upper))})
+    servo_classes, actuators = _servos(robot, joints)
     poses = [("home", robot.home())] + [(p.name, p.q) for p in robot.poses if p.name != "home"]
-    obstacles, targets = _cell(robot)
     return {
-        "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
-        "library": robot.library.name if robot.library else "", "version": __version__,
-        "timestep": num(TIME_STEP), "gravity": vec(G),
-        "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()]
-        + [{"name": "obstacle", "rgba": vec(OBSTACLE_RGBA)}, {"name": "target", "rgba": vec(TARGET_RGBA)}],
-        "meshes": _assets(desc), "bodies": _bodies(desc, robot), "obstacles": obstacles, "targets": targets,
+        "name": robot.file_stem, "robot": comment(robot.name), "sequence": comment(robot.sequence),
+        "source": comment(build.source_name), "library": comment(robot.library.name if robot.library else ""),
+        "version": __version__, "timestep": num(TIME_STEP), "gravity": vec(G),
+        "armature": num(ARMATURE), "visual_group": VISUAL_GROUP, "collision_group": COLLISION_GROUP,
+        "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()],
+        "meshes": _assets(desc), "bodies": _bodies(desc, robot),
         "excludes": [{"body1": p.link1, "body2": p.link2} for p in collision_matrix(build, robot).disabled],
-        "actuators": actuators,
+        "servo_classes": servo_classes, "actuators": actuators,
         "keys": [{"name": n, "qpos": vec(q)} for n, q in poses],
         "derivative_time": num(derivative_time(robot)), "error_at_peak": num(ERROR_AT_PEAK),
     }
 
 
 def mjcf_text(build: Build, robot: Robot) -> str:
-    return render("mjcf/robot.xml.j2", context(build, robot))
+    return render("mjcf/robot.xml.j2", _finite(robot, lambda: context(build, robot)))
 
 
-@register("mjcf", "MuJoCo model per robot (tool0 site, cell, keyframes, servos): mjcf/mod<n>_<name>.xml", heavy=True)
+def scene_name(robot: Robot) -> str:
+    return f"{SCENE_PREFIX}{robot.file_stem}.xml"
+
+
+def scene_text(build: Build, robot: Robot) -> str:
+    from .mjcf_scene import scene_context
+
+    return render("mjcf/scene.xml.j2", _finite(robot, lambda: scene_context(build, robot)))
+
+
+def _finite(robot: Robot, make):
+    """make(), or a not-finite diagnostic (at the robot's `library` statement, where the number
+    comes from, else at the robot) when a number of the model is infinite or not a number."""
+    from ..compiler import InputError
+    from ..diagnostics import NOWHERE, codes
+
+    try:
+        return make()
+    except NotFinite as e:
+        what = str(e) or f"every number of robot {robot.name}'s MuJoCo model"
+        span = robot.library_span if robot.library_span != NOWHERE else robot.span
+        raise InputError(codes.NOT_FINITE.at(span, what=what)) from None
+
+
+@register("mjcf", "MuJoCo model per robot (tool0 site, keyframes, servos; visual and collision geoms) and its "
+                  "scene (floor, light, camera, cell, targets): mjcf/mod<n>_<name>.xml, mjcf/scene_mod<n>_<name>.xml",
+          heavy=True)
 def emit(build: Build):
-    return {f"mjcf/{r.file_stem}.xml": mjcf_text(build, r) for r in build.design.robots}
+    files = {}
+    for r in build.design.robots:
+        files[f"mjcf/{r.file_stem}.xml"] = mjcf_text(build, r)
+        files[f"mjcf/{scene_name(r)}"] = scene_text(build, r)
+    return files

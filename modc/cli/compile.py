@@ -95,7 +95,12 @@ def compile_cmd(
             _err(f"modc: smoke test failed; nothing written to {out}")
             raise SystemExit(EXIT_ERRORS)
     ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
-    files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
+    try:
+        files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
+    except InputError as e:  # a backend refuses a value it cannot write (mjcf: not-finite)
+        _print_diagnostics([e.diagnostic], checked.sources)
+        _err(f"modc: nothing written to {out}")
+        raise SystemExit(EXIT_ERRORS) from None
     with usage_errors("compile", writing=out):
         write_tree(files, out, force=force, inputs=inputs)
     if verbose:

@@ -88,13 +88,16 @@ def render_cmd(
 @app.command("play")
 @argument("file", help=".mod file (or its YAML form)")
 @click.option("--traj", required=True, help="trajectory JSON, as `modc plan --json` prints")
-@click.option("--record", help="write a GIF of the motion (headless TinyRenderer)")
+@click.option("--record", help="write a GIF of the motion (headless: TinyRenderer, or MuJoCo's offscreen renderer)")
 @click.option("--robot", help="the robot the trajectory is for (files with several robots)")
 @click.option("--headless", is_flag=True, help="never open the PyBullet GUI")
+@click.option("--engine", default="pybullet",
+              help="pybullet (the URDF) or mujoco (the MJCF scene, servos with inverse-dynamics feed-forward)")
 @library_option
-def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headless: bool, library: str | None) -> None:
-    """Play a trajectory in PyBullet: in the GUI when a display works, else headless; report
-    tracking and collisions; --record OUT.gif."""
+def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headless: bool, engine: str,
+             library: str | None) -> None:
+    """Play a trajectory in PyBullet (in the GUI when a display works, else headless) or MuJoCo
+    (--engine mujoco); report tracking error (max per joint) and collisions; --record OUT.gif."""
     from ..sim.play import play
     from ..sim.scene import UsageError
 
@@ -104,7 +107,7 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
 
             check_output_file(record, inputs_of(file, library, more=[traj]), "--record", "motion.gif")
         ok, lines, checked = play(
-            file, traj, record=record, robot=robot, library=library, gui=False if headless else None
+            file, traj, record=record, robot=robot, library=library, gui=False if headless else None, engine=engine
         )
     _print_diagnostics(checked.diagnostics, checked.sources)
     if not ok:

@@ -1,5 +1,6 @@
 """`modc sim FILE --engine mujoco`: the smoke test of smoke.py, measured in MuJoCo on the compiled
-MJCF (backends/mjcf.py: exactly what `modc FILE -o OUT` writes as mjcf/*.xml, with its meshes).
+MJCF scene (backends/mjcf.py: exactly what `modc FILE -o OUT` writes as mjcf/scene_*.xml, which
+includes the robot's mjcf/*.xml, with its meshes).
 
 The checks and messages are verdict.py's, as for PyBullet; what differs is the measuring:
 
@@ -8,12 +9,14 @@ The checks and messages are verdict.py's, as for PyBullet; what differs is the m
   per pose  home, then every other named pose:
     FK          the tool0 site in base_link against modc.kinematics to FK_TOL: MuJoCo computes in
                 double precision, so 1e-9 as the URDF's consumers (SPEC section 7), not PyBullet's 1e-6.
-    self        signed distances between the geoms of link pairs (mj_geomDistance on the meshes'
-                convex hulls, as PyBullet), pairs adjacent (contacts.py's rule) or allowed by an
-                SRDF skipped, deeper than CONTACT_TOL. The MJCF excludes every SRDF pair from
-                MuJoCo's own contacts, "Never" pairs too; the check asks the geometry directly, so a
-                pose that brings a "Never" pair into contact is still reported.
-    environment every arm geom against every obstacle geom, the same way.
+    self        signed distances between the collision geoms of link pairs (mj_geomDistance on
+                the parts' primitives; the visual meshes never collide), pairs adjacent
+                (contacts.py's rule) or allowed by an SRDF skipped, deeper than CONTACT_TOL. The
+                MJCF excludes every SRDF pair from MuJoCo's own contacts, "Never" pairs too; the
+                check asks the geometry directly, so a pose that brings a "Never" pair into
+                contact is still reported.
+    environment every arm collision geom against every obstacle geom (the file's obstacles: the
+                scene's floor is not one), the same way.
     hold        ctrl = the pose, the arm resting there; contacts switched off (obstacles are checked
                 geometrically, as in PyBullet), HOLD_TIME at the model's 1 ms step with its servos
                 (kp, kv and the peak-torque force limit of the MJCF). Tracking, divergence and the
@@ -35,6 +38,22 @@ FK_TOL = (1e-9, 1e-9)  # m, rotation-matrix entries
 ENGINE = "MuJoCo"
 
 
+def import_mujoco():
+    """mujoco, with an offscreen GL chosen before its first import when there is no display (its
+    GL platform is fixed when the module loads): EGL, which Debian's libegl1 provides."""
+    import os
+    import sys
+
+    if "mujoco" not in sys.modules and not os.environ.get("MUJOCO_GL"):
+        from .scene import display_available
+
+        if not display_available():
+            os.environ["MUJOCO_GL"] = "egl"
+    import mujoco
+
+    return mujoco
+
+
 @dataclass
 class MujocoScene(CollisionQueries):
     """A loaded MJCF: body names play the URDF links' part in contacts.py's adjacency rule."""
@@ -48,9 +67,12 @@ class MujocoScene(CollisionQueries):
     obstacles: dict[str, int] = field(default_factory=dict)  # obstacle geom name -> geom id
 
     def geoms(self, body: str) -> list[int]:
+        """The body's collision geoms (visual geoms have contype = conaffinity = 0)."""
         import numpy as np
 
-        return [int(g) for g in np.flatnonzero(self.model.geom_bodyid == self.links[body])]
+        m = self.model
+        colliding = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+        return [int(g) for g in np.flatnonzero((m.geom_bodyid == self.links[body]) & colliding)]
 
     def _distance(self, g1: list[int], g2: list[int]) -> float:
         import mujoco
@@ -95,17 +117,26 @@ class MujocoScene(CollisionQueries):
         return np.linalg.inv(pose(base.xpos, base.xmat)) @ pose(tool.xpos, tool.xmat)
 
 
-def load(robot, xml: Path) -> MujocoScene:
-    """Load the MJCF (ValueError when MuJoCo rejects it)."""
-    import mujoco
+def scene_path(robot, xml: Path) -> Path:
+    """The scene file beside the robot's MJCF."""
+    from ..backends.mjcf import scene_name
 
-    m = mujoco.MjModel.from_xml_path(str(xml))
+    return xml.parent / scene_name(robot)
+
+
+def load(robot, xml: Path) -> MujocoScene:
+    """Load the robot's MJCF scene (ValueError when MuJoCo rejects it); xml: the robot file."""
+    mujoco = import_mujoco()
+
+    m = mujoco.MjModel.from_xml_path(str(scene_path(robot, xml)))
     d = mujoco.MjData(m)
     names = {i: m.body(i).name for i in range(1, m.nbody)}
     links = {n: i for i, n in names.items()}
     parents = {n: (names.get(int(m.body_parentid[i])) or "world") for i, n in names.items() if m.body_parentid[i] != 0}
-    geometry_links = [n for n, i in links.items() if int(m.body_geomnum[i]) > 0]
-    obstacles = {m.geom(g).name: g for g in range(m.ngeom) if m.geom_bodyid[g] == 0}
+    colliding = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+    geometry_links = [n for n, i in links.items() if bool((colliding & (m.geom_bodyid == i)).any())]
+    cell = {ob.name for ob in robot.obstacles}
+    obstacles = {m.geom(g).name: g for g in range(m.ngeom) if m.geom_bodyid[g] == 0 and m.geom(g).name in cell}
     return MujocoScene(m, d, links, parents, geometry_links, [f"joint_{i}" for i in range(1, robot.dof + 1)], obstacles)
 
 
@@ -193,4 +224,4 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
         return [simulate_robot(r, xmls[r.name], allowed_from_srdf(out_dir, r), hold_time) for r in robots]
 
 
-__all__ = ["ENGINE", "FK_TOL", "MujocoScene", "load", "simulate", "simulate_robot"]
+__all__ = ["ENGINE", "FK_TOL", "MujocoScene", "import_mujoco", "load", "simulate", "simulate_robot"]

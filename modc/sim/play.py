@@ -71,9 +71,16 @@ def save_gif(frames, out: str | Path, fps: float = FPS) -> None:
                 disposal=1)
 
 
+ENGINES = ("pybullet", "mujoco")
+
+
 def play(path, traj_json, record=None, robot: str | None = None, library: str | None = None, gui: bool | None = None,
-         fps: float = FPS, size: tuple[int, int] = GIF_SIZE, azimuth: float | None = None):
+         fps: float = FPS, size: tuple[int, int] | None = None, azimuth: float | None = None, engine: str = "pybullet"):
     """`modc play`. Returns (ok, report lines, checked).
+
+    engine: "pybullet" (this module, on the URDF) or "mujoco" (mujoco_play.py, on the MJCF scene,
+    with inverse-dynamics feed-forward; always headless). size: the GIF's, default GIF_SIZE or
+    mujoco_play.GIF_SIZE.
 
     ok is False when the file has errors (see checked.diagnostics; lines empty) or the trajectory
     does not fit (lines: one error each, "TRAJ.json: points[3].t: …"); nothing is played then.
@@ -81,12 +88,17 @@ def play(path, traj_json, record=None, robot: str | None = None, library: str | 
     Raises modc.compiler.InputError (unreadable .mod), scene.UsageError (unreadable trajectory),
     modc.model.select.RobotChoiceError (unknown or ambiguous robot) and OSError (cannot write the GIF).
     """
+    if engine not in ENGINES:
+        raise scene.UsageError(f"unknown engine '{engine}' (choose from {', '.join(ENGINES)})")
     checked = scene.load_checked(path, library)
     if not checked.ok:
         return False, [], checked
     r, traj, errors = _trajectory_for(checked, traj_json, robot)
     if errors:
         return False, [f"{traj_json}: {e}" for e in errors], checked
+    if engine == "mujoco":
+        return True, _play_mujoco(checked, r, traj, record, fps, size), checked
+    size = size or GIF_SIZE
     want_gui = scene.display_available() if gui is None else gui
     with scene.compiled(checked) as urdfs, scene.connect(gui=want_gui) as client:
         client.setTimeStep(TIME_STEP)
@@ -101,6 +113,18 @@ def play(path, traj_json, record=None, robot: str | None = None, library: str | 
         save_gif(run.frames, record, fps)
         lines.append(f"  wrote {record}: {len(run.frames)} frames at {fps:g} fps, {size[0]}x{size[1]}")
     return True, lines, checked
+
+
+def _play_mujoco(checked, r, traj, record, fps: float, size) -> list[str]:
+    from . import mujoco_play
+
+    run = mujoco_play.play_in_mujoco(checked, r, traj, record, fps, size, HOLD_AFTER, CHECK_HZ)
+    lines = mujoco_play.report_lines(r, traj, run, TIME_STEP, HOLD_AFTER) + _contact_lines(run)
+    if record is not None:
+        save_gif(run.frames, record, fps)
+        w, h = run.frames[0].size
+        lines.append(f"  wrote {record}: {len(run.frames)} frames at {fps:g} fps, {w}x{h}")
+    return lines
 
 
 def _trajectory_for(checked, traj_json, robot: str | None):
@@ -198,12 +222,14 @@ def _report(r, traj, run: _Run) -> list[str]:
              f"simulated at {1 / TIME_STEP:.0f} Hz {run.mode}",
              f"  worst tracking error {run.worst[j]:.2g} rad (joint_{j + 1}) during the motion, "
              f"{run.final.max():.1g} rad after {HOLD_AFTER:g} s at the last point"]
-    if run.contacts:
-        for (a, b), (t_first, depth) in sorted(run.contacts.items(), key=lambda kv: kv[1][0]):
-            what = f"obstacle {b}" if b in run.obstacles else b
-            lines.append(
-                f"  warning: {a} collides with {what} from t = {t_first:.2f} s ({depth * 1000:.1f} mm deep at most)"
-            )
-    else:
-        lines.append("  no collisions (between links, or with the environment)")
-    return lines
+    return lines + _contact_lines(run)
+
+
+def _contact_lines(run) -> list[str]:
+    """The contacts seen while playing (either engine's run: contacts, obstacles)."""
+    lines = []
+    for (a, b), (t_first, depth) in sorted(run.contacts.items(), key=lambda kv: kv[1][0]):
+        what = f"obstacle {b}" if b in run.obstacles else b
+        lines.append(f"  warning: {a} collides with {what} from t = {t_first:.2f} s "
+                     f"({depth * 1000:.1f} mm deep at most)")
+    return lines or ["  no collisions (between links, or with the environment)"]

@@ -27,14 +27,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import scene
+from .camera import FILL, Camera, fit_camera, vec3
 
 if TYPE_CHECKING:
     import numpy as np
 
 WIDTH, HEIGHT = 800, 600
 SUPERSAMPLE = 2
-FOV = 35.0  # degrees, vertical
-FILL = 0.9  # the scene's box fits inside this share of the frame
 GRID = 0.1  # m, ground grid spacing
 GRID_LINE = 0.004  # m, width of a grid line
 GROUND_RGB = (236, 238, 240)
@@ -49,76 +48,6 @@ AXIS_LENGTH, AXIS_RADIUS = 0.06, 0.003  # m, the tool0 triad
 AXIS_RGBA = ((0.85, 0.1, 0.1, 1.0), (0.1, 0.7, 0.1, 1.0), (0.1, 0.25, 0.9, 1.0))
 LIGHT = dict(lightDirection=[-0.4, -0.6, 1.0], lightColor=[1.0, 1.0, 1.0], lightDistance=4.0,
              lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.08)
-
-
-def _vec3(v) -> tuple[float, float, float]:
-    return float(v[0]), float(v[1]), float(v[2])
-
-
-@dataclass
-class Camera:
-    eye: tuple[float, float, float]
-    target: tuple[float, float, float]
-    up: tuple[float, float, float]
-    fov: float
-    aspect: float
-    near: float
-    far: float
-    azimuth: float
-    elevation: float
-
-    def matrices(self, client):
-        view = client.computeViewMatrix(self.eye, self.target, self.up)
-        proj = client.computeProjectionMatrixFOV(self.fov, self.aspect, self.near, self.far)
-        return view, proj
-
-
-def _basis(azimuth: float, elevation: float):
-    """Unit vectors: d from the target towards the eye, right, up (camera frame in the world)."""
-    import numpy as np
-
-    az, el = math.radians(azimuth), math.radians(elevation)
-    d = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
-    right = np.cross([0.0, 0.0, 1.0], d)
-    right /= np.linalg.norm(right)
-    up = np.cross(d, right)
-    return d, right, up
-
-
-def fit_camera(points, azimuth: float, elevation: float, aspect: float, fov: float = FOV, fill: float = FILL) -> Camera:
-    """The closest camera at this azimuth and elevation that sees every point inside `fill` of
-    the frame, aimed so that the points' projection is centred."""
-    import numpy as np
-
-    pts = np.asarray(points, dtype=float)
-    d, right, up = _basis(azimuth, elevation)
-    ty = math.tan(math.radians(fov) / 2.0) * fill
-    tx = ty * aspect
-    target = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
-    radius = float(np.linalg.norm(pts - target, axis=1).max()) or 0.1
-    dist = radius / math.sin(math.radians(fov) / 2.0)
-    for _ in range(4):  # each round: centre the projection, then the smallest distance that fits
-        rel = pts - target
-        x, y, z = rel @ right, rel @ up, rel @ d  # z towards the eye
-        # a point fits when |x| <= tx (dist - z) and |y| <= ty (dist - z): dist >= z + |x|/tx
-        dist = float(max(np.max(z + np.abs(x) / tx), np.max(z + np.abs(y) / ty)))
-        depth = dist - z
-        u, v = x / depth, y / depth  # normalised screen coordinates (times the tangents)
-        du = (u.max() + u.min()) / 2.0
-        dv = (v.max() + v.min()) / 2.0
-        if abs(du) < 1e-4 and abs(dv) < 1e-4:
-            break
-        # shift the target across the view so that the projection's centre moves to the middle
-        mean_depth = float(np.median(depth))
-        target = target + right * du * mean_depth + up * dv * mean_depth
-    rel = pts - target
-    z = rel @ d
-    dist = float(max(np.max(z + np.abs(rel @ right) / tx), np.max(z + np.abs(rel @ up) / ty)))
-    eye = target + d * dist
-    span = float(np.linalg.norm(pts - eye, axis=1).max())
-    near = max(0.01, float((dist - (rel @ d).max()) * 0.5))
-    return Camera(_vec3(eye), _vec3(target), _vec3(up), fov, aspect,
-                  near, span * 3.0 + 1.0, azimuth, elevation)
 
 
 @dataclass
@@ -342,7 +271,7 @@ class Stage:
             target = target + shift
             dist *= scale
             eye = target - fwd * dist
-            cam = Camera(_vec3(eye), _vec3(target), cam.up, cam.fov, cam.aspect,
+            cam = Camera(vec3(eye), vec3(target), cam.up, cam.fov, cam.aspect,
                          max(0.01, cam.near * scale), cam.far, cam.azimuth, cam.elevation)
             if abs(scale - 1.0) < 0.02 and abs(u0 + u1) < 0.02 and abs(v0 + v1) < 0.02:
                 break
