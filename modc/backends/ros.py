@@ -34,13 +34,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .. import __version__
+from .._version import __version__
 from ..kinematics import rpy_matrix
 from ..physical.assembly import kdl_root
-from . import Build, register
-from . import srdf as srdf_backend
-from . import urdf as urdf_backend
+from .build import Build
+from .common import BASE_LINK, GROUP, urdf_context
 from .format import num
+from .registry import register
 from .ros_target import IK_PLUGINS, Target, resolve
 from .templates import comment, render, scene_token
 
@@ -206,9 +206,9 @@ def context(build: Build, robot, target: Target) -> dict:
         "sequence": robot.sequence,
         "dof": robot.dof,
         "library": comment(robot.library.name),
-        "group": srdf_backend.GROUP,
+        "group": GROUP,
         "virtual_parent": VIRTUAL_JOINT_PARENT,
-        "virtual_child": srdf_backend.BASE_LINK,
+        "virtual_child": BASE_LINK,
         "controller": ARM_CONTROLLER,
         "joint_state_controller": JOINT_STATE_CONTROLLER,
         "joint_state_broadcaster": JOINT_STATE_BROADCASTER,
@@ -330,7 +330,7 @@ def robot_outputs(build: Build, robot, target: Target) -> dict[str, str]:
     # inertia-free root for KDL (base_link's mass on base_link_inertia)
     desc = kdl_root(build.description(robot))
     mesh_prefix = f"package://{target.package}/meshes/"
-    out = {f["description"]: render("urdf.xml.j2", urdf_backend.context(desc, robot, build.source_name, mesh_prefix))}
+    out = {f["description"]: render("urdf.xml.j2", urdf_context(desc, robot, build.source_name, mesh_prefix))}
     if target.ros == 2:
         out[f["urdf_xacro"]] = render("ros/ros2/robot.urdf.xacro.j2", ctx)
         out[f["ros2_control"]] = render("ros/ros2/ros2_control.xacro.j2", ctx)
@@ -356,6 +356,7 @@ def emit_package(build: Build) -> dict[str, str]:
     return dict(sorted(out.items()))
 
 
-@register("ros", "ROS package: the MoveIt Setup Assistant's layout for ROS 2 (or ROS 1), package.xml, launch files")
+@register("ros", "ROS package: the MoveIt Setup Assistant's layout for ROS 2 (or ROS 1), package.xml, launch files",
+          reads=("mjcf",))
 def emit(build: Build):
     return emit_package(build)
