@@ -41,14 +41,12 @@ from .build import Build
 from .common import BASE_LINK, GROUP, urdf_context
 from .format import num
 from .registry import register
-from .ros_target import IK_PLUGINS, Target, resolve
+from .ros_target import IK_PLUGINS, PLACEHOLDER_LICENSE, PLACEHOLDER_MAINTAINER, Target, resolve
 from .templates import comment, render, scene_token
 
 # --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
 
 PACKAGE_VERSION = "0.1.0"
-PACKAGE_LICENSE = "BSD-3-Clause"  # what MoveIt Setup Assistant writes; the generated package is the user's
-MAINTAINER = ("modc user", "user@example.com")  # placeholder: edit package.xml before releasing
 
 # The SRDF backend's planning group and virtual joint (world -> base_link, templates/srdf.xml.j2)
 VIRTUAL_JOINT_PARENT = "world"
@@ -238,9 +236,13 @@ def context(build: Build, robot, target: Target) -> dict:
         "scene": _scene(robot),
         "files": robot_files(robot.file_stem),
         "package_version": PACKAGE_VERSION,
-        "license": PACKAGE_LICENSE,
-        "maintainer": MAINTAINER[0],
-        "maintainer_email": MAINTAINER[1],
+        "license": target.license,
+        "maintainer": target.maintainer[0],
+        "maintainer_email": target.maintainer[1],
+        # package.xml names the placeholders (an XML comment: the option names without their dashes)
+        "placeholders": [flag for flag, placeholder in (("package-license", target.license == PLACEHOLDER_LICENSE),
+                                                        ("maintainer", target.maintainer == PLACEHOLDER_MAINTAINER))
+                         if placeholder],
         "robots": ", ".join(f"{r.name} = {r.sequence}" for r in build.design.robots),
         "depends": exec_depends(target),
         # mjcf/ when that backend is in this build (it runs before this one)
