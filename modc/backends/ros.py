@@ -239,10 +239,7 @@ def context(build: Build, robot, target: Target) -> dict:
         "license": target.license,
         "maintainer": target.maintainer[0],
         "maintainer_email": target.maintainer[1],
-        # package.xml names the placeholders (an XML comment: the option names without their dashes)
-        "placeholders": [flag for flag, placeholder in (("package-license", target.license == PLACEHOLDER_LICENSE),
-                                                        ("maintainer", target.maintainer == PLACEHOLDER_MAINTAINER))
-                         if placeholder],
+        "placeholder_note": _placeholder_note(target),
         "robots": ", ".join(f"{r.name} = {r.sequence}" for r in build.design.robots),
         "depends": exec_depends(target),
         # mjcf/ when that backend is in this build (it runs before this one)
@@ -254,6 +251,20 @@ def context(build: Build, robot, target: Target) -> dict:
             "urdf",
         ],
     }
+
+
+def _placeholder_note(target: Target) -> str | None:
+    """package.xml's comment naming what is still a placeholder and the option that sets it (an XML
+    comment cannot hold the options' leading dashes)."""
+    left = [(what, option) for what, option, placeholder in (
+        ("license", "package-license", target.license == PLACEHOLDER_LICENSE),
+        ("maintainer", "maintainer", target.maintainer == PLACEHOLDER_MAINTAINER)) if placeholder]
+    if not left:
+        return None
+    if len(left) == 1:
+        return f"TODO: the {left[0][0]} below is a placeholder; set it with the modc option {left[0][1]}"
+    return ("TODO: the license and maintainer below are placeholders; "
+            "set them with the modc options package-license and maintainer")
 
 
 # --- package.xml: what the package runs, per ROS version (every one released in the target distro)
