@@ -124,7 +124,8 @@ def _object(name: str, schema: dict) -> list[str]:
     required = set(schema.get("required", []))
     lines.append("| key | type | required | meaning |\n|---|---|---|---|\n")
     for key, prop in schema.get("properties", {}).items():
-        lines.append(f"| `{key}` | {_type(prop)} | {'yes' if key in required else ''} | {_cell(_description(prop))} |\n")
+        needed = "yes" if key in required else ""
+        lines.append(f"| `{key}` | {_type(prop)} | {needed} | {_cell(_description(prop))} |\n")
     return [*lines, "\n"]
 
 

@@ -61,7 +61,8 @@ def test_package_xml_placeholders_say_so():
 
 @pytest.mark.parametrize("distro", ["jazzy", "noetic"])
 def test_package_xml_takes_the_users_license_and_maintainer(distro):
-    xml = _package_xml(ros_distro=distro, package_license="Apache-2.0 OR MIT", maintainer="Ana Pérez <ana@lab.example.org>")
+    xml = _package_xml(ros_distro=distro, package_license="Apache-2.0 OR MIT",
+                       maintainer="Ana Pérez <ana@lab.example.org>")
     assert "<license>Apache-2.0 OR MIT</license>" in xml
     assert '<maintainer email="ana@lab.example.org">Ana Pérez</maintainer>' in xml
     assert "TODO" not in xml
@@ -89,8 +90,9 @@ def test_bad_license_or_maintainer_is_refused(field, value):
 
 def test_cli_flags_and_a_bad_maintainer_is_a_usage_error(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    ok = subprocess.run([sys.executable, "-m", "modc", str(FARM), "-o", str(tmp_path / "out"), "--only", "urdf,srdf,ros",
-                         "--package-license", "MIT", "--maintainer", "Ana <ana@lab.example.org>"],
+    ok = subprocess.run([sys.executable, "-m", "modc", str(FARM), "-o", str(tmp_path / "out"),
+                         "--only", "urdf,srdf,ros", "--package-license", "MIT",
+                         "--maintainer", "Ana <ana@lab.example.org>"],
                         capture_output=True, text=True, env=env, cwd=tmp_path)
     assert ok.returncode == 0, ok.stderr
     assert "<license>MIT</license>" in (tmp_path / "out" / "package.xml").read_text(encoding="utf-8")
@@ -112,7 +114,8 @@ def _deps_dir(tmp_path: Path) -> Path:
     deps.mkdir()
     for lib in dict.fromkeys([sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]]):
         for entry in Path(lib).iterdir():
-            if entry.name.lower().startswith(("modc", "_editable_impl_modc", "__editable__")) or (deps / entry.name).exists():
+            own = entry.name.lower().startswith(("modc", "_editable_impl_modc", "__editable__"))
+            if own or (deps / entry.name).exists():
                 continue
             (deps / entry.name).symlink_to(entry)
     return deps
