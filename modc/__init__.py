@@ -1,8 +1,11 @@
 """modc: a compiler for MOIRs Mark-2 modular robot arms (.mod -> URDF and friends).
 
-Kept free of imports so that `modc lint` starts fast; the API lives in modc.api.
+It imports only the version (modc/_version.py) so that `modc lint` starts fast and no layer below the
+API reaches it through `__version__`; the API lives in modc.api and is imported when first called.
 """
-__version__ = "0.1.0"
+from ._version import __version__
+
+__all__ = ["__version__", "chain", "load"]
 
 
 def load(path, robot=None, library=None):

@@ -90,6 +90,10 @@ def check_text(text: str, path: str = "<string>", library: str | None = None, **
 
     text = normalize_newlines(text)  # the same length: offsets into the original stay right
     tree, diags = parse_text(text, path)
+    if "torque" in options.get("analyses", ()) and "torque_analysis" not in options:
+        from .dynamics.worst import analyse  # the passes run it, but only the compiler imports the physics
+
+        options["torque_analysis"] = analyse
     ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
     design = run_all(design, ctx)

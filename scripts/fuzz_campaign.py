@@ -178,7 +178,7 @@ def check_one(kind: str, item, work: Path, ctx: dict | None = None):
     if kind == "hostile":
         kind, item = {"mod": "grammar", "yaml": "yaml", "bytes": "bytes"}[item[0]], item[1]
     if kind == "csv":
-        from modc.dh.convert_file import convert_table
+        from modc.dh2mod import convert_table
 
         convert_table(item, "fuzz.csv")
         return None

@@ -107,7 +107,7 @@ def test_a_command_that_needs_the_full_extra_says_so(light, tmp_path, command):
     assert r.returncode == 2, r.stderr
     assert "Traceback" not in r.stderr
     line = r.stderr.strip().splitlines()[-1]
-    assert "pip install 'modc[full]'" in line and "light install" in line
+    assert "pip install 'CHECKOUT[full]'" in line and "light install" in line
     assert not (tmp_path / "out").exists()
 
 

@@ -12,8 +12,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from modc.compiler import build, check_text
-from modc.dh.convert_file import convert_table
 from modc.dh.extract import axis_angles, realised_dh
+from modc.dh2mod import convert_table
 from modc.kinematics import Chain
 
 PI = math.pi

@@ -193,7 +193,7 @@ def case_param(path: Path, known_bugs: bool = True):
 
 def run_case(path: Path) -> list[Diagnostic]:
     if path.suffix == ".csv":
-        from modc.dh.convert_file import convert_table
+        from modc.dh2mod import convert_table
 
         return list(convert_table(read_source(path), str(path))[1])
     try:

@@ -39,11 +39,11 @@ def _emitted(path, robot, tmp_path):
 def _full_precision_urdf(robot, monkeypatch) -> str:
     """The URDF backend's text with every number in 17 significant digits (round-trip exact), so
     that the comparison measures the model, not the text's rounding."""
-    from modc.backends import Build, urdf
+    from modc.backends import Build, common, urdf
     from modc.model import Design
 
-    monkeypatch.setattr(urdf, "num", lambda x: repr(float(x)))
-    monkeypatch.setattr(urdf, "vec", lambda xs: " ".join(repr(float(x)) for x in xs))
+    monkeypatch.setattr(common, "num", lambda x: repr(float(x)))  # the URDF's context is built in common
+    monkeypatch.setattr(common, "vec", lambda xs: " ".join(repr(float(x)) for x in xs))
     return urdf.urdf_text(Build(Design(path="t.mod", robots=(robot,))), robot)
 
 

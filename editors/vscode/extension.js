@@ -61,7 +61,7 @@ async function start(context) {
     client = null;
     const choice = await vscode.window.showErrorMessage(
       `modc: could not start \`${[command].concat(args).join(" ")}\` (${err && err.message ? err.message : err}). ` +
-        "Install modc (pip install modc) or set `modc.path` to its executable.",
+        "Install modc from its checkout (pip install -e PATH) or set `modc.path` to its executable.",
       "Open Settings"
     );
     if (choice === "Open Settings") {

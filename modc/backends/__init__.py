@@ -1,39 +1,17 @@
 """Backends: registered by name; each turns a checked design into {relative path: content}.
 
-A new backend is one module here (plus its templates) that calls ``register``.
+A new backend is one module here (plus its templates) that calls ``registry.register``; what it
+shares with other backends lives in common.py, never in another backend.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-
 from .build import Build
-
-Files = dict[str, "str | bytes"]
-
-
-@dataclass(frozen=True)
-class Backend:
-    name: str
-    summary: str
-    emit: Callable[[Build], Files]
-    heavy: bool = False  # needs more than the core (meshes: trimesh on a cache miss)
-
-
-BACKENDS: dict[str, Backend] = {}
-
-
-def register(name: str, summary: str, heavy: bool = False):
-    def deco(fn: Callable[[Build], Files]):
-        BACKENDS[name] = Backend(name, summary, fn, heavy)
-        return fn
-
-    return deco
+from .registry import BACKENDS, Backend, Files, check_order, register
 
 
 def load_all() -> dict[str, Backend]:
-    # Registration happens on import, in run order: later backends may read earlier outputs
-    # (ros installs mjcf/ when the mjcf backend ran); report runs last so that it lists every output.
+    # Registration happens on import, in run order: a backend that reads another's outputs declares
+    # it (`reads`) and check_order enforces it; report runs last so that it lists every output.
     # The order of these imports is the run order: not sorted on purpose.
     from . import meshes, urdf  # noqa: F401, I001
     from . import srdf  # noqa: F401
@@ -42,6 +20,7 @@ def load_all() -> dict[str, Backend]:
     from . import xacro  # noqa: F401
     from . import report  # noqa: F401
 
+    check_order(BACKENDS)
     return BACKENDS
 
 

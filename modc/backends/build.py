@@ -22,6 +22,9 @@ class Build:
     ik_solver: str | None = None
     command_interface: str | None = None
     ros_package: str | None = None
+    # package.xml's license (an SPDX expression) and maintainer ("Name <email>"); None: placeholders
+    package_license: str | None = None
+    maintainer: str | None = None
     _descriptions: dict[str, Description] = field(default_factory=dict)
 
     @property

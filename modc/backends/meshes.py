@@ -2,7 +2,8 @@
 from __future__ import annotations
 
 from ..physical.meshes import stl_bytes
-from . import Build, register
+from .build import Build
+from .registry import register
 
 
 @register("meshes", "binary STL meshes of the parts: meshes/*.stl")

@@ -3,13 +3,14 @@ from __future__ import annotations
 
 import json
 
-from .. import __version__
+from .._version import __version__
 from ..dh.report import compare
 from ..files import REPORT
 from ..kinematics import Chain
 from ..physical.assembly import library_mass
-from . import Build, register
+from .build import Build
 from .format import num
+from .registry import register
 
 
 def _r(x: float) -> float:
@@ -40,7 +41,8 @@ def robot_report(build: Build, robot) -> dict:
     }
 
 
-@register("report", "report.json: robots, joints, masses, outputs and warnings")
+@register("report", "report.json: robots, joints, masses, outputs and warnings",
+          reads=("meshes", "urdf", "srdf", "mjcf", "ros", "xacro"))
 def emit(build: Build):
     outputs = sorted([*build.files, REPORT])
     doc = {

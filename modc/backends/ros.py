@@ -34,21 +34,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .. import __version__
+from .._version import __version__
 from ..kinematics import rpy_matrix
 from ..physical.assembly import kdl_root
-from . import Build, register
-from . import srdf as srdf_backend
-from . import urdf as urdf_backend
+from .build import Build
+from .common import BASE_LINK, GROUP, urdf_context
 from .format import num
-from .ros_target import IK_PLUGINS, Target, resolve
+from .registry import register
+from .ros_target import IK_PLUGINS, PLACEHOLDER_LICENSE, PLACEHOLDER_MAINTAINER, Target, resolve
 from .templates import comment, render, scene_token
 
 # --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
 
 PACKAGE_VERSION = "0.1.0"
-PACKAGE_LICENSE = "BSD-3-Clause"  # what MoveIt Setup Assistant writes; the generated package is the user's
-MAINTAINER = ("modc user", "user@example.com")  # placeholder: edit package.xml before releasing
 
 # The SRDF backend's planning group and virtual joint (world -> base_link, templates/srdf.xml.j2)
 VIRTUAL_JOINT_PARENT = "world"
@@ -206,9 +204,9 @@ def context(build: Build, robot, target: Target) -> dict:
         "sequence": robot.sequence,
         "dof": robot.dof,
         "library": comment(robot.library.name),
-        "group": srdf_backend.GROUP,
+        "group": GROUP,
         "virtual_parent": VIRTUAL_JOINT_PARENT,
-        "virtual_child": srdf_backend.BASE_LINK,
+        "virtual_child": BASE_LINK,
         "controller": ARM_CONTROLLER,
         "joint_state_controller": JOINT_STATE_CONTROLLER,
         "joint_state_broadcaster": JOINT_STATE_BROADCASTER,
@@ -238,9 +236,10 @@ def context(build: Build, robot, target: Target) -> dict:
         "scene": _scene(robot),
         "files": robot_files(robot.file_stem),
         "package_version": PACKAGE_VERSION,
-        "license": PACKAGE_LICENSE,
-        "maintainer": MAINTAINER[0],
-        "maintainer_email": MAINTAINER[1],
+        "license": target.license,
+        "maintainer": target.maintainer[0],
+        "maintainer_email": target.maintainer[1],
+        "placeholder_note": _placeholder_note(target),
         "robots": ", ".join(f"{r.name} = {r.sequence}" for r in build.design.robots),
         "depends": exec_depends(target),
         # mjcf/ when that backend is in this build (it runs before this one)
@@ -252,6 +251,20 @@ def context(build: Build, robot, target: Target) -> dict:
             "urdf",
         ],
     }
+
+
+def _placeholder_note(target: Target) -> str | None:
+    """package.xml's comment naming what is still a placeholder and the option that sets it (an XML
+    comment cannot hold the options' leading dashes)."""
+    left = [(what, option) for what, option, placeholder in (
+        ("license", "package-license", target.license == PLACEHOLDER_LICENSE),
+        ("maintainer", "maintainer", target.maintainer == PLACEHOLDER_MAINTAINER)) if placeholder]
+    if not left:
+        return None
+    if len(left) == 1:
+        return f"TODO: the {left[0][0]} below is a placeholder; set it with the modc option {left[0][1]}"
+    return ("TODO: the license and maintainer below are placeholders; "
+            "set them with the modc options package-license and maintainer")
 
 
 # --- package.xml: what the package runs, per ROS version (every one released in the target distro)
@@ -330,7 +343,7 @@ def robot_outputs(build: Build, robot, target: Target) -> dict[str, str]:
     # inertia-free root for KDL (base_link's mass on base_link_inertia)
     desc = kdl_root(build.description(robot))
     mesh_prefix = f"package://{target.package}/meshes/"
-    out = {f["description"]: render("urdf.xml.j2", urdf_backend.context(desc, robot, build.source_name, mesh_prefix))}
+    out = {f["description"]: render("urdf.xml.j2", urdf_context(desc, robot, build.source_name, mesh_prefix))}
     if target.ros == 2:
         out[f["urdf_xacro"]] = render("ros/ros2/robot.urdf.xacro.j2", ctx)
         out[f["ros2_control"]] = render("ros/ros2/ros2_control.xacro.j2", ctx)
@@ -356,6 +369,7 @@ def emit_package(build: Build) -> dict[str, str]:
     return dict(sorted(out.items()))
 
 
-@register("ros", "ROS package: the MoveIt Setup Assistant's layout for ROS 2 (or ROS 1), package.xml, launch files")
+@register("ros", "ROS package: the MoveIt Setup Assistant's layout for ROS 2 (or ROS 1), package.xml, launch files",
+          reads=("mjcf",))
 def emit(build: Build):
     return emit_package(build)

@@ -50,6 +50,19 @@ PACKAGE_SUFFIX = "_moveit_config"  # the Setup Assistant's own naming: <robot>_m
 _PACKAGE_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 
 
+# The generated package is the user's: its license and maintainer are theirs to choose
+# (Build.package_license, Build.maintainer; `--package-license`, `--maintainer` on the command line).
+# Until they do, placeholders that say so, as `ros2 pkg create` writes them.
+PLACEHOLDER_LICENSE = "TODO: License declaration"
+PLACEHOLDER_MAINTAINER = ("TODO maintainer", "todo@todo.todo")
+# An SPDX license expression (MIT, BSD-3-Clause, Apache-2.0 OR MIT, LicenseRef-Mine); nothing that
+# could break out of the XML element or a YAML scalar.
+_LICENSE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9.+\-]*( (AND|OR|WITH) [A-Za-z0-9][A-Za-z0-9.+\-]*)*$")
+# "Name <email>": a name of letters (any script), digits, spaces and . , ' - ; catkin_pkg's email rule.
+_MAINTAINER = re.compile(r"^(?P<name>[^\W_][\w .,'-]{0,99}) <(?P<email>[-a-zA-Z0-9_%+]+(\.[-a-zA-Z0-9_%+]+)*"
+                         r"@[-a-zA-Z0-9%]+(\.[-a-zA-Z0-9%]+)*\.[a-zA-Z]{2,})>$")
+
+
 class RosOptionError(ValueError):
     """An option the target cannot honour (the CLI reports it as a usage error)."""
 
@@ -67,6 +80,27 @@ def package_name(robot_name: str) -> str:
     elif not stem[0].isalpha():
         stem = f"modc_{stem}"
     return stem + PACKAGE_SUFFIX
+
+
+def package_license(text: str | None) -> str:
+    """The package.xml license: an SPDX expression the user chose, else the placeholder."""
+    if text is None:
+        return PLACEHOLDER_LICENSE
+    if len(text) > 100 or not _LICENSE.match(text):
+        raise RosOptionError(f"package license {text[:100]!r} is not an SPDX license expression "
+                             "(e.g. MIT, BSD-3-Clause, Apache-2.0 OR MIT)")
+    return text
+
+
+def maintainer(text: str | None) -> tuple[str, str]:
+    """(name, email) from "Name <email>", else the placeholder."""
+    if text is None:
+        return PLACEHOLDER_MAINTAINER
+    m = _MAINTAINER.match(text.strip())
+    if not m:
+        raise RosOptionError(f"maintainer {text[:100]!r} is not \"Name <email>\" (a name of letters, digits, "
+                             "spaces and . , ' -, and an e-mail address)")
+    return m["name"].strip(), m["email"]
 
 
 def distro_for(ros_version: int | None = None, ros_distro: str | None = None,
@@ -104,6 +138,8 @@ class Target:
     ik_solver: str
     command_interface: str
     package: str
+    license: str = PLACEHOLDER_LICENSE
+    maintainer: tuple[str, str] = PLACEHOLDER_MAINTAINER  # (name, email)
 
     @property
     def ros(self) -> int:
@@ -130,4 +166,4 @@ def resolve(build) -> Target:
     if not valid_package_name(package):
         raise RosOptionError(f"'{package}' is not a valid ROS package name "
                              "(lowercase letters, digits and single underscores, starting with a letter)")
-    return Target(distro, solver, iface, package)
+    return Target(distro, solver, iface, package, package_license(build.package_license), maintainer(build.maintainer))

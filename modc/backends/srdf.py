@@ -20,40 +20,20 @@ returned by warnings(build) for the driver to report.
 """
 from __future__ import annotations
 
-from .. import __version__
+from .._version import __version__
 from ..model import Robot, Transform
 from ..physical import collisions
-from . import Build, register
+from .build import Build
+from .common import BASE_LINK, GROUP, TIP_LINK, TOOL_GROUP, collision_matrix, options
 from .format import num
+from .registry import register
 from .templates import comment, render
 
-GROUP = "arm"
-TOOL_GROUP = "tool"
-BASE_LINK = "base_link"
-TIP_LINK = "tool0"
+# collision_matrix and options: tests and the mjcf backend read them here today
+__all__ = ["BASE_LINK", "GROUP", "TIP_LINK", "TOOL_GROUP", "collision_matrix", "emit", "options", "srdf_text",
+           "warnings"]
+
 FRAME_LINKS = ("tool0", "payload")  # frames without geometry by design: no warning for them
-_CACHE = "_srdf_collision_matrices"
-
-
-def options(build: Build) -> tuple[int, int]:
-    """(samples, seed) for this build: attributes set by the driver, else the defaults."""
-    samples = getattr(build, "collision_samples", None)
-    seed = getattr(build, "seed", None)
-    samples = collisions.DEFAULT_SAMPLES if samples is None else int(samples)
-    seed = collisions.DEFAULT_SEED if seed is None else int(seed)
-    if samples < 0 or seed < 0:
-        raise ValueError(f"collision samples and seed must be >= 0 (got {samples}, {seed})")
-    return samples, seed
-
-
-def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
-    """The robot's self-collision matrix, computed once per build (emit and warnings share it)."""
-    samples, seed = options(build)
-    cache = build.__dict__.setdefault(_CACHE, {})
-    key = (robot.name, samples, seed)
-    if key not in cache:
-        cache[key] = collisions.cached_matrix(build.description(robot), samples, seed)
-    return cache[key]
 
 
 def robot_warnings(robot: Robot, matrix: collisions.CollisionMatrix) -> list[str]:

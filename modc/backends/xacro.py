@@ -28,16 +28,17 @@ from typing import Any
 import numpy as np
 from markupsafe import Markup
 
-from .. import __version__
+from .._version import __version__
 from ..kinematics import A_J, matrix_rpy
 from ..model import Robot
 from ..model.library import Library
 from ..physical.inertia import Inertial, combine, part_inertial
 from ..physical.parts import Part, Primitive, unit_parts
-from . import Build, register
+from .build import Build
+from .common import MATERIALS
 from .format import num, vec
+from .registry import register
 from .templates import comment, render
-from .urdf import MATERIALS
 from .xacro_srdf import macro_srdf_text
 
 LIBRARY_FILE = "modc_modules.xacro"

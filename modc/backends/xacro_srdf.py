@@ -5,7 +5,7 @@ its parts (xacro.LINKS), so the SRDF of the URDF, which names only base_link and
 the pairs of those bodies enabled: at the zero pose MoveIt would see the arm in collision.
 
 This file is a macro (prefix, like the arm's own macro) of disable_collisions over the macro
-form's links, derived from the URDF's collision matrix (srdf.collision_matrix) without sampling
+form's links, derived from the URDF's collision matrix (common.collision_matrix) without sampling
 again. A macro link's geometry is part of exactly one URDF link's (its body, body_of); so
     - two bodies of the same URDF link are rigidly joined: disabled ("Adjacent", as the Setup
       Assistant does for links that cannot move relative to each other);
@@ -16,10 +16,10 @@ from __future__ import annotations
 
 from itertools import combinations
 
-from .. import __version__
+from .._version import __version__
 from ..model import Robot
-from . import Build
-from .srdf import collision_matrix
+from .build import Build
+from .common import collision_matrix
 from .templates import comment, render
 
 

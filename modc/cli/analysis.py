@@ -141,7 +141,7 @@ def _along(traj_path: str, design, robots, mass) -> dict:
 def dh2mod_cmd(table: str, json_out: bool, fit_links: bool, name: str | None, library: str | None) -> None:
     """Convert a standard DH table into a module chain (paper section 4.2); .mod text on stdout."""
     from ..compiler import InputError, SourceError, read_source
-    from ..dh.convert_file import convert_table
+    from ..dh2mod import convert_table
 
     try:
         text = read_source(table)

@@ -188,7 +188,9 @@ def missing_extra(e: ModuleNotFoundError, command: str) -> str | None:
     if root not in HEAVY:
         return None
     package = f"{root} (pip package {HEAVY[root]})" if HEAVY[root] != root.lower() else root
-    return f"modc {command}: needs {package}, which the light install leaves out: pip install 'modc[full]'"
+    # modc is not on PyPI: the extra is installed from the checkout (or the wheel) modc came from
+    return (f"modc {command}: needs {package}, which the light install leaves out: "
+            "pip install 'CHECKOUT[full]' (or the wheel, 'modc-VERSION-py3-none-any.whl[full]')")
 
 
 def route(args: list[str], commands: list[str]) -> list[str] | str:

@@ -37,6 +37,9 @@ from .app import (
 @click.option("--ik-solver", help="MoveIt IK plugin: kdl, trac_ik or pick_ik (default: the distro's)")
 @click.option("--ros-package", help="ROS package name (default: <robot>_moveit_config)")
 @click.option("--command-interface", help="ros2_control command interface: position (default) or effort")
+@click.option("--package-license", metavar="SPDX",
+              help="package.xml license, e.g. MIT (default: a TODO placeholder)")
+@click.option("--maintainer", metavar="'NAME <EMAIL>'", help="package.xml maintainer (default: a TODO placeholder)")
 @click.option("-q", "--quiet", is_flag=True, help="print errors only")
 @click.option("-v", "--verbose", is_flag=True, help="list the files written")
 def compile_cmd(
@@ -54,6 +57,8 @@ def compile_cmd(
     ik_solver: str | None,
     ros_package: str | None,
     command_interface: str | None,
+    package_license: str | None,
+    maintainer: str | None,
     quiet: bool,
     verbose: bool,
 ) -> None:
@@ -94,7 +99,8 @@ def compile_cmd(
         if not ok:
             _err(f"modc: smoke test failed; nothing written to {out}")
             raise SystemExit(EXIT_ERRORS)
-    ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface)
+    ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface,
+                               package_license, maintainer)
     try:
         files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     except InputError as e:  # a backend refuses a value it cannot write (mjcf: not-finite)
@@ -113,7 +119,8 @@ def compile_cmd(
             _err(f"modc: {file} holds design problems, no robot: `modc design {file} -o DIR` finds arms for them")
 
 
-def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface) -> dict:
+def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface,
+                 package_license=None, maintainer=None) -> dict:
     """Build fields of the ROS backend. The environment ($ROS_DISTRO, $ROS_VERSION) is read here
     and only here, below the command-line options (README "Use in ROS 2 / ROS 1")."""
     import os
@@ -123,7 +130,8 @@ def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, com
 
     try:
         options = {"ros_distro": distro_for(ros, ros_distro, dict(os.environ)), "ik_solver": ik_solver,
-                   "ros_package": ros_package, "command_interface": command_interface}
+                   "ros_package": ros_package, "command_interface": command_interface,
+                   "package_license": package_license, "maintainer": maintainer}
         if selected is None or "ros" in selected:
             resolve(Build(checked.design, **options))
     except RosOptionError as e:

@@ -1,7 +1,9 @@
 """What every pass receives besides the model: where to report, and run-wide options."""
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 from ..diagnostics import REGISTRY, Diagnostic
 from ..model import Robot
@@ -15,6 +17,9 @@ class Context:
     analyses: frozenset[str] = frozenset()
     torque_severity: str = "error"  # error | warning | off: how an over-peak joint is reported
     payload_override: float | None = None  # `check --payload MASS`, kg at tool0
+    # The worst-case torque search (modc.dynamics.worst.analyse), handed in by the compiler when
+    # analyses has "torque": a pass never imports the physics (pyproject's import contracts).
+    torque_analysis: Callable[[Robot, float | None], Sequence[Any]] | None = None
     sources: dict[str, str] = field(default_factory=dict)  # other files diagnostics point into (libraries)
 
     def report(self, d: Diagnostic, robot: Robot | None = None) -> None:

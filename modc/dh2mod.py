@@ -1,4 +1,8 @@
-"""`modc dh2mod`: a DH CSV -> checked model -> .mod text or JSON, through the normal passes."""
+"""`modc dh2mod`: a DH CSV -> checked model -> .mod text or JSON, through the normal passes.
+
+A driver like modc.compiler (it runs the pass list), so it sits at the compiler's layer, above
+modc.dh (which the convert_dh pass calls) and modc.passes.
+"""
 from __future__ import annotations
 
 import json
@@ -6,14 +10,14 @@ import math
 import re
 from pathlib import Path
 
-from .. import names
-from ..diagnostics import Diagnostic, Span, codes
-from ..diagnostics.span import NOWHERE
-from ..model import Design, Robot
-from ..model.write import robot_text
-from ..passes import Context, run_all
-from .report import compare
-from .table import read_csv
+from . import names
+from .dh.report import compare
+from .dh.table import read_csv
+from .diagnostics import Diagnostic, Span, codes
+from .diagnostics.span import NOWHERE
+from .model import Design, Robot
+from .model.write import robot_text
+from .passes import Context, run_all
 
 
 def _name(path: str) -> str:
