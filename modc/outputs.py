@@ -197,16 +197,15 @@ def protect(inputs: Iterable[PathLike]) -> None:
     _protected.extend(os.fspath(p) for p in inputs if os.fspath(p) not in _protected)
 
 
-_warned: set[str] = set()
+_verdicts: dict[tuple[str, int], bool] = {}  # (directory, inputs declared so far): the list only grows
 
 
 def cache_dir_ok(directory: PathLike) -> bool:
     """False (once saying why on stderr) when the cache directory is, or holds, an input."""
-    for src in _protected:
-        if holds(directory, src):
-            key = os.fspath(directory)
-            if key not in _warned:
-                _warned.add(key)
-                sys.stderr.write(f"modc: not caching in {key}: it is or holds the input {src}\n")
-            return False
-    return True
+    key = (os.fspath(directory), len(_protected))
+    if key not in _verdicts:
+        bad = next((src for src in _protected if holds(directory, src)), None)
+        if bad is not None and not any(k[0] == key[0] and not ok for k, ok in _verdicts.items()):
+            sys.stderr.write(f"modc: not caching in {key[0]}: it is or holds the input {bad}\n")
+        _verdicts[key] = bad is None
+    return _verdicts[key]

@@ -228,6 +228,7 @@ def test_a_cache_dir_holding_an_input_is_not_written(project, capsys, monkeypatc
         monkeypatch.setenv("MODC_CACHE_DIR", str(cache))
         rc, err = modc(capsys, project / "arm.mod", "-o", Path("out"), "--only", "urdf,srdf")
         assert rc == 0, err
+        assert err.count(f"not caching in {cache}: it is or holds the input") == 1, err
         assert unchanged(before) and sorted(project.iterdir()) == sorted(before)
 
 
