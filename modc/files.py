@@ -197,6 +197,15 @@ def _lock(directory: Path) -> int:
     return fd
 
 
+def foreign_now(out: Path) -> list[str]:
+    """foreign_entries(out) under the lock a writer of out holds: never a tree seen mid-exchange."""
+    fd = _lock(out.parent)
+    try:
+        return foreign_entries(out)
+    finally:
+        os.close(fd)
+
+
 def replace_tree(files: Mapping[str, str | bytes], out: Path, force: bool,
                  keep: Callable[[Path], bool] = lambda p: False) -> None:
     """Put files (and their manifest) at out. The caller has decided that out may be replaced

@@ -130,8 +130,15 @@ def check_output_dir(out: PathLike, inputs: Sequence[PathLike] = (), force: bool
     """Raise modc.compiler.InputError with the diagnostic writing a tree to OUT would give
     (output-unsafe, output-not-modc), before any work is done; return when OUT may be written.
     The same check runs again in write_tree, which is what makes it hold."""
-    from .files import foreign_entries
+    from .files import foreign_now
 
+    _check_rule(out, inputs, force)
+    if not force and Path(out).is_dir() and not Path(out).is_symlink():
+        _refuse_foreign(out, foreign_now(Path(os.path.abspath(out))))
+
+
+def _check_rule(out: PathLike, inputs: Sequence[PathLike], force: bool) -> None:
+    """check_output_dir but what is in OUT (which replace_tree checks under its lock)."""
     protect(inputs)
     path = Path(out)
     why = _never_replaced(path, inputs)
@@ -140,11 +147,8 @@ def check_output_dir(out: PathLike, inputs: Sequence[PathLike] = (), force: bool
     if path.exists() and not path.is_dir():
         # never replaced by a folder, even with --force: -o names the folder to create, not a file
         raise _unsafe(out, "a file, not a directory", f"-o names the directory modc creates; {DIR_HINT}")
-    if not force:
-        if path.is_symlink():
-            _refuse_foreign(out, ["(OUT itself is a symbolic link)"])
-        if path.is_dir():
-            _refuse_foreign(out, foreign_entries(path))
+    if not force and path.is_symlink():
+        _refuse_foreign(out, ["(OUT itself is a symbolic link)"])
 
 
 def _refuse_foreign(out: PathLike, entries: list[str]) -> None:
@@ -176,7 +180,7 @@ def write_tree(files: Mapping[str, str | bytes], out: PathLike, force: bool = Fa
     OUT is either the old tree or the complete new one, never half-written or missing."""
     from .files import ForeignOutput, replace_tree
 
-    check_output_dir(out, inputs, force)
+    _check_rule(out, inputs, force)
     target = Path(os.path.abspath(out))
     try:
         replace_tree(files, target, force, keep=lambda p: any(holds(p, src) for src in inputs))
@@ -193,16 +197,15 @@ def protect(inputs: Iterable[PathLike]) -> None:
     _protected.extend(os.fspath(p) for p in inputs if os.fspath(p) not in _protected)
 
 
-_warned: set[str] = set()
+_verdicts: dict[tuple[str, int], bool] = {}  # (directory, inputs declared so far): the list only grows
 
 
 def cache_dir_ok(directory: PathLike) -> bool:
     """False (once saying why on stderr) when the cache directory is, or holds, an input."""
-    for src in _protected:
-        if holds(directory, src):
-            key = os.fspath(directory)
-            if key not in _warned:
-                _warned.add(key)
-                sys.stderr.write(f"modc: not caching in {key}: it is or holds the input {src}\n")
-            return False
-    return True
+    key = (os.fspath(directory), len(_protected))
+    if key not in _verdicts:
+        bad = next((src for src in _protected if holds(directory, src)), None)
+        if bad is not None and not any(k[0] == key[0] and not ok for k, ok in _verdicts.items()):
+            sys.stderr.write(f"modc: not caching in {key[0]}: it is or holds the input {bad}\n")
+        _verdicts[key] = bad is None
+    return _verdicts[key]

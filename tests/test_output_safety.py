@@ -156,7 +156,8 @@ def test_render_never_replaces_its_source(project, capsys):
     arm = project / "arm.mod"
     before = snapshot(*project.iterdir())
     Path("arm.png").symlink_to(arm)
-    for out in (arm, Path("arm.png"), project / "nowhere" / ".." / "arm.mod", project):
+    os.link(arm, "hard.png")  # a second name of the same file: PIL would write through it
+    for out in (arm, Path("arm.png"), Path("hard.png"), project / "nowhere" / ".." / "arm.mod", project):
         rc, err = modc(capsys, "render", arm, "-o", out)
         assert rc == 2 and "error[output-unsafe]" in err and "-o arm.png" in err, (out, err)
     assert unchanged(before)
@@ -228,6 +229,7 @@ def test_a_cache_dir_holding_an_input_is_not_written(project, capsys, monkeypatc
         monkeypatch.setenv("MODC_CACHE_DIR", str(cache))
         rc, err = modc(capsys, project / "arm.mod", "-o", Path("out"), "--only", "urdf,srdf")
         assert rc == 0, err
+        assert err.count(f"not caching in {cache}: it is or holds the input") == 1, err
         assert unchanged(before) and sorted(project.iterdir()) == sorted(before)
 
 

@@ -22,7 +22,8 @@ from .app import (
 @library_option
 @click.option("--only", help="comma-separated backends to run (default: all; `modc backends`)")
 @click.option("--force/--no-force", default=False,
-              help="replace OUT whatever it holds (deletes files modc did not write)")
+              help="replace OUT whatever it holds (deletes files modc did not write; never an input or a "
+                   "folder holding one)")
 @click.option("--collision-samples", type=click.IntRange(min=0), default=10_000,
               help="random poses for the SRDF collision matrix (MoveIt's default)")
 @click.option("--seed", type=click.IntRange(min=0), default=0,
