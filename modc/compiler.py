@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from .diagnostics import Diagnostic, Span, codes
+from .diagnostics.errors import InputError, SourceError
 from .model import Design
 from .model.lower import lower
 from .passes import Context, run_all
@@ -28,23 +30,6 @@ class Checked:
     @property
     def ok(self) -> bool:
         return not any(d.is_error for d in self.diagnostics)
-
-
-class InputError(Exception):
-    """A file that cannot be read at all (exit 2)."""
-
-    def __init__(self, diagnostic: Diagnostic):
-        super().__init__(diagnostic.message)
-        self.diagnostic = diagnostic
-
-
-class SourceError(InputError):
-    """A file that was read but whose bytes are wrong (not UTF-8, too large): an error in the
-    file, exit 1 like any other (check_file reports it as the file's diagnostic)."""
-
-    def __init__(self, diagnostic: Diagnostic, text: str | None = None):
-        super().__init__(diagnostic)
-        self.text = text  # what can be shown of the file (undecodable bytes replaced), for the excerpt
 
 
 def read_source(path: str | os.PathLike) -> str:
@@ -136,3 +121,35 @@ def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: boo
     from .outputs import write_tree as write
 
     write(files, out, force, inputs)
+
+
+def inputs_of(file: str | os.PathLike, library: str | None = None, checked: Checked | None = None,
+              more: Iterable[str | os.PathLike] = ()) -> list[str]:
+    """Every input file of a command: FILE, the --library file, each library file FILE's robots
+    and design blocks use (from checked, a modc.compiler.Checked; found by checking FILE when not
+    given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out.
+    They are protected from the caches (protect) from this call on."""
+    from .model import library as lib
+    from .outputs import protect
+
+    found = [os.fspath(file), *(os.fspath(m) for m in more)]
+    if library and library not in lib.BUILTIN:
+        found.append(library)
+    if checked is None:
+        try:
+            checked = check_file(file, library)
+        except (InputError, OSError, ValueError):  # the command itself reports an unreadable file
+            checked = None
+    if checked is not None:
+        robots = [*checked.design.robots, *(p.cell for p in checked.design.problems)]
+        for r in robots:
+            ref = library or r.library_ref
+            if ref in lib.BUILTIN:
+                continue
+            where = Path(r.library_dir) if r.library_dir and not library else None
+            path = lib.resolve(ref, where)
+            if path is not None:
+                found.append(str(path))
+    found = list(dict.fromkeys(found))
+    protect(found)
+    return found

@@ -70,40 +70,8 @@ def holds(directory: PathLike, path: PathLike) -> bool:
     return False
 
 
-def inputs_of(file: PathLike, library: str | None = None, checked=None, more: Iterable[PathLike] = ()) -> list[str]:
-    """Every input file of a command: FILE, the --library file, each library file FILE's robots
-    and design blocks use (from checked, a modc.compiler.Checked; found by checking FILE when not
-    given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out.
-    They are protected from the caches (protect) from this call on."""
-    from .model import library as lib
-
-    found = [os.fspath(file), *(os.fspath(m) for m in more)]
-    if library and library not in lib.BUILTIN:
-        found.append(library)
-    if checked is None:
-        from .compiler import InputError, check_file
-
-        try:
-            checked = check_file(file, library)
-        except (InputError, OSError, ValueError):  # the command itself reports an unreadable file
-            checked = None
-    if checked is not None:
-        robots = [*checked.design.robots, *(p.cell for p in checked.design.problems)]
-        for r in robots:
-            ref = library or r.library_ref
-            if ref in lib.BUILTIN:
-                continue
-            where = Path(r.library_dir) if r.library_dir and not library else None
-            path = lib.resolve(ref, where)
-            if path is not None:
-                found.append(str(path))
-    found = list(dict.fromkeys(found))
-    protect(found)
-    return found
-
-
 def _unsafe(out: PathLike, what: str, hint: str):
-    from .compiler import InputError
+    from .diagnostics.errors import InputError
 
     shown = os.fspath(out)
     return InputError(codes.OUTPUT_UNSAFE.at(Span.point(shown), path=shown, what=what, hint=hint))
@@ -152,7 +120,7 @@ def _check_rule(out: PathLike, inputs: Sequence[PathLike], force: bool) -> None:
 
 
 def _refuse_foreign(out: PathLike, entries: list[str]) -> None:
-    from .compiler import InputError
+    from .diagnostics.errors import InputError
 
     if not entries:
         return

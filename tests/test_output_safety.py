@@ -132,8 +132,8 @@ def test_a_plain_file_as_out_gets_one_message_with_or_without_force(project, cap
 
 def test_check_output_dir_is_the_writes_own_check(project, tmp_path):
     """The call a command makes before its work raises exactly what the write would."""
-    from modc.compiler import InputError
-    from modc.outputs import check_output_dir, inputs_of, write_tree
+    from modc.compiler import InputError, inputs_of
+    from modc.outputs import check_output_dir, write_tree
 
     inputs = inputs_of(project / "arm.mod")
     foreign = tmp_path / "foreign"

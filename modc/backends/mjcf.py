@@ -219,8 +219,8 @@ def scene_text(build: Build, robot: Robot) -> str:
 def _finite(robot: Robot, make):
     """make(), or a not-finite diagnostic (at the robot's `library` statement, where the number
     comes from, else at the robot) when a number of the model is infinite or not a number."""
-    from ..compiler import InputError
     from ..diagnostics import NOWHERE, codes
+    from ..diagnostics.errors import InputError
 
     try:
         return make()

@@ -64,8 +64,8 @@ def compile_cmd(
     verbose: bool,
 ) -> None:
     """Check FILE and write URDF, meshes and a report into OUT."""
-    from ..compiler import COMPILE_ANALYSES, InputError, build, check_file
-    from ..outputs import check_output_dir, inputs_of, write_tree
+    from ..compiler import COMPILE_ANALYSES, InputError, build, check_file, inputs_of
+    from ..outputs import check_output_dir, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
     inputs = inputs_of(file, library)  # first: the analyses' caches must know them (modc.outputs)

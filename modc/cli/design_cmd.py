@@ -99,12 +99,12 @@ def design_cmd(
     """Find the best module chains for the cells and targets of FILE's design blocks."""
     import json
 
-    from ..compiler import InputError, check_file
+    from ..compiler import InputError, check_file, inputs_of
     from ..design import run as search
     from ..design.write import files as design_files
     from ..design.write import ranking, summary_line
     from ..diagnostics import codes
-    from ..outputs import check_output_dir, inputs_of, write_tree
+    from ..outputs import check_output_dir, write_tree
 
     try:
         checked = check_file(file, library)

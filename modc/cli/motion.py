@@ -74,7 +74,8 @@ def render_cmd(
         _err(f"modc render: --colors {colors}: expected 2 to 256")
         raise SystemExit(EXIT_USAGE)
     with usage_errors("render", (UsageError,), writing=out):
-        from ..outputs import check_output_file, inputs_of
+        from ..compiler import inputs_of
+        from ..outputs import check_output_file
 
         check_output_file(out, inputs_of(file, library), "-o", "arm.png")
         ok, lines, checked = render(file, out, pose=pose, robot=robot, library=library, width=width, height=height,
@@ -103,7 +104,8 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
 
     with usage_errors("play", (UsageError,), writing=record):
         if record is not None:
-            from ..outputs import check_output_file, inputs_of
+            from ..compiler import inputs_of
+            from ..outputs import check_output_file
 
             check_output_file(record, inputs_of(file, library, more=[traj]), "--record", "motion.gif")
         ok, lines, checked = play(
