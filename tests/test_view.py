@@ -155,9 +155,9 @@ def test_saving_rechecks_and_an_error_keeps_the_last_good_arm(tmp_path):
     assert page.q[0] == 0.4  # same joints: the sliders stay where they were
     assert dict(page.arm.poses)["ready"][0] == pytest.approx(math.radians(10))
 
-    _write(f, LONGER)
+    _write(f, LONGER)  # one more module: the joints it had keep their values, the new one starts at home
     assert page.poll()
-    assert page.arm.dof == 4 and page.q == page.arm.robot.home()
+    assert page.arm.dof == 4 and page.q == (0.4, 0.0, 0.0, page.arm.robot.home()[3])
 
 
 def test_a_file_that_starts_broken_shows_an_arm_once_fixed(tmp_path):
@@ -167,6 +167,94 @@ def test_a_file_that_starts_broken_shows_an_arm_once_fixed(tmp_path):
     assert page.arm is None and page.source.errors
     _write(f, GOOD)
     assert page.poll() and page.arm is not None and page.q == page.arm.robot.home()
+
+
+HEAVY = "robot heavy {\n    chain H1 - H4(pivot=-90deg) - L3\n    payload 5 kg\n    target far at (0.3, 0, 0.2) m\n}\n"
+
+
+def test_the_page_shows_what_the_compile_says_and_the_module_it_names(tmp_path):
+    """`modc FILE -o OUT` refuses an arm whose elbow cannot hold 5 kg (torque-over-peak): the page
+    says so too, still draws the arm, and names the module."""
+    from modc.compiler import COMPILE_ANALYSES
+    from modc.diagnostics.render import render_text
+
+    f = tmp_path / "heavy.mod"
+    _write(f, HEAVY)
+    page = Page([Source(f)])
+    compiled = check_file(f, analyses=COMPILE_ANALYSES, torque_severity="error")
+    assert not compiled.ok and "torque-over-peak" in {d.code for d in compiled.diagnostics}
+    assert page.source.diagnostics == render_text(compiled.diagnostics, compiled.sources)
+    assert page.source.errors and page.arm is not None and page.source.current
+    named = {page.arm.unit_named(d) for d in page.source.found if d.code == "torque-over-peak"}
+    assert named == {2}  # L3, the third module
+    assert {s.unit for s in page.arm.shapes()} == {0, 1, 2}
+
+
+def test_each_part_belongs_to_its_module():
+    """Shapes per module are exactly that module's parts (physical.parts.unit_parts)."""
+    from collections import Counter
+
+    from modc.physical.parts import unit_parts
+
+    arm = Arm(_robot())
+    got = Counter(s.unit for s in arm.shapes())
+    lib = arm.robot.library
+    want = {i: len(unit_parts(lib, u.variant, u.kind, arm.robot.link_length(u))) for i, u in enumerate(arm.robot.units)}
+    assert dict(got) == want
+    meshes = {i: sorted(s.name.rsplit("_", 1)[0] for s in arm.shapes() if s.unit == i) for i in want}
+    for i, u in enumerate(arm.robot.units):
+        assert meshes[i] == sorted(p.mesh for p in unit_parts(lib, u.variant, u.kind, arm.robot.link_length(u)))
+
+
+FLOOR = ("robot arm {\n    chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)\n"
+         "    box floor size (0.8, 0.8, 0.02) m at (0, 0, -0.01) m\n"
+         "    target plant at (0.25, 0.1, 0.2) m\n    target tray at (0.25, 0.05, 0.22) m rpy (0, 90, 0) deg\n}\n")
+
+
+def test_contacts_are_the_planner_s(tmp_path):
+    """Bending the shoulder down puts the arm into the floor: the page lists what `modc plan`'s
+    checker (the URDF's collision meshes, the SRDF's disabled pairs, the obstacles) finds."""
+    from modc.plan.collision import CollisionChecker
+
+    f = tmp_path / "floor.mod"
+    _write(f, FLOOR)
+    page = Page([Source(f)])
+    arm = page.arm
+    assert arm.contacts(page.q) == []
+    page.set_joint(1, arm.limits[1][1])
+    got = arm.contacts(page.q)
+    assert {(c.a, c.b) for c in got} >= {("link_2", "floor")}
+    assert got == CollisionChecker(arm.robot).contacts(page.q)
+
+
+def test_framing_fits_the_scene_beside_the_panel():
+    from modc.view.camera import ASPECT, PANEL, frame, project
+
+    arm = Arm(_robot())
+    pts = arm.extent(arm.robot.home())
+    cam = frame(pts, math.radians(210), math.radians(30))
+    p = project(pts, cam)
+    assert p[:, 0].min() >= -1 and p[:, 0].max() <= 1 - 2 * PANEL and abs(p[:, 1]).max() <= 1
+    # as close as that allows: the scene spans the free area's width or its height, nearly
+    span = max((p[:, 0].max() - p[:, 0].min()) / (2 - 2 * PANEL), (p[:, 1].max() - p[:, 1].min()) / 2)
+    assert span > 0.75, span
+    assert ASPECT > 1
+
+
+def test_labels_do_not_overlap_on_screen(tmp_path):
+    from modc.view import draw
+    from modc.view.camera import HEIGHT, frame, project
+
+    f = tmp_path / "floor.mod"
+    _write(f, FLOOR)
+    arm = Page([Source(f)]).arm
+    cam = frame(arm.extent(arm.robot.home()), math.radians(210), math.radians(30))
+    targets = arm.robot.targets
+    lifts = draw.label_lifts(targets, cam, arm.T_world_base)
+    anchors = project(np.array([np.asarray(t.xyz) + d for t, d in zip(targets, lifts, strict=True)]), cam)
+    y = (1 - anchors[:, 1]) / 2 * HEIGHT
+    assert abs(y[0] - y[1]) >= draw.LABEL_HEIGHT - 1  # the two targets are 5 cm apart: stacked
+    assert [draw.target_label(t) for t in targets] == ["plant ±5 mm", "tray ±5 mm, ±2°"]
 
 
 def test_several_robots_need_a_choice(tmp_path):

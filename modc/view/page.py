@@ -13,7 +13,8 @@ import json
 import os
 from pathlib import Path
 
-from ..compiler import InputError, check_file
+from ..compiler import COMPILE_ANALYSES, InputError, check_file
+from ..diagnostics import Diagnostic, codes
 from ..diagnostics.render import render_text
 from ..model.select import RobotChoiceError, choose_robot
 from ..sim import trajectory
@@ -32,10 +33,17 @@ def _stamp(path: Path) -> tuple[int, int] | None:
     return (st.st_mtime_ns, st.st_size)
 
 
+# Errors of an arm that is well formed but too weak: `modc FILE -o OUT` refuses it, the page
+# shows it (with the error and the module named) so the user sees what to change.
+DRAWABLE_ERRORS = frozenset({codes.TORQUE_OVER_PEAK.name})
+
+
 class Source:
-    """One .mod file, checked again whenever it changes. `arm` is the last good robot (None
-    until the file first checks without errors); `diagnostics` the text of the last check's
-    diagnostics (errors and warnings), empty when there are none."""
+    """One .mod file, checked again whenever it changes, as `modc FILE -o OUT` checks it (torque
+    analysis included). `arm` is the last good robot (None until the file first checks without
+    errors other than DRAWABLE_ERRORS); `diagnostics` the text of the last check's diagnostics
+    (errors and warnings), empty when there are none; `found` the same as Diagnostic objects, and
+    `current` whether `arm` is the one they are about."""
 
     def __init__(self, path: str | os.PathLike, robot: str | None = None, library: str | None = None,
                  traj: trajectory.Trajectory | None = None):
@@ -46,6 +54,8 @@ class Source:
         self.arm: Arm | None = None
         self.trajectory: trajectory.Trajectory | None = None  # traj in joint_1..n order, when it fits the arm
         self.diagnostics = ""
+        self.found: list[Diagnostic] = []
+        self.current = False
         self.errors = False
         self.generation = 0  # counts arms: the page rebuilds its scene when it changes
         self._stamp: tuple[int, int] | None = None
@@ -54,18 +64,22 @@ class Source:
         """Check the file now. strict: an unreadable file or an unknown robot raises (the first
         load, which is a command-line error) instead of showing in the page."""
         self._stamp = _stamp(self.path)
+        self.current = False
         try:
-            checked = check_file(self.path, self.library)
+            checked = check_file(self.path, self.library, analyses=COMPILE_ANALYSES, torque_severity="error")
             say = '--robot NAME, or "robot" in the trajectory file' if self.traj is not None else "--robot NAME"
-            robot = choose_robot(checked.design, self.robot_name, say=say) if checked.ok else None
+            drawable = all(d.code in DRAWABLE_ERRORS for d in checked.diagnostics if d.is_error)
+            robot = choose_robot(checked.design, self.robot_name, say=say) if drawable else None
         except (InputError, RobotChoiceError) as e:
             if strict:
                 raise
-            self.diagnostics, self.errors = render_text([e.diagnostic]), True
+            self.diagnostics, self.found, self.errors = render_text([e.diagnostic]), [e.diagnostic], True
             return
         self.diagnostics, self.errors = render_text(checked.diagnostics, checked.sources), not checked.ok
+        self.found = list(checked.diagnostics)
         if robot is None:
             return
+        self.current = True
         self.arm = Arm(robot)
         self.generation += 1
         self.trajectory = None
@@ -168,11 +182,14 @@ class Page:
         self._follow()
 
     def _follow(self) -> None:
-        """A new arm keeps the joint values when it has as many joints (clamped to its ranges), else goes home."""
+        """A new arm of the same file keeps the joint values (clamped to its ranges; joints it
+        adds start at home); a design shown for the first time starts at home."""
         arm = self.arm
         if arm is None or self._shown == self.source.generation:
             return
-        self.q = arm.clamp(self.q) if len(self.q) == arm.dof and self._shown != -1 else arm.poses[0][1]
+        home = arm.poses[0][1]
+        kept = self.q[: arm.dof] if self._shown != -1 else ()
+        self.q = arm.clamp(tuple(kept) + tuple(home[len(kept):]))
         self._shown = self.source.generation
         self.playing, self.t = False, 0.0
 

@@ -15,21 +15,13 @@ import math
 import threading
 import time
 
-import numpy as np
-
-from ..kinematics import transform
-from .arm import OBSTACLE_RGB, TARGET_RADIUS, TARGET_RGB, Arm
+from . import draw
+from .arm import COLLISION_RGB, NAMED_RGB, Arm
+from .camera import Camera
 from .page import Page
 
-CAMERA_DISTANCE = 2.0  # bounding-sphere radii, so the scene fills the view beside the control panel
 PANEL_TEXT = "padding:0 0.75em;font-size:0.9em"  # HTML blocks aligned with viser's own panel text
 TICK = 0.05  # s between looks at the file and playback steps: a saved file shows well within a second
-
-
-def _wxyz(T: np.ndarray) -> np.ndarray:
-    from viser.transforms import SO3
-
-    return SO3.from_matrix(T[:3, :3]).wxyz
 
 
 def torque_table(arm: Arm, q) -> str:
@@ -58,12 +50,17 @@ class View:
         self.url = ""  # the page's address with its token, set by start()
         self.lock = threading.RLock()
         self._generation = (-1, -1)  # (design index, arm generation) on show
+        self._framed: int | None = None  # design index the connected browsers' cameras were framed on
         self._diagnostics: str | None = None
         self._nodes: list = []
         self._shown = 0
         self._gui: list = []
         self._links: dict = {}
+        self._meshes: list = []  # (Shape, handle, colour shown)
         self._sliders: list = []
+        self.camera: Camera | None = None  # the framing camera of the arm on view
+        self.contacts: list = []  # what touches at the pose shown (plan.collision.Contact)
+        self.named: dict[int, str] = {}  # module index -> "error" | "warning": modules the diagnostics name
         gui = server.gui
         server.scene.set_up_direction("+z")
         server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1, section_size=0.5)
@@ -73,6 +70,7 @@ class View:
             prev.on_click(lambda e: self._go(-1))
             nxt.on_click(lambda e: self._go(+1))
         self._errors = gui.add_html("", visible=False)
+        self._contacts = gui.add_html("")
         self._rebuild()
 
     # -- building -----------------------------------------------------------------------------
@@ -80,7 +78,7 @@ class View:
     def _clear(self) -> None:
         for h in self._nodes[:1] + self._gui:  # the arm's root node takes everything under it along
             h.remove()
-        self._nodes, self._gui, self._links, self._sliders = [], [], {}, []
+        self._nodes, self._gui, self._links, self._sliders, self._meshes = [], [], {}, [], []
 
     def _rebuild(self) -> None:
         self._build()
@@ -93,37 +91,28 @@ class View:
         who = (f"robot <code>{html.escape(arm.robot.name)}</code>: {html.escape(arm.robot.sequence)}" if arm is not None
                else "no good arm yet")
         self._title.content = f'<div style="{PANEL_TEXT}"><b>{html.escape(page.caption)}</b><br>{who}</div>'
+        self._diagnostics = None
         self._show_diagnostics()
         if arm is None:
+            self._framed = None
+            self._contacts.content = ""
             return
         scene, gui = self.server.scene, self.server.gui
         T = arm.T_world_base
         self._shown += 1
         base = f"/arm{self._shown}"  # fresh names for every arm: browsers never see a name removed and re-added
-        self._nodes.append(scene.add_frame(base, show_axes=False, position=T[:3, 3], wxyz=_wxyz(T)))
-        for ob in arm.robot.obstacles:
-            T_ob = transform(ob.origin.xyz, ob.origin.rpy)
-            kw = dict(color=OBSTACLE_RGB, opacity=0.6, position=T_ob[:3, 3], wxyz=_wxyz(T_ob))
-            name = f"{base}/cell/{ob.name}"
-            if ob.shape == "box":
-                h = scene.add_box(name, dimensions=tuple(ob.size), **kw)
-            elif ob.shape == "sphere":
-                h = scene.add_icosphere(name, radius=ob.size[0], **kw)
-            else:
-                h = scene.add_cylinder(name, radius=ob.size[0], height=ob.size[1], **kw)
-            self._nodes.append(h)
-        for t in arm.robot.targets:
-            name = f"{base}/targets/{t.name}"
-            self._nodes.append(scene.add_icosphere(name, radius=TARGET_RADIUS, color=TARGET_RGB, position=tuple(t.xyz)))
-            self._nodes.append(scene.add_label(f"{name}/label", t.name, position=(0.0, 0.0, 0.03)))
+        self._nodes.append(scene.add_frame(base, show_axes=False, position=T[:3, 3], wxyz=draw.wxyz(T)))
+        cam = self._camera(arm)
+        self._nodes += draw.cell(scene, base, arm, cam)
         for link in arm.description.links:
             self._links[link.name] = scene.add_frame(f"{base}/{link.name}", show_axes=link.name == "tool0",
-                                                     axes_length=0.05, axes_radius=0.003)
+                                                     axes_length=draw.AXES, axes_radius=0.003)
             self._nodes.append(self._links[link.name])
+        self._nodes += draw.tool_and_payload(scene, base, arm)
         for s in arm.shapes():
-            name = f"{base}/{s.link}/{s.name}"
-            self._nodes.append(scene.add_mesh_simple(name, s.vertices, s.faces, color=s.rgb, flat_shading=True))
-        self._camera(arm)
+            h = scene.add_mesh_simple(f"{base}/{s.link}/{s.name}", s.vertices, s.faces, color=s.rgb, flat_shading=True)
+            self._meshes.append([s, h, s.rgb])
+            self._nodes.append(h)
 
         joints = gui.add_folder("Joints")
         self._gui.append(joints)
@@ -140,6 +129,8 @@ class View:
             for name, _ in arm.poses:
                 b = gui.add_button(name)
                 b.on_click(self._on_pose(name))
+            reset = gui.add_button("frame the arm")
+            reset.on_click(lambda e: self._locked(lambda: self._camera(arm, everyone=True)))
         readout = gui.add_folder("tool0 and torques")
         self._gui.append(readout)
         with readout:
@@ -157,32 +148,76 @@ class View:
                 self._time.on_update(self._on_time)
         self._move()
 
-    def _camera(self, arm: Arm) -> None:
-        """New browsers look at what `modc render` frames (the arm at home, its cell and targets)
-        from render's canonical view (front left, above, as RViz's default orbit camera)."""
+    def _camera(self, arm: Arm, everyone: bool = False) -> Camera:
+        """The arm at its pose with its cell and targets, framed beside the panel (camera.py), for
+        new browsers and "reset view"; browsers already open are framed too when they had no arm
+        to look at, see a new design, or ask (everyone)."""
         from ..sim.render import VIEWS
-        from ..sim.scene import extent_points
+        from .camera import frame
 
-        pts = extent_points(arm.robot, arm.poses[0][1], arm.T_world_base)
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        centre, radius = (lo + hi) / 2, max(float(np.linalg.norm(hi - lo)) / 2, 0.2)
-        az, el = (math.radians(a) for a in VIEWS[0])
-        direction = np.array((math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)))
-        self.server.initial_camera.look_at = tuple(centre)
-        self.server.initial_camera.position = tuple(centre + direction * CAMERA_DISTANCE * radius)
+        cam = frame(arm.extent(self.page.q), math.radians(VIEWS[0][0]), math.radians(VIEWS[0][1]))
+        self.camera = cam
+        initial = self.server.initial_camera
+        initial.fov, initial.look_at, initial.position = cam.fov, tuple(cam.look_at), tuple(cam.position)
+        if everyone or self._framed != self.page.index:
+            self._framed = self.page.index
+            for client in self.server.get_clients().values():
+                with client.atomic():
+                    client.camera.fov = cam.fov
+                    client.camera.look_at = tuple(cam.look_at)
+                    client.camera.position = tuple(cam.position)
+        return cam
 
     def _show_diagnostics(self) -> None:
         text = self.page.source.diagnostics
         if text == self._diagnostics:
             return
         self._diagnostics = text
-        errors, arm = self.page.source.errors, self.page.arm
-        head = "errors: showing the last good arm" if errors and arm is not None else "errors" if errors else "warnings"
+        source, arm = self.page.source, self.page.arm
+        errors = source.errors
+        shown_is_checked = arm is not None and source.current
+        head = ("errors: showing the last good arm" if errors and arm is not None and not shown_is_checked
+                else "errors" if errors else "warnings")
         pre = '<pre style="white-space:pre-wrap;font-size:0.72em;margin:4px 0">'
-        self._errors.content = (f'<div style="{PANEL_TEXT}"><b style="color:#b42318">{head}</b>{pre}{html.escape(text)}'
-                                '</pre></div>') if text else ""
+        self.named = {}
+        if shown_is_checked:
+            assert arm is not None
+            for d in sorted(source.found, key=lambda d: not d.is_error):  # errors win over warnings
+                i = arm.unit_named(d)
+                if i is not None:
+                    self.named.setdefault(i, "error" if d.is_error else "warning")
+        marked = ", ".join(f"{arm.robot.units[i].name} ({level})" for i, level in sorted(self.named.items())) \
+            if arm is not None else ""
+        note = f'<div style="font-size:0.8em">highlighted in the view: {html.escape(marked)}</div>' if marked else ""
+        self._errors.content = (f'<div style="{PANEL_TEXT}"><b style="color:#b42318">{head}</b>{note}{pre}'
+                                f'{html.escape(text)}</pre></div>') if text else ""
         self._errors.visible = bool(text)
+        self._paint()
         self.server.flush()
+
+    def _paint(self) -> None:
+        """Colour the meshes: links in contact red, modules a diagnostic names magenta (error) or
+        amber (warning), the rest as the URDF colours them. Only changed colours are sent."""
+        touching = {c.a for c in self.contacts} | {c.b for c in self.contacts if not c.b_is_obstacle}
+        for m in self._meshes:
+            s, h, shown = m
+            rgb = COLLISION_RGB if s.link in touching else NAMED_RGB[self.named[s.unit]] if s.unit in self.named \
+                else s.rgb
+            if rgb != shown:
+                h.color, m[2] = rgb, rgb
+
+    def _show_contacts(self) -> None:
+        arm = self.page.arm
+        assert arm is not None
+        self.contacts = arm.contacts(self.page.q)
+        if self.contacts:
+            rows = "".join(f"<li>{html.escape(c.describe())}</li>" for c in self.contacts)
+            self._contacts.content = (f'<div style="{PANEL_TEXT}" data-contacts="{len(self.contacts)}">'
+                                      f'<b style="color:#b42318">in contact</b> (as <code>modc plan</code> checks)'
+                                      f'<ul style="margin:2px 0;padding-left:1.2em;font-size:0.85em">{rows}</ul></div>')
+        else:
+            self._contacts.content = '<div style="padding:0 0.75em;font-size:0.8em" data-contacts="0">no contact</div>'
+        self._paint()
 
     def _show_pose(self) -> None:
         with self.server.atomic():  # every link moves in the same frame
@@ -196,12 +231,13 @@ class View:
         for name, T in arm.link_poses(page.q).items():
             if name in self._links:
                 self._links[name].position = T[:3, 3]
-                self._links[name].wxyz = _wxyz(T)
+                self._links[name].wxyz = draw.wxyz(T)
         for s, x in zip(self._sliders, page.q, strict=True):
             s.value = round(math.degrees(x), 1)
         x, y, z = arm.tool0(page.q)
         self._tool.content = f"tool0 in base_link: ({x:.4f}, {y:.4f}, {z:.4f}) m"
         self._torques.content = torque_table(arm, page.q)
+        self._show_contacts()
         if page.source.trajectory is not None:
             self._time.value = round(page.t, 3)
 
