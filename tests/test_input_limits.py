@@ -150,7 +150,7 @@ def test_design_workers_are_capped_at_the_cpu_count(tmp_path):
     assert "capped" not in r.stderr
 
 
-@pytest.mark.parametrize("scheduler", ["tls://127.0.0.1:8786", "ucx://127.0.0.1:8786", "inproc://x",
+@pytest.mark.parametrize("scheduler", ["tls://127.0.0.1:8786", "ucx://127.0.0.1:8786", "ws://x:1",
                                        "tl\x1bs://x"])
 def test_design_scheduler_schemes_modc_cannot_use_are_refused(tmp_path, scheduler):
     """tls:// needs certificates and ucx:// a package modc does not ship: both gave tracebacks

@@ -22,7 +22,9 @@ def _cap_workers(_ctx: click.Context, _param: click.Parameter, value: int) -> in
     return min(value, cpus)
 
 
-SCHEDULER_SCHEMES = ("tcp",)  # what `distributed` connects to without extra packages or TLS settings
+# what `distributed` connects to without extra packages or TLS settings (inproc: a cluster in
+# this same process, as the API and the tests start one)
+SCHEDULER_SCHEMES = ("tcp", "inproc")
 
 
 def _scheduler(_ctx: click.Context, _param: click.Parameter, value: str | None) -> str | None:
