@@ -290,3 +290,73 @@ def read_bounded(path: str | os.PathLike, limit: int) -> tuple[bytes, int]:
         return b"".join(chunks), max(st.st_size, got)
     finally:
         os.close(fd)
+
+
+# --- reading JSON inputs (trajectory files, ranking.json) under the limits of .mod files -------
+
+MAX_JSON_BYTES = 16_000_000  # a planned trajectory is tens of kB; a ranking.json a few
+MAX_JSON_DEPTH = 32  # a trajectory nests 3 levels, a ranking.json 4
+
+
+class InputProblem(ValueError):
+    """Bytes of an input file modc will not take (too large, not UTF-8, not JSON, nested too
+    deeply). The message quotes none of the file; line and col (1-based) say where, if known."""
+
+    def __init__(self, message: str, line: int = 1, col: int = 1, offset: int = 0):
+        super().__init__(message)
+        self.line, self.col, self.offset = line, col, offset
+
+
+def _position(text: str, offset: int) -> tuple[int, int]:
+    line = text.count("\n", 0, offset) + 1
+    return line, offset - (text.rfind("\n", 0, offset) + 1) + 1
+
+
+def read_text(path: str | os.PathLike, limit: int) -> str:
+    """A regular file's UTF-8 text (a BOM dropped). OSError when it cannot be read or is not a
+    regular file (a FIFO, a device, a directory: refused before anything is read);
+    InputProblem when it is larger than limit bytes or not UTF-8."""
+    data, size = read_bounded(path, limit)
+    if size > limit:
+        raise InputProblem(f"the file is too large ({size:,} bytes; the limit is {limit:,} bytes)")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        before = data[: e.start].decode("utf-8-sig")
+        line, col = _position(before, len(before))
+        raise InputProblem(f"the file is not UTF-8 text (byte 0x{data[e.start]:02x} at line {line}, column {col})",
+                           line, col, len(before)) from None
+
+
+_JSON_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"?|[\[\]{}]')
+
+
+def _check_depth(text: str, limit: int) -> None:
+    """InputProblem at the first bracket nested deeper than limit (Python's json recurses)."""
+    if text.count("[") + text.count("{") <= limit:
+        return
+    depth = 0
+    for m in _JSON_TOKEN.finditer(text):
+        c = m.group()
+        if c in "[{":
+            depth += 1
+            if depth > limit:
+                line, col = _position(text, m.start())
+                raise InputProblem(f"nested more than {limit} levels deep at line {line}, column {col}",
+                                   line, col, m.start())
+        elif c in "]}":
+            depth -= 1
+
+
+def read_json(path: str | os.PathLike, limit: int = MAX_JSON_BYTES, depth: int = MAX_JSON_DEPTH):
+    """A JSON input file, read as .mod files are (read_text) and at most depth levels deep.
+    OSError when it cannot be read; InputProblem when its content is not acceptable JSON."""
+    text = read_text(path, limit)
+    _check_depth(text, depth)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        where = f"at line {e.lineno}, column {e.colno}"
+        raise InputProblem(f"not JSON: {e.msg} {where}", e.lineno, e.colno, e.pos) from None
+    except (ValueError, RecursionError):  # an integer of more than 4,300 digits
+        raise InputProblem("not JSON modc can read: a number with too many digits") from None

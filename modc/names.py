@@ -12,6 +12,12 @@ in both input forms and in library files, so no backend ever sees anything else:
     label        a library's own name: the grammar's LIBRARY_REF (mark2-strict), at most MAX_NAME
     text         free text (descriptions, actuator models, sources): no control or line-breaking
                  characters, at most MAX_TEXT characters
+    ROS package  --ros-package (REP 144): lowercase letters, digits and single underscores,
+                 starting with a letter and not ending with '_', at most MAX_PACKAGE characters
+                 (a robot's name and _moveit_config fit)
+
+Every rule matches the WHOLE string (re.fullmatch): `^…$` with re.match would let a trailing
+newline through ("pkg\n"), and that newline would reach launch files and package:// URIs.
 
 Each rule is one function returning why a string breaks it (None when it does not), so the model's
 validators, lowering and the library loader share the wording.
@@ -24,7 +30,9 @@ import unicodedata
 IDENTIFIER = r"[A-Za-z_][A-Za-z0-9_]*"
 VARIANT = r"[A-Za-z]+"
 LABEL = r"[A-Za-z_][A-Za-z0-9_.-]*"
+ROS_PACKAGE = r"[a-z][a-z0-9_]*"
 MAX_NAME = 64
+MAX_PACKAGE = 100
 MAX_VARIANT = 16
 MAX_TEXT = 500
 
@@ -33,6 +41,7 @@ IDENTIFIER_RULE = f"ASCII letters, digits and '_', not starting with a digit, at
 _IDENTIFIER = re.compile(IDENTIFIER)
 _VARIANT = re.compile(VARIANT)
 _LABEL = re.compile(LABEL)
+_ROS_PACKAGE = re.compile(ROS_PACKAGE)
 # Cc/Cf/Cs/Co/Cn: controls, format (bidi overrides), surrogates, private use, unassigned;
 # Zl/Zp: U+2028/U+2029, which YAML and JavaScript take for line breaks.
 _BAD_CATEGORIES = {"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"}
@@ -73,6 +82,15 @@ def variant_problem(text: str) -> str | None:
 
 def label_problem(text: str) -> str | None:
     return _check(text, _LABEL, MAX_NAME, "a library name")
+
+
+def ros_package_problem(text: str) -> str | None:
+    """REP 144's package names."""
+    what = "a ROS package name"
+    problem = _check(text, _ROS_PACKAGE, MAX_PACKAGE, what)
+    if problem is None and ("__" in text or text.endswith("_")):
+        problem = f"{what} has single underscores, not at the end"
+    return problem
 
 
 def text_problem(text: str) -> str | None:

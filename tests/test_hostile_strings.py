@@ -73,6 +73,32 @@ def test_the_rule_accepts_identifiers_up_to_the_limit():
         Pose(name=good, q=())
 
 
+RULES = {"identifier": (names.identifier_problem, "joint_1"), "variant": (names.variant_problem, "H"),
+         "label": (names.label_problem, "mark2-strict"),
+         "ros package": (names.ros_package_problem, "farm_moveit_config")}
+
+
+@pytest.mark.parametrize("rule", RULES)
+@pytest.mark.parametrize("tail", ["\n", "\r\n", "\n\n", " ", "\x00"], ids=repr)
+def test_every_rule_matches_the_whole_string(rule, tail):
+    """`^…$` with re.match lets a trailing newline through; every rule refuses it."""
+    problem, good = RULES[rule]
+    assert problem(good) is None
+    assert problem(good + tail) is not None
+
+
+def test_ros_package_with_a_trailing_newline_is_refused(tmp_path):
+    """It reached package:// URIs and launch files, one line too many."""
+    src = tmp_path / "a.mod"
+    src.write_text(FARM)
+    for bad in ("farm_pkg\n", "farm_pkg\r\n", "farm__pkg", "farm_pkg_", "Farm"):
+        r = subprocess.run([sys.executable, "-m", "modc", str(src), "-o", str(tmp_path / "out"), "--ros", "2",
+                            "--ros-package", bad], capture_output=True, text=True)
+        assert r.returncode == 2 and "is not a valid ROS package name" in r.stderr, (bad, r.stderr)
+        assert "\n'" not in r.stderr.replace("\\n'", "")  # the name is shown escaped, on one line
+        assert not (tmp_path / "out").exists()
+
+
 # --- names in the YAML form ------------------------------------------------------------------------
 
 def _yaml_robot(kind: str, name: str) -> tuple[str, str]:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 
@@ -72,7 +73,7 @@ def test_user_library_file_is_used(tmp_path):
 
 
 @pytest.mark.parametrize("mutation, fragment", [
-    (("mass: 0.57", "mass: -1"), "mass: must be greater than 0"),
+    (("mass: 0.57", "mass: -1"), "mass: must be at least 1e-06"),
     (("epsilon: 3", "epsilon: 0"), "epsilon: must be at least 1"),
     (("max_dof: 6", 'max_dof: "six"'), "max_dof: expected a whole number"),
     (("first_variant: H", "first_variant: X"), "variant 'X'"),
@@ -85,3 +86,112 @@ def test_invalid_library_is_a_diagnostic(tmp_path, mutation, fragment):
     assert [d.code for d in c.diagnostics] == ["library-invalid"]
     assert fragment in c.diagnostics[0].message
     assert "Input should" not in c.diagnostics[0].message  # the author's words, not pydantic's
+
+
+# --- a file that is not a module library is never quoted (issue 21, item 6) ---------------------
+
+SECRET = "hunter2-do-not-print"
+NOT_LIBRARIES = {
+    "passwd": f"root:x:0:0:{SECRET}:/root:/bin/bash\ndaemon:x:1:1::/:/sbin/nologin\n",
+    "dotenv": f"API_TOKEN={SECRET}\nDEBUG=1\n",
+    "yaml-secrets": f"password: {SECRET}\nuser: admin\n",
+    "yaml-secret-key": f"{SECRET}: 1\nname: x\n",  # library keys beside a foreign one: still not a library
+    "yaml-list": f"- {SECRET}\n- b\n",
+    "broken-yaml": f"token: [{SECRET}\nother: {{\n",
+    "bad-character": f"key: {SECRET}\n\tx: @{SECRET}\n",
+    "json": f'{{"token": "{SECRET}"}}\n',
+    "empty": "",
+}
+
+
+@pytest.mark.parametrize("kind", NOT_LIBRARIES)
+def test_a_file_that_is_not_a_library_is_never_quoted(tmp_path, kind):
+    """`library "PATH"` in an untrusted .mod (lint in pre-commit or CI) may name /etc/passwd or a
+    .env file: the diagnostic says what kind of file it is not, and no line, key or character of
+    it reaches any output format."""
+    from modc.diagnostics.render import render_github, render_json, render_sarif, render_text
+
+    (tmp_path / "lib.txt").write_text(NOT_LIBRARIES[kind])
+    src = tmp_path / "arm.mod"
+    src.write_text('robot r {\n    library "lib.txt"\n    chain H1 - L1\n}\n')
+    c = check_text(src.read_text(), str(src))
+    assert [d.code for d in c.diagnostics] == ["library-invalid"]
+    d = c.diagnostics[0]
+    assert "not a module library" in d.message
+    assert (d.span.file, d.span.line) == (str(src), 2)  # at the reference, not inside the file
+    assert str(tmp_path / "lib.txt") not in c.sources
+    outputs = [render_text(c.diagnostics, c.sources), render_json(c.diagnostics), render_github(c.diagnostics),
+               render_sarif(c.diagnostics, "0", tmp_path, c.sources)]
+    assert not any(SECRET in out for out in outputs)
+    r = subprocess.run([sys.executable, "-m", "modc", "lint", str(src)], capture_output=True, text=True)
+    assert r.returncode == 1 and "not a module library" in r.stderr and SECRET not in r.stderr + r.stdout
+
+
+def test_a_file_that_is_not_utf8_is_not_quoted(tmp_path):
+    (tmp_path / "lib.bin").write_bytes(b"name: \xff\xfe" + SECRET.encode())
+    c = check_text('robot r { library "lib.bin" chain H1 - L1 }', str(tmp_path / "a.mod"))
+    assert [d.code for d in c.diagnostics] == ["library-invalid"]
+    assert "not UTF-8" in c.diagnostics[0].message and SECRET not in c.diagnostics[0].message
+
+
+def test_a_library_is_quoted_once_it_parses(tmp_path):
+    """A file with the library's keys is the user's library: its lines are shown with a caret."""
+    text = (ROOT / "libraries" / "mark2.yaml").read_text().replace("epsilon: 3", "epsilon: 0", 1)
+    (tmp_path / "lib.yaml").write_text(text)
+    c = check_text('robot r { library "lib.yaml" chain H1 - L1 }', str(tmp_path / "a.mod"))
+    from modc.diagnostics.render import render_text
+
+    assert "epsilon: 0" in render_text(c.diagnostics, c.sources)
+
+
+# --- every library number has a range (issue 21, item 8) -----------------------------------------
+
+_NUMBER_LINE = re.compile(r"^(\s*[a-z_0-9]+:\s*)(-?[0-9][0-9.e+-]*)(\s*(#.*)?)$")
+MARK2 = (ROOT / "libraries" / "mark2.yaml").read_text()
+NUMBER_LINES = [i for i, line in enumerate(MARK2.split("\n")) if _NUMBER_LINE.match(line)]
+EXTREMES = ["1e308", "-1e308", "1e-320", ".nan", "-.inf", "1e400", str(10**30), str(10**400)]
+
+
+def _with(line: int, value: str) -> str:
+    lines = MARK2.split("\n")
+    m = _NUMBER_LINE.match(lines[line])
+    assert m is not None
+    lines[line] = m.group(1) + value + m.group(3)
+    return "\n".join(lines)
+
+
+@pytest.mark.parametrize("value", EXTREMES)
+def test_extreme_library_numbers_are_diagnostics(tmp_path, value):
+    """Every number of the library set to an extreme: a diagnostic or a working arm, never a
+    traceback (the torque analysis crashed on a 1e-320 kg mass and on a 1e308 kg one)."""
+    src = 'robot r {\n    library "lib.yaml"\n    chain H1 - L4(port=45deg) - L1\n}\n'
+    for line in NUMBER_LINES:
+        (tmp_path / "lib.yaml").write_text(_with(line, value))
+        library._load_path.cache_clear()
+        c = check_text(src, str(tmp_path / "a.mod"), analyses={"torque"})
+        errors = [d for d in c.diagnostics if d.is_error]
+        where = MARK2.split("\n")[line].strip()
+        if errors:
+            assert errors[0].code in ("library-invalid", "out-of-range", "not-finite"), (where, errors[0])
+            assert errors[0].span.file == str(tmp_path / "lib.yaml"), where
+        assert not any(re.search(r"\b(inf|nan)\b", d.message) for d in c.diagnostics), where
+
+
+def test_a_huge_peak_torque_is_out_of_range(tmp_path):
+    """Its servo gain (kp = torque / 0.005 rad) would be infinite in the MJCF."""
+    (tmp_path / "lib.yaml").write_text(MARK2.replace("torque_peak: 30.5 ", "torque_peak: 1e300", 1))
+    c = check_text('robot r { library "lib.yaml" chain H1 - L1 }', str(tmp_path / "a.mod"))
+    assert [d.code for d in c.diagnostics] == ["out-of-range"]
+    assert c.diagnostics[0].message == (
+        "variants.H.actuator.torque_peak = 1e+300 N·m is out of range (at most 1e+06 N·m)")
+    assert c.diagnostics[0].span.file == str(tmp_path / "lib.yaml")
+
+
+def test_the_smallest_accepted_sizes_still_build(tmp_path):
+    """A 0.1 mm actuator (the smallest length accepted) still has a mesh: a 1 µm one left no
+    triangles and crashed the collision matrix."""
+    from modc.compiler import build
+
+    (tmp_path / "lib.yaml").write_text(MARK2.replace("diameter: 0.075 ", f"diameter: {library.SMALLEST_LENGTH}", 1))
+    c = checked_ok('robot r { library "lib.yaml" chain H1 - L4(port=45deg) - L1 }', str(tmp_path / "a.mod"))
+    assert "urdf/mod3_r.urdf" in build(c, only=["urdf", "srdf"])

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -223,3 +224,23 @@ def test_caret_under_double_width_characters():
     assert caret.index("^") - len("     | ") == display_width(line[: col - 1]) == (col - 1) + 2
     assert caret.endswith(" ^^^")
     assert display_width("準備") == 4 and display_width("é") == 1 and display_width("e\u0301") == 1
+
+
+def test_sarif_for_a_file_name_that_is_not_utf8(tmp_path):
+    """A file name that is not UTF-8 (bytes Python holds as surrogate escapes) gives valid SARIF:
+    its URI percent-encodes the bytes as they are, and no text holds a lone surrogate (which
+    JSON consumers other than Python reject)."""
+    name = b"bad\xff\xfe.mod"
+    with open(os.path.join(os.fsencode(tmp_path), name), "w") as f:
+        f.write("robot r {\n    chain H1 - L4(port=45deg) - X1\n}\n")
+    missing = os.fsdecode(b"gone\xff.mod")  # file-not-found quotes the name in its message
+    r = subprocess.run([sys.executable, "-m", "modc", "lint", "--format", "sarif", os.fsdecode(name), missing],
+                       capture_output=True, cwd=tmp_path)
+    assert b"Traceback" not in r.stderr, r.stderr.decode(errors="replace")
+    text = r.stdout.decode("utf-8")  # strict: the output is UTF-8
+    assert "\\ud" not in text.lower()  # no escaped lone surrogate anywhere
+    doc = json.loads(text)
+    uris = [loc["physicalLocation"]["artifactLocation"]["uri"]
+            for res in doc["runs"][0]["results"] for loc in res["locations"]]
+    assert "bad%FF%FE.mod" in uris
+    assert all(uri.isascii() for uri in uris)

@@ -15,6 +15,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from .. import names
+
 # name -> (MoveIt kinematics_solver plugin, the package that provides it)
 IK_PLUGINS = {
     "kdl": ("kdl_kinematics_plugin/KDLKinematicsPlugin", "moveit_kinematics"),
@@ -47,7 +49,6 @@ COMMAND_INTERFACES = ("position", "effort")
 DEFAULT_COMMAND_INTERFACE = "position"
 
 PACKAGE_SUFFIX = "_moveit_config"  # the Setup Assistant's own naming: <robot>_moveit_config
-_PACKAGE_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 
 
 # The generated package is the user's: its license and maintainer are theirs to choose
@@ -69,7 +70,7 @@ class RosOptionError(ValueError):
 
 def valid_package_name(name: str) -> bool:
     """REP 144: lowercase letters, digits and single underscores, starting with a letter."""
-    return bool(_PACKAGE_NAME.match(name)) and "__" not in name and not name.endswith("_")
+    return names.ros_package_problem(name) is None  # the whole string: "pkg\n" is not one
 
 
 def package_name(robot_name: str) -> str:
@@ -164,6 +165,6 @@ def resolve(build) -> Target:
     robots = build.design.robots
     package = build.ros_package or package_name(robots[0].name if robots else "modc")
     if not valid_package_name(package):
-        raise RosOptionError(f"'{package}' is not a valid ROS package name "
+        raise RosOptionError(f"'{names.shown(package, 80)}' is not a valid ROS package name "
                              "(lowercase letters, digits and single underscores, starting with a letter)")
     return Target(distro, solver, iface, package, package_license(build.package_license), maintainer(build.maintainer))

@@ -109,14 +109,18 @@ def _along(traj_path: str, design, robots, mass) -> dict:
     from ..dynamics.along import peaks
     from ..dynamics.worst import Dynamics
     from ..model.select import choose_robot
-    from ..sim.trajectory import load, validate_for
+    from ..sim.trajectory import diagnostics, load, validate_for
 
     def invalid(lines) -> NoReturn:
-        _print_diagnostics([codes.TRAJ_INVALID.at(Span.point(traj_path), detail=line) for line in lines], {})
+        _print_diagnostics(diagnostics(traj_path, lines), {})
         raise SystemExit(EXIT_ERRORS)
 
-    with usage_errors("check"):
+    try:
         traj, errors = load(traj_path)
+    except OSError as e:  # missing, a directory, a FIFO, a device: a usage error, as for FILE
+        _print_diagnostics([codes.FILE_NOT_FOUND.at(Span.point(traj_path), path=traj_path,
+                                                    detail=e.strerror or str(e))], {})
+        raise SystemExit(EXIT_USAGE) from None
     if traj is None:
         invalid(errors)
     with usage_errors("check"):

@@ -6,9 +6,32 @@ from contextlib import contextmanager, nullcontext
 
 import click
 
+from .. import names
 from .app import EXIT_ERRORS, EXIT_USAGE, _err, _print_diagnostics, app, argument, library_option, usage_errors
 
 RENDERED = 3  # pictures of the top designs in report.html
+
+
+def _cap_workers(_ctx: click.Context, _param: click.Parameter, value: int) -> int:
+    """More processes than CPUs only add memory and switching: cap at the CPUs this process may use."""
+    import os
+
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if value > cpus:
+        _err(f"modc design: --workers {value} capped at {cpus}, the CPUs this process may use")
+    return min(value, cpus)
+
+
+# what `distributed` connects to without extra packages or TLS settings (inproc: a cluster in
+# this same process, as the API and the tests start one)
+SCHEDULER_SCHEMES = ("tcp", "inproc")
+
+
+def _scheduler(_ctx: click.Context, _param: click.Parameter, value: str | None) -> str | None:
+    scheme = value.partition("://")[0] if value is not None and "://" in value else "tcp"
+    if scheme not in SCHEDULER_SCHEMES:
+        raise click.BadParameter(f"the scheme '{names.shown(scheme, 20)}://' is not supported; give tcp://HOST:PORT")
+    return value
 
 
 @contextmanager
@@ -77,8 +100,9 @@ def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
 @click.option("--max-units", type=click.IntRange(min=1), help="largest chain, over `units`")
 @click.option("--top", type=click.IntRange(min=1), default=5, help="designs to keep")
 @click.option("--seed", type=click.IntRange(min=0), default=0, help="same file and seed, same ranking")
-@click.option("--workers", type=click.IntRange(min=1), default=1, help="local worker processes")
-@click.option("--scheduler", help="run on a Dask cluster: tcp://host:8786")
+@click.option("--workers", type=click.IntRange(min=1), default=1, callback=_cap_workers,
+              help="local worker processes (at most the CPU count)")
+@click.option("--scheduler", callback=_scheduler, help="run on a Dask cluster: tcp://host:8786")
 @click.option("--json", "json_out", is_flag=True, help="print ranking.json on stdout")
 @click.option("--render/--no-render", default=True, help="pictures of the top designs")
 @library_option

@@ -39,14 +39,27 @@ def sim_cmd(file: str, robot: str | None, srdf_from: str | None, library: str | 
     raise SystemExit(EXIT_OK if ok else EXIT_ERRORS)
 
 
+MAX_PIXELS = 4096  # per side: a 4096x4096 RGBA frame is 64 MB; 100000x100000 aborted in TinyRenderer
+
+
+def _angle(limit: float):
+    """A click callback: a finite angle in degrees within ±limit (FloatRange lets nan through)."""
+    def check(_ctx: click.Context, param: click.Parameter, value: float | None) -> float | None:
+        if value is not None and not -limit <= value <= limit:
+            raise click.BadParameter(f"expected degrees from {-limit:g} to {limit:g}")
+        return value
+    return check
+
+
 @app.command("render")
 @argument("file", help=".mod file (or its YAML form)")
 @click.option("-o", "--out", required=True, help="PNG file to write")
 @click.option("--pose", help="named pose (default: home)")
 @click.option("--robot", help="render only this robot of the file")
 @click.option("--size", default="800x600", help="WIDTHxHEIGHT in pixels")
-@click.option("--azimuth", type=float, help="camera azimuth in degrees from +x towards +y (default: chosen)")
-@click.option("--elevation", type=float, help="camera elevation in degrees (default 30)")
+@click.option("--azimuth", type=float, callback=_angle(360.0),
+              help="camera azimuth in degrees from +x towards +y (default: chosen)")
+@click.option("--elevation", type=float, callback=_angle(90.0), help="camera elevation in degrees (default 30)")
 @click.option("--colors", type=int, help="quantise to a palette of this many colours (<= 256) for small files")
 @library_option
 def render_cmd(
@@ -66,9 +79,9 @@ def render_cmd(
 
     try:
         width, height = (int(v) for v in size.lower().split("x"))
-        assert width > 0 and height > 0
+        assert 0 < width <= MAX_PIXELS and 0 < height <= MAX_PIXELS
     except (ValueError, AssertionError):
-        _err(f"modc render: --size {size!r}: expected WIDTHxHEIGHT, e.g. 800x600")
+        _err(f"modc render: --size {size[:40]!r}: expected WIDTHxHEIGHT, each 1 to {MAX_PIXELS}, e.g. 800x600")
         raise SystemExit(EXIT_USAGE) from None
     if colors is not None and not 2 <= colors <= 256:
         _err(f"modc render: --colors {colors}: expected 2 to 256")

@@ -7,6 +7,7 @@ same for one process, a local pool or a Dask cluster.
 """
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor
@@ -42,6 +43,8 @@ class Outcome:
         far = {t: d for t, d in self.closest.items() if d > 0}
         if far:
             name = max(far, key=lambda t: far[t])
+            if not math.isfinite(far[name]):  # closest starts at inf: never print it
+                return f"target '{name}': no design was measured against it"
             return f"target '{name}': no design gets closer than {_length(far[name])}"
         if self.rejections:
             return (f"{len(self.rejections)} chains reach every target, but none passes the checks "
@@ -50,7 +53,9 @@ class Outcome:
 
 
 def _length(x: float) -> str:
-    return f"{x:.3g} m" if x >= 0.1 else f"{x * 1000:.3g} mm"
+    from ..model.quantities import distance
+
+    return distance(x)
 
 
 def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> float:

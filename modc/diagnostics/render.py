@@ -98,9 +98,16 @@ def sarif_location(file: str, root: Path) -> dict:
     try:
         rel = path.relative_to(root)
     except ValueError:
-        return {"uri": path.as_uri()}
-    # quote() encodes ' ', '#', '%', ':' and non-ASCII (as UTF-8): a reference, never a scheme.
-    return {"uri": quote(rel.as_posix(), safe="/"), "uriBaseId": SARIF_ROOT}
+        return {"uri": path.as_uri()}  # pathlib quotes os.fsencode(path): any bytes
+    # quote() encodes ' ', '#', '%', ':' and non-ASCII: a reference, never a scheme. The name's
+    # bytes, not its str: a name that is not UTF-8 (surrogate escapes) is percent-encoded as is.
+    return {"uri": quote(os.fsencode(rel.as_posix()), safe="/"), "uriBaseId": SARIF_ROOT}
+
+
+def _unicode(text: str) -> str:
+    """text without lone surrogates (a file name that is not UTF-8, quoted in a message): JSON
+    consumers other than Python reject them. Each undecodable byte becomes U+FFFD."""
+    return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
 
 
 def _template_text(template: str) -> str:
@@ -113,7 +120,7 @@ def _fingerprint(d: Diagnostic, uri: str, sources: Mapping[str, str]) -> str:
     not its number."""
     lines = sources.get(d.span.file, "").split("\n")
     line = lines[d.span.line - 1].strip() if 1 <= d.span.line <= len(lines) else ""
-    key = "\0".join((d.code, uri, d.message, line))
+    key = "\0".join((d.code, uri, _unicode(d.message), _unicode(line)))
     return hashlib.sha256(key.encode("utf-8")).hexdigest()[:32]
 
 
@@ -156,7 +163,7 @@ def render_sarif(
                 "ruleId": d.code,
                 "ruleIndex": names.index(d.code),
                 "level": level[d.severity.value],
-                "message": {"text": d.message + (f"\nhint: {d.hint}" if d.hint else "")},
+                "message": {"text": _unicode(d.message + (f"\nhint: {d.hint}" if d.hint else ""))},
                 "locations": [
                     {
                         "physicalLocation": {

@@ -16,6 +16,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validat
 from .. import names
 from ..diagnostics import Span
 from ..diagnostics.plain_words import plain_words
+from . import quantities as Q
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
@@ -36,19 +37,54 @@ Label = Annotated[str, _rule(names.label_problem)]
 Text = Annotated[str, _rule(names.text_problem)]
 
 
+@dataclasses.dataclass(frozen=True)
+class Unit:
+    """The unit of a library number (for out-of-range messages)."""
+
+    symbol: str
+
+
+# Every library number has a range, as .mod quantities do (quantities.LIMIT): nothing beyond it
+# is a module, and beyond it arithmetic overflows (a 1e308 kg mass, a 1e-320 kg inertia, a peak
+# torque whose servo gain is infinite). Below SMALLEST_LENGTH (0.1 mm) a part's mesh has no
+# triangles left; below SMALLEST (a milligram, a millionth of a N·m) a number is a typo.
+SMALLEST = 1e-6
+SMALLEST_LENGTH = 1e-4
+MAX_TORQUE = 1e6  # N·m
+MAX_RPM = 1e6
+MAX_JOINT_DEG = 3600.0  # ten turns either way
+MAX_GAIN = 1e9
+MAX_COUNT = 32  # modules per arm (the paper's arms have 1-6)
+
+
+_LENGTH, _MASS = Q.LIMIT["a length"], Q.LIMIT["a mass"]
+Length = Annotated[float, Field(ge=SMALLEST_LENGTH, le=_LENGTH), Unit("m")]
+Offset = Annotated[float, Field(ge=-_LENGTH, le=_LENGTH), Unit("m")]
+Mass = Annotated[float, Field(ge=SMALLEST, le=_MASS), Unit("kg")]
+LinearDensity = Annotated[float, Field(ge=SMALLEST, le=_MASS), Unit("kg/m")]
+Torque = Annotated[float, Field(ge=SMALLEST, le=MAX_TORQUE), Unit("N·m")]
+Speed = Annotated[float, Field(ge=SMALLEST, le=MAX_RPM), Unit("rev/min")]
+JointDeg = Annotated[float, Field(ge=-MAX_JOINT_DEG, le=MAX_JOINT_DEG), Unit("deg")]
+TwistDeg = Annotated[float, Field(ge=-360.0, le=360.0), Unit("deg")]
+TwistStep = Annotated[float, Field(ge=1.0, le=360.0), Unit("deg")]  # `modc design` enumerates every value
+Gain = Annotated[float, Field(ge=0, le=MAX_GAIN), Unit("")]
+PositiveGain = Annotated[float, Field(gt=0, le=MAX_GAIN), Unit("")]
+Count = Annotated[int, Field(ge=1, le=MAX_COUNT), Unit("")]
+
+
 class _Frozen(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
 
 class Actuator(_Frozen):
     model: Text
-    mass: float = Field(gt=0, description="kg (paper Table 1)")
-    rpm: float = Field(gt=0, description="rated speed, rev/min (paper Table 1)")
-    torque_nominal: float = Field(gt=0, description="N·m (paper Table 1)")
-    torque_peak: float = Field(gt=0, description="N·m (paper Table 1)")
-    epsilon: int = Field(ge=1, description="modules of this kind one module can carry (paper Table 1)")
-    diameter: float = Field(gt=0, description="m, housing diameter")
-    length: float = Field(gt=0, description="m, housing length along the joint axis")
+    mass: Mass = Field(description="kg (paper Table 1)")
+    rpm: Speed = Field(description="rated speed, rev/min (paper Table 1)")
+    torque_nominal: Torque = Field(description="N·m (paper Table 1)")
+    torque_peak: Torque = Field(description="N·m (paper Table 1)")
+    epsilon: Count = Field(description="modules of this kind one module can carry (paper Table 1)")
+    diameter: Length = Field(description="m, housing diameter")
+    length: Length = Field(description="m, housing length along the joint axis")
 
     @property
     def velocity(self) -> float:
@@ -57,28 +93,28 @@ class Actuator(_Frozen):
 
 
 class Part(_Frozen):
-    mass: float = Field(gt=0, description="kg")
+    mass: Mass = Field(description="kg")
 
 
 class Casings(_Frozen):
-    input_mass: float = Field(gt=0)
-    output_mass: float = Field(gt=0)
-    wall: float = Field(gt=0, description="m, casing wall thickness")
-    output_thickness: float = Field(gt=0, description="m, output casing (flange) thickness")
-    boss_radius: float = Field(gt=0, description="m, radius of the pivotal extension")
+    input_mass: Mass
+    output_mass: Mass
+    wall: Length = Field(description="m, casing wall thickness")
+    output_thickness: Length = Field(description="m, output casing (flange) thickness")
+    boss_radius: Length = Field(description="m, radius of the pivotal extension")
 
 
 class TwistUnit(_Frozen):
-    mass: float = Field(gt=0)
-    plate: float = Field(gt=0, description="m, base plate thickness")
-    cheek_thickness: float = Field(gt=0)
-    cheek_width: float = Field(gt=0)
+    mass: Mass
+    plate: Length = Field(description="m, base plate thickness")
+    cheek_thickness: Length
+    cheek_width: Length
 
 
 class LinkModule(_Frozen):
-    mass_per_length: float = Field(gt=0, description="kg/m of a printed link bar")
-    width: float = Field(gt=0, description="m, along y of the joint frame")
-    height: float = Field(gt=0, description="m, along z of the joint frame")
+    mass_per_length: LinearDensity = Field(description="kg/m of a printed link bar")
+    width: Length = Field(description="m, along y of the joint frame")
+    height: Length = Field(description="m, along z of the joint frame")
 
 
 class Variant(_Frozen):
@@ -87,8 +123,8 @@ class Variant(_Frozen):
     casings: Casings
     twist_unit: TwistUnit
     link_module: LinkModule
-    lower_deg: float = Field(description="joint position limit")
-    upper_deg: float
+    lower_deg: JointDeg = Field(description="joint position limit")
+    upper_deg: JointDeg
 
     @model_validator(mode="after")
     def _limits(self):
@@ -102,18 +138,18 @@ class UnitType(_Frozen):
 
     port: Literal["Ip1", "Ip2"]
     link: bool
-    x01: float
-    z01: float
-    z12: float
-    x23: float = Field(0.0, description="default link length for units with a link module")
+    x01: Offset
+    z01: Offset
+    z12: Offset
+    x23: Offset = Field(0.0, description="default link length for units with a link module")
 
 
 class TwistSet(_Frozen):
     """Realisable twist values: min..max in steps of step (all degrees)."""
 
-    min_deg: float
-    max_deg: float
-    step_deg: float = Field(gt=0)
+    min_deg: TwistDeg
+    max_deg: TwistDeg
+    step_deg: TwistStep
     wraps: bool = Field(False, description="angles are taken modulo 360 (ports)")
 
     def nearest(self, deg: float) -> float:
@@ -157,14 +193,14 @@ class Rules(_Frozen):
     first_variant: VariantName
     last_variant: VariantName
     may_follow: dict[VariantName, list[VariantName]]
-    min_dof: int = Field(1, ge=1)
-    max_dof: int = Field(ge=1)
+    min_dof: Count = 1
+    max_dof: Count
 
 
 class Control(_Frozen):
-    p: float = Field(gt=0, description="proportional gain, actuator units (paper section 4.4)")
-    i: float = Field(ge=0)
-    d: float = Field(ge=0)
+    p: PositiveGain = Field(description="proportional gain, actuator units (paper section 4.4)")
+    i: Gain
+    d: Gain
 
 
 class Library(_Frozen):
@@ -174,8 +210,8 @@ class Library(_Frozen):
     variants: dict[VariantName, Variant]
     units: dict[Annotated[int, Field(ge=1, le=99)], UnitType]  # unit type numbers: H1..H4
     twists: Twists
-    link_length_min: float = Field(gt=0)
-    link_length_max: float = Field(gt=0)
+    link_length_min: Length
+    link_length_max: Length
     rules: Rules
     control: Control
 
@@ -209,11 +245,21 @@ class Library(_Frozen):
 
 class LibraryError(Exception):
     """A library that cannot be used; span points into the library file when the problem has a
-    place there (text is that file, for the caret excerpt), else it is None."""
+    place there (text is that file, for the caret excerpt), else it is None. code is the
+    diagnostic code's name; fields fill its message when it is not library-invalid's."""
 
-    def __init__(self, message: str, span: Span | None = None, text: str | None = None):
+    def __init__(self, message: str, span: Span | None = None, text: str | None = None,
+                 code: str = "library-invalid", fields: dict[str, str] | None = None):
         super().__init__(message)
-        self.span, self.text = span, text
+        self.span, self.text, self.code, self.fields = span, text, code, fields or {}
+
+    def diagnostic(self, span: Span, ref: str):
+        """The diagnostic at span (the reference in the .mod file, or self.span in the library)."""
+        from ..diagnostics import REGISTRY
+
+        fields = self.fields or {"name": names.shown(ref, 200), "detail": str(self),
+                                 "builtins": ", ".join(BUILTIN)}
+        return REGISTRY[self.code].at(span, **fields)
 
 
 def _node_span(file: str, node) -> Span:
@@ -252,35 +298,101 @@ def _where(text: str, file: str, loc: tuple) -> Span:
 
 
 MAX_LIBRARY_BYTES = 1_000_000  # the shipped libraries are 4 kB; a 6 MB one took 30 s and 550 MB
+# What makes a YAML mapping a module library. Until a file has them it may be anything the
+# reference names (/etc/passwd, a .env file): then no line, key or character of it is shown.
+LIBRARY_KEYS = ("variants", "units")
+
+
+def _not_a_library(data) -> str | None:
+    """Why parsed YAML is not a module library (in words that quote none of it), else None."""
+    if not isinstance(data, dict):
+        kind = ("empty" if data is None else "a YAML list" if isinstance(data, list)
+                else "plain text or a single value")
+        return f"it is {kind}, not a YAML mapping"
+    missing = [k for k in LIBRARY_KEYS if k not in data]
+    return f"it has no `{missing[0]}` key" if missing else None
+
+
+def _not(why: str) -> LibraryError:
+    return LibraryError(f"not a module library: {why}")
+
+
+def _parse(path: str):
+    """(text, data) of a file that parses as a module library; LibraryError without any of its
+    content otherwise."""
+    import yaml
+
+    from ..files import read_bounded
+
+    try:
+        raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
+    except OSError as e:
+        raise LibraryError(f"it cannot be read: {e.strerror or type(e).__name__}") from None
+    if size > MAX_LIBRARY_BYTES:
+        raise LibraryError(f"the file is too large ({size:,} bytes; the limit is {MAX_LIBRARY_BYTES:,})")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise _not(f"it is not UTF-8 text (at byte {e.start + 1})") from None
+    try:
+        data = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    except RecursionError:
+        raise _not("its YAML is nested too deeply") from None
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
+        raise _not(f"it is not YAML{where}") from None
+    why = _not_a_library(data)
+    if why:
+        raise _not(why)
+    return text, data
+
+
+def _range_error(err, text: str, path: str) -> LibraryError | None:
+    """A number beyond its field's upper bound: out-of-range, as for .mod quantities."""
+    ctx = err.get("ctx") or {}
+    if err.get("type") != "less_than_equal" or "le" not in ctx:
+        return None
+    try:  # YAML 1.1 reads 1e308 (no dot) as text, which pydantic takes for a number
+        value = float(err.get("input"))
+    except (TypeError, ValueError, OverflowError):
+        return None
+    unit = _unit(err["loc"])
+    what = ".".join(str(p) for p in err["loc"])
+    fields = {"what": what, "value": f"{value:g}{unit}", "limit": f"{ctx['le']:g}{unit}"}
+    message = f"{what} = {fields['value']} is out of range (at most {fields['limit']})"
+    return LibraryError(message, _where(text, path, err["loc"]), text, "out-of-range", fields)
+
+
+def _unit(loc: tuple) -> str:
+    """' kg' for a location whose field is annotated with Unit('kg'), else ''."""
+    cls: object = Library
+    info = None
+    for part in loc:
+        fields = getattr(cls, "model_fields", None)
+        if fields is not None and isinstance(part, str) and part in fields:
+            info = fields[part]
+            cls = info.annotation
+        elif getattr(cls, "__origin__", None) is dict:
+            cls = cls.__args__[1]  # type: ignore[attr-defined]
+        else:
+            return ""
+    unit = next((m.symbol for m in getattr(info, "metadata", ()) if isinstance(m, Unit)), "")
+    return f" {unit}" if unit else ""
 
 
 @cache
 def _load_path(path: str, mtime: float) -> Library:
-    import yaml
-
-    from ..files import read_bounded
-    from ..resources import data_dir  # noqa: F401  (keeps import graph obvious)
-
-    try:
-        raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
-        if size > MAX_LIBRARY_BYTES:
-            raise LibraryError(f"the file is too large ({size:,} bytes; the limit is {MAX_LIBRARY_BYTES:,})")
-        text = raw.decode("utf-8")
-        data = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except (OSError, UnicodeDecodeError) as e:
-        raise LibraryError(str(e)) from None
-    except RecursionError:
-        raise LibraryError("the YAML is nested too deeply") from None
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
-        span = Span.point(path, mark.line + 1, mark.column + 1, mark.index) if mark else None
-        raise LibraryError(f"YAML error: {getattr(e, 'problem', None) or e}", span, text) from None
     from pydantic import ValidationError
 
+    text, data = _parse(path)
     try:
         return Library.model_validate(data)
     except ValidationError as e:
         first = e.errors()[0]
+        ranged = _range_error(first, text, path)
+        if ranged is not None:
+            raise ranged from None
         loc = ".".join(str(p) for p in first["loc"] if p != "[key]")
         message = plain_words(first)
         raise LibraryError(f"{loc}: {message}" if loc else message, _where(text, path, first["loc"]), text) from None
@@ -310,7 +422,7 @@ def load(ref: str = "mark2", relative_to: Path | None = None) -> Library:
         return _builtin(ref)
     path = resolve(ref, relative_to)
     if path is None:
-        raise LibraryError(f"library '{ref}' not found")
+        raise LibraryError(f"library '{ref}' not found", code="library-not-found")
     try:
         return _load_path(str(path.resolve()), path.stat().st_mtime)
     except LibraryError as e:  # point at the file as the user named it, not at its resolved path

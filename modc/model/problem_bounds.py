@@ -15,6 +15,9 @@ MAX_LINK_LENGTHS = 12  # per link unit: beyond this the search space is not wort
 
 
 def _count(low, q: ast.Quantity, what: str) -> int | None:
+    if not math.isfinite(q.value):
+        low.error(codes.NOT_FINITE.at(q.span, what=what))
+        return None
     if q.value != int(q.value) or q.value < 1:
         low.error(codes.DESIGN_BOUND.at(q.span, what=f"{what} must be a whole number of units, got {q.value:g}",
                                         hint="write e.g. `units 1 to 3`"))
@@ -52,11 +55,13 @@ def _links(low, st: ast.Links, out: dict) -> None:
         low.error(codes.DESIGN_BOUND.at(where, what="the link step must be positive",
                                         hint="e.g. `links 150 mm to 300 mm step 50 mm`"))
         return
-    n = int(math.floor((hi - lo) / step + 1e-9)) + 1
-    if n > MAX_LINK_LENGTHS:
-        low.error(codes.DESIGN_BOUND.at(st.span, what=f"{n} link lengths per link unit are too many to search",
+    steps = (hi - lo) / step  # inf for a subnormal step (1e-320 m): compare before int()
+    if not steps + 1e-9 < MAX_LINK_LENGTHS:
+        many = f"{int(steps + 1e-9) + 1:,}" if steps < 1e12 else "over a trillion"
+        low.error(codes.DESIGN_BOUND.at(st.span, what=f"{many} link lengths per link unit are too many to search",
                                         hint=f"use a coarser step: at most {MAX_LINK_LENGTHS} lengths"))
         return
+    n = int(math.floor(steps + 1e-9)) + 1
     out["links"] = tuple(round(lo + k * step, 9) for k in range(n))
     out["bound_spans"]["links"] = st.span
 

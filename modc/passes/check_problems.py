@@ -22,9 +22,8 @@ def _library(p: Problem, ctx: Context):
     try:
         return lib.load(ref, where)
     except lib.LibraryError as e:
-        code = codes.LIBRARY_NOT_FOUND if "not found" in str(e) else codes.LIBRARY_INVALID
         span = r.library_span if r.library_ref == ref and r.library_span.file != "<unknown>" else r.name_span
-        ctx.report(code.at(span, name=ref, detail=str(e), builtins=", ".join(lib.BUILTIN)))
+        ctx.report(e.diagnostic(span, ref))
         return None
 
 

@@ -3,8 +3,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .. import names
-from ..diagnostics import codes
 from ..model import Design
 from ..model import library as lib
 from .context import Context
@@ -18,12 +16,13 @@ def run(design: Design, ctx: Context) -> Design:
         try:
             library = lib.load(ref, where)
         except lib.LibraryError as e:
-            code = codes.LIBRARY_NOT_FOUND if "not found" in str(e) else codes.LIBRARY_INVALID
             span = r.library_span if r.library_ref == ref and r.library_span.file != "<unknown>" else r.name_span
-            if e.span is not None:  # a problem inside the library file: point at it there
+            if e.span is not None and e.text is not None:
+                # a problem inside a file that has parsed as a library: point at it there (with
+                # the caret excerpt); a file that is not a library is never quoted
                 span = e.span
-                ctx.sources[span.file] = e.text or ""
-            ctx.report(code.at(span, name=names.shown(ref, 200), detail=str(e), builtins=", ".join(lib.BUILTIN)))
+                ctx.sources[span.file] = e.text
+            ctx.report(e.diagnostic(span, ref))
             robots.append(r)
             continue
         units = []

@@ -161,11 +161,34 @@ def validate_for(traj: Trajectory, robot) -> list[str]:
     return errors
 
 
+class Problem(str):
+    """An error message with the place in the file it is about (1-based; 1, 1 when it has none)."""
+
+    line: int = 1
+    col: int = 1
+
+    @classmethod
+    def at(cls, message: str, line: int, col: int) -> Problem:
+        p = cls(message)
+        p.line, p.col = line, col
+        return p
+
+
 def load(path: str | Path) -> tuple[Trajectory | None, list[str]]:
-    """Read and check the structure. Raises OSError when the file cannot be read."""
-    text = Path(path).read_text(encoding="utf-8-sig")
+    """Read and check the structure, under the limits of every input file (files.read_json).
+    Raises OSError when the file cannot be read (missing, a directory, a FIFO or a device)."""
+    from ..files import InputProblem, read_json
+
     try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as e:
-        return None, [f"not JSON: {e.msg} at line {e.lineno}, column {e.colno}"]
+        doc = read_json(path)
+    except InputProblem as e:
+        return None, [Problem.at(str(e), e.line, e.col)]
     return parse(doc)
+
+
+def diagnostics(path: str, errors: list[str]) -> list:
+    """traj-invalid diagnostics for load's or validate_for's errors, at their place in the file."""
+    from ..diagnostics import Span, codes
+
+    return [codes.TRAJ_INVALID.at(Span.point(path, getattr(e, "line", 1), getattr(e, "col", 1)), detail=e)
+            for e in errors]

@@ -9,7 +9,6 @@ re-check of the file whenever it changes on disk (an error keeps the last good a
 """
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
@@ -115,12 +114,14 @@ class Ranking:
 
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
-        try:
-            doc = json.loads(self.path.read_text(encoding="utf-8"))
+        from ..files import InputProblem, read_json
+
+        try:  # under the limits of every input: a regular file, bounded, UTF-8, not nested deeply
+            doc = read_json(self.path)
         except OSError as e:
             raise ViewError(f"cannot read {self.path}: {e.strerror or e}") from None
-        except ValueError as e:
-            raise ViewError(f"{self.path}: not JSON ({e})") from None
+        except InputProblem as e:
+            raise ViewError(f"{self.path}: {e}") from None
         designs = doc.get("designs") if isinstance(doc, dict) else None
         if not isinstance(designs, list) or not designs:
             raise ViewError(f'{self.path}: expected {{"designs": [{{"rank": …, "file": …}}, …]}}, at least one design')

@@ -4,4 +4,4 @@ robot farm {
     chain H1 - L4(port=45deg) - L1
 }
 # the message is long: its expectation sits here, not on line 3
-# expect-line 3: error[library-invalid] module library 'libraries/not-utf8.yaml' is invalid: 'utf-8' codec can't decode byte 0xb0 in position 144: invalid start byte
+# expect-line 3: error[library-invalid] module library 'libraries/not-utf8.yaml' is invalid: not a module library: it is not UTF-8 text (at byte 145)
