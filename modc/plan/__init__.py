@@ -14,6 +14,7 @@ Steps (modules of this package):
     planner.py    OMPL RRT-Connect in joint space, then shortcutting
     timing.py     stop-at-every-vertex trapezoidal timing within the velocity limits
     errors.py     PlanError (diagnostics of the registry, exit code)
+    advice.py     why a target is out of reach: too far, too close, orientation, joint limits
 
 Everything is deterministic for a given file, target, start pose and seed: numpy's
 default_rng(seed) for IK seeds and shortcuts, OMPL's RNG seeded from it, and a planner budget
@@ -232,7 +233,7 @@ def _goals(job: _Job, checker, q_start):
     import numpy as np
 
     from ..kinematics import rpy_matrix
-    from . import ik
+    from . import advice, ik
 
     tgt = job.target
     rotation = None if tgt.rpy is None else rpy_matrix(tgt.rpy)
@@ -255,13 +256,8 @@ def _goals(job: _Job, checker, q_start):
         enough=free,
         tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf),
     )
-    if not solutions:
-        tool = solver.position(best.q)
-        raise job.fail(
-            codes.TARGET_UNREACHABLE, tgt.span, target=tgt.name, distance=f"{best.error:.3f}",
-            hint=(f"the closest tool0 gets is ({', '.join(f'{v:.3f}' for v in tool)}) m, at joint angles "
-                  f"({', '.join(f'{math.degrees(v):.1f}' for v in best.q)}) deg; move the target towards the arm, "
-                  "or lengthen the arm (link=…, more units)"))
+    if not solutions:  # say why: too far, too close, orientation or limits (advice.py)
+        raise advice.unreachable(job, checker, solver, best, q_start)
     return solver, solutions, _free_goals(job, checker, solutions, free)
 
 
