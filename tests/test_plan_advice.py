@@ -120,3 +120,18 @@ def test_one_joint_arm_says_which(tmp_path):
             "    target out at (0.5, 0, 0.148) m\n    target in at (0.02, 0, 0.148) m\n}\n")
     assert "too far" in _error(src, "out", text).message
     assert "too close" in _error(src, "in").message
+
+
+def test_obstacle_says_the_target_is_inside_it(tmp_path):
+    """target-in-collision names the colliding links and, when the point itself is inside an
+    obstacle, how deep (a tilted box: 0.05 m to its nearest face)."""
+    src = tmp_path / "crate.mod"
+    crate = "    box crate size (0.1, 0.3, 0.3) m at (0.3, 0, 0.3) m rpy (0, 0, 30) deg\n"
+    src.write_text(FARM.replace("    target far", crate + "    target boxed at (0.3, 0, 0.3) m\n    target far"),
+                   encoding="utf-8")
+    with pytest.raises(PlanError) as e:
+        plan(src, "boxed")
+    err = e.value
+    assert err.code == "target-in-collision" and "box 'crate'" in err.message
+    assert "the target lies 0.050 m inside box 'crate': move it out" in err.hint
+    assert re.search(r"all \d+ arm pose\(s\)", err.hint)

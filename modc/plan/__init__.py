@@ -264,6 +264,8 @@ def _goals(job: _Job, checker, q_start):
 def _free_goals(job: _Job, checker, solutions, free) -> list:
     """The IK solutions that keep the margin (closest to the start first); else the first with
     more than 2 MIN_MARGIN of clearance, the margin shrunk to it; else target-in-collision."""
+    from . import advice
+
     goals: list = []
     near: list = []
     colliding: list = []
@@ -290,9 +292,11 @@ def _free_goals(job: _Job, checker, solutions, free) -> list:
                 if c.describe() not in names:
                     names.append(c.describe())
         what = "; ".join(names) if names else f"closer than {2 * MIN_MARGIN * 1000:.1f} mm to an obstacle"
+        inside = advice.inside_obstacle(job.robot, job.target.xyz)
         raise job.fail(codes.TARGET_IN_COLLISION, job.target.span, target=job.target.name, contacts=what,
                        hint=f"all {len(solutions)} arm pose(s) that put tool0 on the target collide; "
-                            "move the target or the obstacle")
+                            + (f"the target lies {inside}: move it out" if inside else
+                               "move the target or the obstacle"))
     return goals
 
 

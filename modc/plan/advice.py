@@ -10,7 +10,8 @@ tells the cases apart:
     too far       otherwise, when the target is farther from joint_1 than tool0 gets in the
                   closest pose found;
     too close     when it is nearer to joint_1 than tool0 gets (the arm cannot fold that tight).
-Obstacles are another code (target-in-collision). Every number printed is finite.
+Obstacles are another code (target-in-collision), whose hint says when the target itself lies
+inside an obstacle (inside_obstacle). Every number printed is finite.
 """
 from __future__ import annotations
 
@@ -127,4 +128,23 @@ def _distance(job, solver, best, closest: str) -> PlanError:
     return job.fail(codes.TARGET_UNREACHABLE, tgt.span, target=tgt.name, why=why, hint=hint)
 
 
-__all__ = ["unreachable"]
+def inside_obstacle(robot, xyz) -> str | None:
+    """'0.125 m inside box 'crate'' when the target point lies in one of the robot's obstacles
+    (the deepest), else None: then no arm pose can put tool0 there without touching it."""
+    from ..kinematics import rpy_matrix
+
+    deepest: tuple[float, str] | None = None
+    for o in robot.obstacles:
+        p = rpy_matrix(o.origin.rpy).T @ (np.asarray(xyz, float) - np.asarray(o.origin.xyz, float))
+        if o.shape == "box":
+            depth = float(np.min(np.asarray(o.size) / 2 - np.abs(p)))
+        elif o.shape == "sphere":
+            depth = o.size[0] - float(np.linalg.norm(p))
+        else:  # cylinder: radius, length along its z
+            depth = min(o.size[0] - float(np.hypot(p[0], p[1])), o.size[1] / 2 - abs(float(p[2])))
+        if depth >= 0 and (deepest is None or depth > deepest[0]):
+            deepest = (depth, f"{o.shape} '{o.name}'")
+    return None if deepest is None else f"{deepest[0]:.3f} m inside {deepest[1]}"
+
+
+__all__ = ["inside_obstacle", "unreachable"]
