@@ -135,3 +135,14 @@ def test_obstacle_says_the_target_is_inside_it(tmp_path):
     assert err.code == "target-in-collision" and "box 'crate'" in err.message
     assert "the target lies 0.050 m inside box 'crate': move it out" in err.hint
     assert re.search(r"all \d+ arm pose\(s\)", err.hint)
+
+
+def test_off_to_the_side(tmp_path):
+    """Two coaxial joints sweep tool0 round one circle 0.248 m from joint_1: a target straight above
+    joint_1 at that distance is neither too far nor too close, it is off to the side."""
+    src = tmp_path / "flat.mod"
+    err = _error(src, "up", "robot flat {\n    chain H1 - L3(link=200mm)\n    target up at (0, 0, 0.395) m\n}\n")
+    assert "off to the side of what the arm sweeps" in err.message
+    assert _number(err.message, "no closer than ") == pytest.approx(math.hypot(0.2, 0.101), abs=2e-3)
+    assert _number(err.message, "the target is ") == pytest.approx(0.248, abs=1e-3)
+    assert "two joints move tool0 over a surface" in err.hint

@@ -9,7 +9,8 @@ tells the cases apart:
                   go where;
     too far       otherwise, when the target is farther from joint_1 than tool0 gets in the
                   closest pose found;
-    too close     when it is nearer to joint_1 than tool0 gets (the arm cannot fold that tight).
+    too close     when it is nearer to joint_1 than tool0 gets (the arm cannot fold that tight);
+    to the side   when tool0 gets as far from joint_1 as the target, only not in its direction.
 Obstacles are another code (target-in-collision), whose hint says when the target itself lies
 inside an obstacle (inside_obstacle). Every number printed is finite.
 """
@@ -106,7 +107,9 @@ def _orientation(job, solver, at_position, best) -> PlanError:
 
 
 def _distance(job, solver, best, closest: str) -> PlanError:
-    """Too far, or too close: the target against tool0's closest pose, both measured from joint_1."""
+    """Too far, too close, or beside the workspace: the target against tool0's closest pose, both
+    measured from joint_1. Radial when the distances from joint_1 differ by at least half the gap
+    (or the reach bound proves it); otherwise the arm gets that far out, only not that way."""
     tgt = job.target
     origin, r_min, r_max, _ = reach_shell(job.robot)
     o = np.asarray(origin, float)
@@ -114,17 +117,25 @@ def _distance(job, solver, best, closest: str) -> PlanError:
     d_tool = float(np.linalg.norm(solver.position(best.q) - o))
     gap = f"tool0 gets no closer than {best.error:.3f} m"
     where = f"joint_1 is at {_xyz(origin)} in base_link"
-    if d_target >= d_tool:
+    radial = abs(d_target - d_tool) >= 0.5 * best.error or d_target > r_max or d_target < r_min
+    if radial and d_target >= d_tool:
         reach = (f"no pose puts tool0 farther than {r_max:.3f} m from it" if d_target > r_max else
                  f"the closest pose puts tool0 {d_tool:.3f} m from it")
         why = f"too far: {gap} (the target is {d_target:.3f} m from joint_1, {reach})"
         hint = f"{closest}; move the target towards the arm ({where}), or lengthen the arm (link=…, more units)"
-    else:
+    elif radial:
         reach = (f"no pose puts tool0 nearer than {r_min:.3f} m to it" if d_target < r_min else
                  f"the closest pose puts tool0 {d_tool:.3f} m from it")
         why = f"too close to the arm: {gap} (the target is {d_target:.3f} m from joint_1, {reach})"
         hint = (f"{closest}; move the target away from the arm ({where}), or make the arm fold tighter "
                 "(shorter links, other pivots or ports)")
+    else:
+        dof = job.robot.dof
+        shape = {1: " (one joint moves tool0 along a circle)", 2: " (two joints move tool0 over a surface)"}
+        why = (f"off to the side of what the arm sweeps: {gap} (the target is {d_target:.3f} m from joint_1; "
+               f"tool0 gets {d_tool:.3f} m from it, but not in the target's direction)")
+        hint = (f"{closest}; move the target towards that point ({where}), or change pivots and ports so that "
+                f"the arm points there{shape.get(dof, '')}")
     return job.fail(codes.TARGET_UNREACHABLE, tgt.span, target=tgt.name, why=why, hint=hint)
 
 
