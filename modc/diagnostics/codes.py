@@ -231,7 +231,7 @@ ROBOT_UNKNOWN = _register("robot-unknown", E, "`--robot` naming no robot of the 
 START_IN_COLLISION = _register("start-in-collision", E, "the pose a plan starts from is in collision",
     "the start pose '{pose}' collides: {contacts}", "{hint}")
 TARGET_UNREACHABLE = _register("target-unreachable", E, "a target tool0 cannot reach within the joint limits",
-    "target '{target}' is out of reach: tool0 gets no closer than {distance} m", "{hint}")
+    "target '{target}' is out of reach, {why}", "{hint}")
 TARGET_IN_COLLISION = _register("target-in-collision", E, "a target the arm reaches only in collision",
     "target '{target}' is reachable only in collision: {contacts}", "{hint}")
 NO_PATH = _register("no-path", E, "no collision-free motion to a target was found",

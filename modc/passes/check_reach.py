@@ -121,9 +121,13 @@ def run(design: Design, ctx: Context) -> Design:
         if not _checkable(r):
             continue
         origin, r_min, r_max, longest = reach_shell(r)
+        if not all(math.isfinite(v) for v in (*origin, r_min, r_max)):
+            continue  # beyond any real arm: out-of-range has said so
         at = "(" + ", ".join(f"{v:.3f}" for v in origin) + ") m"
         for t in r.targets:
             d = _dist(t.xyz, origin)
+            if not math.isfinite(d):
+                continue
             slack = t.position_tolerance + EPS
             if d > r_max + slack:
                 ctx.report(codes.TARGET_OUT_OF_REACH.at(

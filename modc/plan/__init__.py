@@ -14,6 +14,7 @@ Steps (modules of this package):
     planner.py    OMPL RRT-Connect in joint space, then shortcutting
     timing.py     stop-at-every-vertex trapezoidal timing within the velocity limits
     errors.py     PlanError (diagnostics of the registry, exit code)
+    advice.py     why a target is out of reach: too far, too close, orientation, joint limits
 
 Everything is deterministic for a given file, target, start pose and seed: numpy's
 default_rng(seed) for IK seeds and shortcuts, OMPL's RNG seeded from it, and a planner budget
@@ -232,7 +233,7 @@ def _goals(job: _Job, checker, q_start):
     import numpy as np
 
     from ..kinematics import rpy_matrix
-    from . import ik
+    from . import advice, ik
 
     tgt = job.target
     rotation = None if tgt.rpy is None else rpy_matrix(tgt.rpy)
@@ -255,19 +256,16 @@ def _goals(job: _Job, checker, q_start):
         enough=free,
         tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf),
     )
-    if not solutions:
-        tool = solver.position(best.q)
-        raise job.fail(
-            codes.TARGET_UNREACHABLE, tgt.span, target=tgt.name, distance=f"{best.error:.3f}",
-            hint=(f"the closest tool0 gets is ({', '.join(f'{v:.3f}' for v in tool)}) m, at joint angles "
-                  f"({', '.join(f'{math.degrees(v):.1f}' for v in best.q)}) deg; move the target towards the arm, "
-                  "or lengthen the arm (link=…, more units)"))
+    if not solutions:  # say why: too far, too close, orientation or limits (advice.py)
+        raise advice.unreachable(job, checker, solver, best, q_start)
     return solver, solutions, _free_goals(job, checker, solutions, free)
 
 
 def _free_goals(job: _Job, checker, solutions, free) -> list:
     """The IK solutions that keep the margin (closest to the start first); else the first with
     more than 2 MIN_MARGIN of clearance, the margin shrunk to it; else target-in-collision."""
+    from . import advice
+
     goals: list = []
     near: list = []
     colliding: list = []
@@ -294,9 +292,11 @@ def _free_goals(job: _Job, checker, solutions, free) -> list:
                 if c.describe() not in names:
                     names.append(c.describe())
         what = "; ".join(names) if names else f"closer than {2 * MIN_MARGIN * 1000:.1f} mm to an obstacle"
+        inside = advice.inside_obstacle(job.robot, job.target.xyz)
         raise job.fail(codes.TARGET_IN_COLLISION, job.target.span, target=job.target.name, contacts=what,
                        hint=f"all {len(solutions)} arm pose(s) that put tool0 on the target collide; "
-                            "move the target or the obstacle")
+                            + (f"the target lies {inside}: move it out" if inside else
+                               "move the target or the obstacle"))
     return goals
 
 
