@@ -65,6 +65,11 @@ def run_cpu(cmd: list[str], *, timeout: float = 600, **kw) -> tuple[subprocess.C
 # Slow tests (over ~2 s alone, measured with --durations) in files whose owners mark them there in
 # time: `-m "not slow"` leaves them out all the same. Tests elsewhere carry @pytest.mark.slow.
 SLOW_ELSEWHERE = frozenset({
+    "tests/test_design.py::test_modc_design_writes_compilable_robots",
+    "tests/test_design.py::test_report_html_shows_the_top_design",
+    "tests/test_design.py::test_cli_engines_give_the_same_ranking",
+    "tests/test_plan.py::test_target_only_in_collision",
+    "tests/test_plan.py::test_obstacle_shapes_agree_with_the_independent_check",
     "tests/test_design.py::test_search_is_identical_for_any_number_of_workers_and_dask",
     "tests/test_hostile_strings.py::test_metacharacters_in_the_file_name_and_library_text_give_valid_outputs",
     "tests/test_hostile_strings.py::test_no_output_expands_user_text",

@@ -164,6 +164,7 @@ def _modc(*args):
     return subprocess.run([sys.executable, "-m", "modc", *args], capture_output=True, text=True)
 
 
+@pytest.mark.slow
 def test_check_json_shape_and_exit_codes():
     r = _modc("check", str(ROOT / "examples" / "farm.mod"), "--json")
     assert r.returncode == 0, r.stderr
@@ -173,6 +174,7 @@ def test_check_json_shape_and_exit_codes():
     assert joints[1]["tau_nom"] == 3.6 and joints[1]["tau_max"] == 6.8
 
 
+@pytest.mark.slow
 def test_payload_over_capacity_fails_naming_joint_and_pose():
     r = _modc("check", str(ROOT / "examples" / "farm.mod"), "--payload", "3kg")
     assert r.returncode == 1

@@ -113,6 +113,7 @@ def test_dot_with_force_from_the_command_line(tmp_path):
     assert listing(tmp_path) == []
 
 
+@pytest.mark.slow
 def test_unwritable_out_is_a_clean_exit_2(tmp_path):
     long = tmp_path / ("x" * 300)  # "file name too long" while writing
     r = subprocess.run([sys.executable, "-m", "modc", str(QUICK), "-o", str(long)], capture_output=True, text=True)

@@ -149,6 +149,7 @@ def publishes(master_uri: str, topic: str, node: str, proc: subprocess.Popen) ->
     return any(t == topic and node in nodes for t, nodes in pubs)
 
 
+@pytest.mark.slow
 def test_robot_state_publisher_has_no_root_inertia_warning(workspace, tmp_path):
     if not RSP.is_file():
         pytest.skip("robot_state_publisher is not installed (apt: ros-robot-state-publisher)")

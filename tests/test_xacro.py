@@ -472,6 +472,7 @@ def test_two_instances_of_one_arm(farm, tmp_path):
     two_arm_case(tmp_path, farm, farm, "two_farms")
 
 
+@pytest.mark.slow
 def test_two_different_arms_from_one_file(tmp_path):
     c = checked_ok(CHAINS["two_libraries"], "two.mod")
     planar, strict = compile_pairs(c, tmp_path / "out")
