@@ -61,8 +61,13 @@ class Hang(BaseException):  # not an Exception: modc code catching Exception mus
     pass
 
 
+_ARMED = [False]  # one Hang per input: the second timer (or a late one) must not hit the handler of the first
+
+
 def _alarm(signum, frame):
-    raise Hang("wall-clock" if signum == signal.SIGALRM else "CPU")
+    if _ARMED[0]:
+        _ARMED[0] = False
+        raise Hang("wall-clock" if signum == signal.SIGALRM else "CPU")
 
 
 # --- generators (hypothesis strategies, drawn with a fixed seed per batch) -------------------------
@@ -307,6 +312,7 @@ def run(args) -> int:
                 t0 = time.monotonic()
                 finding: dict[str, object] | None = None
                 try:
+                    _ARMED[0] = True
                     signal.setitimer(signal.ITIMER_PROF, args.timeout)
                     signal.setitimer(signal.ITIMER_REAL, args.wall)
                     text = check_one(kind, item, work, ctx)
@@ -319,13 +325,16 @@ def run(args) -> int:
                     limit = args.wall if e.args[0] == "wall-clock" else args.timeout
                     finding = {"type": "hang", "detail": f"over {limit} s of {e.args[0]} time"}
                 except fuzz_surfaces.Finding as e:
+                    _ARMED[0] = False
                     finding = {"type": e.kind, "detail": e.detail, "traceback": e.text}
                 except BaseException as e:  # noqa: BLE001  (a finding, whatever it is)
+                    _ARMED[0] = False  # no Hang inside this handler
                     if isinstance(e, KeyboardInterrupt):
                         raise
                     finding = {"type": "traceback", "detail": _signature(e),
                                "traceback": traceback.format_exc()[-3000:]}
                 finally:
+                    _ARMED[0] = False
                     signal.setitimer(signal.ITIMER_REAL, 0)
                     signal.setitimer(signal.ITIMER_PROF, 0)
                 state["inputs"] += 1

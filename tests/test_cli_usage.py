@@ -62,6 +62,7 @@ def test_the_blocker_blocks(light):
     assert r.returncode != 0 and "No module named 'pybullet'" in r.stderr
 
 
+@pytest.mark.slow
 def test_lint_and_fmt_work_from_the_light_install(light, tmp_path):
     r = modc("lint", "examples", light=light)
     assert r.returncode == 0, r.stderr
@@ -75,6 +76,7 @@ def test_lint_and_fmt_work_from_the_light_install(light, tmp_path):
     assert r.returncode == 0 and json.loads(r.stdout)["version"] == "2.1.0"
 
 
+@pytest.mark.slow
 def test_lsp_works_from_the_light_install(light):
     """`modc lsp` over stdio with the heavy modules blocked: diagnostics and hover."""
     from modc.lsp.client import Client
@@ -92,6 +94,7 @@ def test_lsp_works_from_the_light_install(light):
     assert b"Traceback" not in b"".join(c.stderr)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "command",
     [
@@ -133,6 +136,7 @@ def test_a_mistyped_command_gets_did_you_mean():
     assert r.returncode == 2 and "no command or file 'zzzz'" in r.stderr and "modc --help" in r.stderr
 
 
+@pytest.mark.slow
 def test_a_file_is_still_compiled_without_the_command(tmp_path):
     from modc.cli.app import route
 

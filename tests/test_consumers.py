@@ -180,6 +180,7 @@ def assert_check_urdf_accepts(arm: Arm) -> None:
         assert f"child(1):  {name}" in res.stdout, f"check_urdf does not see {name} in the tree"
 
 
+@pytest.mark.slow
 def test_check_urdf_accepts_every_urdf(arms):
     """urdfdom's check_urdf parses the URDF and sees base_link -> link_1 ... link_n -> tool0."""
     for arm in arms:
@@ -460,6 +461,7 @@ def spec_T_base_tool(spec: RobotSpec, q) -> np.ndarray:
     return T @ H(rot(2, y) @ rot(1, p) @ rot(0, r), spec.tool_xyz)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(spec=robot_specs(), seed=st.integers(0, 2**32 - 1))
 def test_random_valid_chains_load_with_spec_kinematics(spec: RobotSpec, seed: int):

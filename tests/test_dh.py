@@ -113,6 +113,7 @@ def _twists_within_half_step(rows, fit):
     [EXAMPLE_A, EXAMPLE_B] + [TABLE3[k][0] for k in ("planar", "spatial", "skew", "wrist", "raven")],
     ids=["A", "B", "planar", "spatial", "skew", "wrist", "raven"],
 )
+@pytest.mark.slow
 @pytest.mark.parametrize("fit", [False, True])
 def test_realised_twists_measured_in_pinocchio(rows, fit):
     _twists_within_half_step(rows, fit)
@@ -161,6 +162,7 @@ def test_dh_block_in_mod_equals_dh2mod():
     assert [u.model_dump() for u in c.design.robots[0].units] == [u.model_dump() for u in d.design.robots[0].units]
 
 
+@pytest.mark.slow
 def test_dh_command_json(tmp_path):
     (tmp_path / "b.mod").write_text(convert(EXAMPLE_B, fit=True)[0])
     r = subprocess.run(
@@ -171,6 +173,7 @@ def test_dh_command_json(tmp_path):
     assert [round(j["realised"]["a"], 9) for j in joints] == [0, 0.3, 0.3, 0, 0, 0]
 
 
+@pytest.mark.slow
 def test_dh2mod_cli_json_shape(tmp_path):
     (tmp_path / "b.csv").write_text(csv(EXAMPLE_B))
     r = subprocess.run(
@@ -195,6 +198,7 @@ def test_dh2mod_cli_json_shape(tmp_path):
     ("a,alpha,d,theta\n", "dh-empty", 1, 1),
     ("a,alpha,d,theta\n" + "0,0,0.1,0\n" * 7, "too-many-units", 8, 1),
 ])
+@pytest.mark.slow
 def test_bad_tables_get_diagnostics(tmp_path, text, code, line, col):
     f = tmp_path / "t.csv"
     f.write_text(text)
@@ -231,6 +235,7 @@ def _normals(chain: Chain):
     return [row.a for row in realised_dh(chain)]
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(normal_form_chains())
 def test_round_trip_keeps_the_axis_geometry(src):

@@ -236,6 +236,7 @@ def test_corpus_is_not_empty():
     assert len(CASES) >= 30
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", [case_param(p) for p in CASES])
 def test_corpus(path: Path, update_golden):
     expected = expectations(path)
@@ -505,6 +506,7 @@ def test_output_not_modc(tmp_path):
     assert not (foreign / "thesis.tex").exists()
 
 
+@pytest.mark.slow
 def test_output_not_modc_from_the_command_line(tmp_path):
     src = tmp_path / "farm.mod"
     src.write_text("robot farm {\n    chain H1 - L4(port=45deg) - L1\n}\n", encoding="utf-8")
@@ -622,6 +624,7 @@ def test_excerpt_with_crlf_line_endings():
     check_rendered(c.diagnostics[0], text, "t.mod")
 
 
+@pytest.mark.slow
 def test_traj_invalid(tmp_path):
     """`modc play` with a trajectory for other joints: a diagnostic at the trajectory file, exit 1."""
     traj = tmp_path / "t.json"
@@ -652,6 +655,7 @@ robot other {
 """
 
 
+@pytest.mark.slow
 def test_plan_errors(tmp_path, capsys):
     """`modc plan`: every way planning can fail is a diagnostic with a hint and no traceback; exit 1,
     or 2 for names given on the command line (target, start pose, robot)."""

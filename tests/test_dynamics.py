@@ -164,6 +164,7 @@ def _modc(*args):
     return subprocess.run([sys.executable, "-m", "modc", *args], capture_output=True, text=True)
 
 
+@pytest.mark.slow
 def test_check_json_shape_and_exit_codes():
     r = _modc("check", str(ROOT / "examples" / "farm.mod"), "--json")
     assert r.returncode == 0, r.stderr
@@ -173,18 +174,21 @@ def test_check_json_shape_and_exit_codes():
     assert joints[1]["tau_nom"] == 3.6 and joints[1]["tau_max"] == 6.8
 
 
+@pytest.mark.slow
 def test_payload_over_capacity_fails_naming_joint_and_pose():
     r = _modc("check", str(ROOT / "examples" / "farm.mod"), "--payload", "3kg")
     assert r.returncode == 1
     assert "error[torque-over-peak]: joint_2 (L4) must hold" in r.stderr and "at q = (0, -73, -12) deg" in r.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("bad", ["abc", "-1kg", "5 lb", "nan"])
 def test_bad_payload_gets_a_diagnostic(bad):
     r = _modc("check", str(ROOT / "examples" / "farm.mod"), "--payload", bad)
     assert r.returncode == 2 and "error[bad-payload]" in r.stderr and "Traceback" not in r.stderr
 
 
+@pytest.mark.slow
 def test_compile_refuses_an_overloaded_arm_unless_told(tmp_path):
     src = tmp_path / "heavy.mod"
     src.write_text("robot heavy {\n    chain H1 - L4(pivot=-90deg, link=450mm) - L4(link=450mm)\n    payload 1 kg\n}\n")
@@ -219,6 +223,7 @@ def test_a_trajectory_at_rest_needs_exactly_the_gravity_torques():
     assert np.allclose(tau, [dyn.gravity(q)] * 3, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_check_along_a_planned_motion(tmp_path):
     """plan -> check --traj: the planned motion (rated speeds) is within the actuators' torques,
     and the same path ten times faster is not; the failure names the joint and the time."""

@@ -357,6 +357,7 @@ def _run_grammar_tests(*files: Path) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 def test_textmate_grammar_tests_pass():
     r = _run_grammar_tests()
     assert r.returncode == 0, r.stdout + r.stderr
@@ -364,6 +365,7 @@ def test_textmate_grammar_tests_pass():
         assert f"tests/{path.name} run successfuly" in r.stdout, r.stdout
 
 
+@pytest.mark.slow
 def test_textmate_grammar_tests_catch_a_wrong_scope(tmp_path):
     """The harness really fails: a test file asserting a wrong scope makes test.sh exit non-zero."""
     broken = tmp_path / "broken.mod"
@@ -375,6 +377,7 @@ def test_textmate_grammar_tests_catch_a_wrong_scope(tmp_path):
     assert "missing required scopes: keyword.other.at.mod" in r.stdout, r.stdout + r.stderr
 
 
+@pytest.mark.slow
 def test_vsce_packages_the_extension(tmp_path):
     """`vsce package` (pinned in package-lock.json, through editors/vscode/package.sh) makes a
     .vsix: no relative README link, a repository field, a LICENSE; the runtime dependency and the

@@ -86,6 +86,7 @@ def assert_fmt_properties(text: str) -> str:
 
 
 # --- every example -------------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("example", EXAMPLES, ids=lambda p: p.stem)
 def test_examples_idempotent_comments_kept_same_output(example: Path):
     text = example.read_text(encoding="utf-8")
@@ -310,6 +311,7 @@ def re_strip_comments(text: str) -> str:
 messy_files = valid_chains().flatmap(lambda t: st.tuples(st.just(t), respaced(t)))
 
 
+@pytest.mark.slow
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(messy_files)
 def test_property_respaced_valid_files(pair):
@@ -320,6 +322,7 @@ def test_property_respaced_valid_files(pair):
     assert_same_meaning(original, out)
 
 
+@pytest.mark.slow
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(valid_chains(), min_size=1, max_size=3).flatmap(lambda ts: respaced("\n".join(ts))))
 def test_property_several_robots_idempotent(messy):
@@ -333,6 +336,7 @@ def test_property_several_robots_idempotent(messy):
 EXAMPLE_TEXTS = {ex.stem: ex.read_text(encoding="utf-8") for ex in EXAMPLES}
 
 
+@pytest.mark.slow
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.sampled_from(sorted(EXAMPLE_TEXTS)).flatmap(lambda k: st.tuples(st.just(k), respaced(EXAMPLE_TEXTS[k]))))
 def test_property_respaced_examples(pair):

@@ -241,6 +241,7 @@ PARSE_CODES = {"syntax-error", "unexpected-character", "unclosed-block", "missin
 MIN_SEMANTIC_CODES = 8
 
 
+@pytest.mark.slow
 def test_generated_mod_text_never_crashes():
     seen: set[str] = set()
 
@@ -257,6 +258,7 @@ def test_generated_mod_text_never_crashes():
     assert len(semantic) >= MIN_SEMANTIC_CODES, f"the generator rarely gets past the parser; reached {sorted(seen)}"
 
 
+@pytest.mark.slow
 @settings(max_examples=100, deadline=None)
 @given(st.lists(unit(), min_size=1, max_size=8), st.sampled_from(["mark2", "mark2-strict"]))
 def test_generated_chains_never_crash(units, library):
@@ -317,6 +319,7 @@ def text_mutation(draw):
     return name, text
 
 
+@pytest.mark.slow
 @FUZZ
 @given(byte_mutation())
 def test_byte_mutated_examples_never_crash(case):
@@ -328,6 +331,7 @@ def test_byte_mutated_examples_never_crash(case):
     assert_sane(text, "mutant.mod", fuzzing=True)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(text_mutation())
 def test_text_mutated_examples_never_crash(case):
@@ -382,6 +386,7 @@ def _mutants(n: int, seed: int) -> list[tuple[str, str]]:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["text", "json"])
 def test_lint_subprocess_on_mutated_files(tmp_path, fmt):
     paths = []
@@ -406,6 +411,7 @@ def test_lint_subprocess_on_mutated_files(tmp_path, fmt):
 CPU_LIMIT_S = 5.0
 
 
+@pytest.mark.slow
 def test_ten_thousand_unit_chain_is_rejected_quickly():
     text = "robot snake {\n    chain " + " - ".join(["H1"] * 9_999 + ["L1"]) + "\n}\n"
     t0 = time.process_time()
@@ -519,6 +525,7 @@ def valid_arm(draw):
     return "robot arm {\n    chain " + " - ".join(units) + "\n    " + "\n    ".join(extra) + "\n}\n"
 
 
+@pytest.mark.slow
 @needs_analyses
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(valid_arm())
@@ -603,6 +610,7 @@ def test_yaml_document_is_valid():
     assert not c.diagnostics
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not YAML_FORM, reason="modc.syntax.yaml_form is not implemented yet")
 @FUZZ
 @given(yaml_mutation())

@@ -35,6 +35,7 @@ def campaign(state: Path, *extra: str) -> subprocess.CompletedProcess:
                           text=True, timeout=1800)
 
 
+@pytest.mark.slow
 def test_a_seeded_slice_finds_nothing_and_resumes(tmp_path):
     first = campaign(tmp_path / "s", "--stop-after", "3")
     assert first.returncode == 0, first.stderr[-3000:]
@@ -77,6 +78,7 @@ def _findings(mod, state: Path, monkeypatch, planted, *limits: str) -> list[dict
     return [json.loads(line) for line in (state / "findings.jsonl").read_text().splitlines()]
 
 
+@pytest.mark.slow
 def test_crashes_and_cpu_hangs_are_recorded(tmp_path, monkeypatch):
     """A spinning input is a hang by its CPU time; the wall-clock limit is far away, so that a
     loaded machine (which stretches 0.3 s of CPU time over seconds) cannot make it the reason."""

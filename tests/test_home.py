@@ -32,6 +32,7 @@ def limited():
     return c, build(c, collision_samples=50)
 
 
+@pytest.mark.slow
 def test_home_is_inside_the_limits(limited):
     c, _ = limited
     r = c.design.robots[0]

@@ -105,6 +105,7 @@ def test_force_replaces_anything_but_never_the_working_directory_or_the_input(tm
     assert listing(tmp_path) == ["link", "out", "src", "target"]
 
 
+@pytest.mark.slow
 def test_dot_with_force_from_the_command_line(tmp_path):
     r = subprocess.run([sys.executable, "-m", "modc", str(QUICK), "-o", ".", "--force"], cwd=tmp_path,
                        capture_output=True, text=True)
@@ -112,6 +113,7 @@ def test_dot_with_force_from_the_command_line(tmp_path):
     assert listing(tmp_path) == []
 
 
+@pytest.mark.slow
 def test_unwritable_out_is_a_clean_exit_2(tmp_path):
     long = tmp_path / ("x" * 300)  # "file name too long" while writing
     r = subprocess.run([sys.executable, "-m", "modc", str(QUICK), "-o", str(long)], capture_output=True, text=True)
@@ -205,6 +207,7 @@ def _state(out: Path, n: int) -> str:
     return f"broken: {len(got)} files"
 
 
+@pytest.mark.slow
 @PROC
 def test_sigkill_at_random_moments_leaves_old_or_new_tree(tmp_path):
     """A process replacing OUT over and over is killed at 15 seeded random moments inside a write
@@ -233,6 +236,7 @@ def test_sigkill_at_random_moments_leaves_old_or_new_tree(tmp_path):
     assert phases == {"A", "B"}, "the kills should land in both phases of the loop"
 
 
+@pytest.mark.slow
 @PROC
 def test_sigkill_of_the_compiler_itself(tmp_path):
     """Killed at seeded random points of its CPU time (start-up, compile, write), the compiler
@@ -317,6 +321,7 @@ def test_deep_yaml_and_huge_unit_numbers_are_diagnostics(tmp_path):
     assert [d.code for d in c.diagnostics] == ["unknown-joint"]
 
 
+@pytest.mark.slow
 def test_lint_without_files_is_a_usage_error(tmp_path):
     (tmp_path / "empty").mkdir()
     for arg, what in (("empty", "holds no .mod file"), ("src/**/*.mod", "matches no file")):
@@ -331,6 +336,7 @@ def test_bad_encoding_is_an_error_in_the_file(tmp_path):
     assert r.returncode == 1 and f"{src}:2:25: error[bad-encoding]" in r.stderr and "chain H1" in r.stderr
 
 
+@pytest.mark.slow
 def test_fmt_formats_the_issues_8000_unit_chain():
     """(Its speed, linear in the chain, is measured by benchmarks/bench_fmt.py.)"""
     import gc
@@ -353,6 +359,7 @@ def test_no_file_is_written_outside_out(tmp_path):
         assert listing(tmp_path) == [], rel
 
 
+@pytest.mark.slow
 def test_concurrent_writers_to_one_out_are_serialised(tmp_path):
     """Two processes replacing the same OUT at once: both succeed (the flock on the parent keeps
     one from removing the other's sibling as a leftover), OUT is one complete tree, nothing left over."""

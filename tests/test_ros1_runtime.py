@@ -65,6 +65,7 @@ def run(cmd: list[str], env: dict, **kwargs) -> subprocess.CompletedProcess:
     return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=240, check=False, **kwargs)
 
 
+@pytest.mark.slow
 def test_roslaunch_resolves_the_moveit1_demo(workspace):
     roslaunch = tool("roslaunch")
     _, pkgs, env = workspace
@@ -91,6 +92,7 @@ def test_roslaunch_resolves_the_moveit1_demo(workspace):
         assert params["/move_group/planning_pipelines/ompl/arm/default_planner_config"] == "RRTConnectkConfigDefault"
 
 
+@pytest.mark.slow
 def test_roslaunch_move_group_with_the_arm_controllers(workspace):
     roslaunch = tool("roslaunch")
     _, pkgs, env = workspace
@@ -116,6 +118,7 @@ def test_roslaunch_move_group_with_the_arm_controllers(workspace):
         assert r.returncode == 0 and r.stdout.strip(), (launch, r.stderr)
 
 
+@pytest.mark.slow
 def test_catkin_lint_and_catkin_make_install(workspace):
     lint = tool("catkin_lint")
     ws, pkgs, env = workspace
@@ -146,6 +149,7 @@ def publishes(master_uri: str, topic: str, node: str, proc: subprocess.Popen) ->
     return any(t == topic and node in nodes for t, nodes in pubs)
 
 
+@pytest.mark.slow
 def test_robot_state_publisher_has_no_root_inertia_warning(workspace, tmp_path):
     if not RSP.is_file():
         pytest.skip("robot_state_publisher is not installed (apt: ros-robot-state-publisher)")
@@ -192,6 +196,7 @@ def test_no_ros2_file_in_a_ros1_package(workspace):
         assert not list(d.rglob("*.launch.py")) and not (d / "config/ros2_controllers.yaml").exists()
 
 
+@pytest.mark.slow
 def test_colcon_builds_the_ros1_package_and_sees_the_ros2_one_as_ament_cmake(workspace, tmp_path):
     """colcon (Debian, with colcon-ros) builds the catkin package; for ROS 2 it identifies the
     package's build type (building it needs ament_cmake, which is not installable here)."""

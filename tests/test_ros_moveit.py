@@ -110,6 +110,7 @@ def packages(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_moveit_configs_builder_defaults_resolve(packages):
     for robot, pkg, d in packages.values():
         cfg = Lookups(robot.file_stem, pkg, {pkg: d}).to_moveit_configs()
@@ -209,6 +210,7 @@ def launch_api(monkeypatch, shares: dict[str, Path], calls: list):
     return kinds
 
 
+@pytest.mark.slow
 def test_launch_files_build_the_moveit_config(packages, monkeypatch):
     for _, pkg, d in packages.values():
         calls: list = []

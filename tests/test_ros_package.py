@@ -211,6 +211,7 @@ def test_package_xml_parses_with_catkin_pkg(packages):
         assert "ROS_VERSION" not in cmake and ("ament" in cmake) == (distro == "jazzy")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="needs cmake")
 def test_cmakelists_installs_the_package_with_ament_or_catkin(packages, tmp_path):
     """Configure and install with a stand-in for ament_cmake / catkin's find_package (the real
@@ -254,6 +255,7 @@ def test_ros_description_is_the_urdf_with_package_meshes_and_no_root_inertia(pac
                 assert (d / m.removeprefix(f"package://{pkg}/")).is_file()
 
 
+@pytest.mark.slow
 def test_urdf_xacro_expands_to_the_robot_with_ros2_control(packages):
     xacro = pytest.importorskip("xacro")
     for (_, distro), (c, files, d) in packages.items():
@@ -352,6 +354,7 @@ def parse_every_file(files: dict) -> None:
             compile(text, rel, "exec")
 
 
+@pytest.mark.slow
 def test_xml_and_yaml_files_parse(packages):
     for _, files, _ in packages.values():
         parse_every_file(files)

@@ -31,6 +31,7 @@ def test_choose_robot_rules():
     assert e.value.diagnostic.message == "empty.mod defines no robot"
 
 
+@pytest.mark.slow
 def test_every_command_says_robot_unknown(tmp_path, capsys):
     two = tmp_path / "two.mod"
     two.write_text(TWO, encoding="utf-8")

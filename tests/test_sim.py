@@ -71,6 +71,7 @@ def write(tmp_path: Path, text: str, name: str = "t.mod") -> Path:
 # modc sim
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", EXAMPLES + YAML_EXAMPLES, ids=lambda p: p.name)
 def test_every_example_passes_sim(path):
     ok, lines, checked = smoke.run_sim(path)
@@ -81,6 +82,7 @@ def test_every_example_passes_sim(path):
             assert any(line.strip().startswith(f"pose {name}: ok") for line in lines), lines
 
 
+@pytest.mark.slow
 def test_every_example_holds_tracks_and_agrees():
     """The measured figures behind the tolerances: tracking (1 kHz, PyBullet's default gains),
     FK against modc's kinematics, holding torques against modc's dynamics."""
@@ -126,6 +128,7 @@ def test_self_colliding_pose_fails_naming_the_pair(tmp_path):
     assert any("pose folded" in line and "base_link and link_2 collide" in line for line in lines)
 
 
+@pytest.mark.slow
 def test_srdf_disabled_pairs_are_honoured_but_never_pairs_are_not(tmp_path):
     path = write(tmp_path, FOLD)
     out = tmp_path / "out"
@@ -241,6 +244,7 @@ def test_pybullet_prints_nothing(capfd):
 
 
 
+@pytest.mark.slow
 def test_render_makes_a_clear_picture(tmp_path):
     from PIL import Image
 
@@ -266,6 +270,7 @@ def test_render_makes_a_clear_picture(tmp_path):
     assert again.read_bytes() == out.read_bytes()
 
 
+@pytest.mark.slow
 def test_render_pose_size_and_errors(tmp_path):
     from PIL import Image
 
@@ -279,6 +284,7 @@ def test_render_pose_size_and_errors(tmp_path):
     assert not (tmp_path / "x.png").exists()
 
 
+@pytest.mark.slow
 def test_render_two_robots_in_one_file(tmp_path):
     from PIL import Image
 
@@ -305,6 +311,7 @@ SWEEP = {
 }
 
 
+@pytest.mark.slow
 def test_play_records_a_gif_of_many_different_frames(tmp_path):
     from PIL import Image
 
@@ -418,6 +425,7 @@ def test_trajectory_roundtrip_and_interpolation():
     assert json.loads(t.dumps()) == SWEEP
 
 
+@pytest.mark.slow
 def test_compile_smoke_option(tmp_path):
     """`modc FILE -o OUT --smoke` runs the PyBullet smoke test first; a failure writes nothing."""
     import subprocess

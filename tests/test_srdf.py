@@ -79,6 +79,7 @@ def test_every_example_has_one_srdf_per_robot(example_srdfs):
         assert sorted(files) == sorted(f"config/{r.file_stem}.srdf" for r in _robots(b)), stem
 
 
+@pytest.mark.slow
 def test_srdf_parses_and_names_only_urdf_links_and_joints(example_srdfs, compiled_examples):
     for stem, (b, files) in example_srdfs.items():
         for r in _robots(b):
@@ -200,6 +201,7 @@ def _geometry_model(gm, owner: list[str], pairs: dict, reason: str):
     return g, g.createData()
 
 
+@pytest.mark.slow
 def test_never_pairs_do_not_collide_when_resampled_with_another_seed(example_srdfs, compiled_examples):
     """2,000 fresh samples (another generator, another seed), all mesh pairs of every pair the
     SRDF marks Never, pinocchio + coal called directly: none may collide. Default pairs must
@@ -254,6 +256,7 @@ def test_example_b_keeps_colliding_pairs_enabled(example_srdfs, compiled_example
     assert frozenset(("base_link", "link_2")) not in pairs
 
 
+@pytest.mark.slow
 def test_fast_and_naive_classifications_agree():
     """The broad phase and early exits are filters: the all-mesh-pairs, all-samples anchor
     must give the same matrix."""
@@ -291,6 +294,7 @@ def test_batch_forward_kinematics_matches_pinocchio():
 # determinism and options
 
 
+@pytest.mark.slow
 def test_srdf_is_deterministic_and_seeded(example_srdfs, monkeypatch):
     monkeypatch.setenv("MODC_NO_CACHE", "1")  # really recompute: a cache hit would only compare with itself
     for stem in ("example_a", "example_b", "farm"):
@@ -320,6 +324,7 @@ def test_zero_samples_gives_only_adjacent_and_default_pairs():
     assert set(_pairs(root).values()) == {"Adjacent"}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("threads", ["1", "2", "4"])
 def test_same_srdf_in_a_fresh_process_with_other_thread_settings(example_srdfs, threads):
     """Nothing in the computation is threaded; this shows BLAS/OpenMP settings do not matter."""

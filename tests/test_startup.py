@@ -11,6 +11,7 @@ import os
 import subprocess
 import sys
 
+import pytest
 from conftest import ROOT
 
 HEAVY = ("pinocchio", "coal", "pybullet", "ompl", "trimesh", "pygls", "scipy", "networkx", "mujoco", "dask")
@@ -39,6 +40,7 @@ def _run(args: list[str], cache_dir, no_cache: bool = False) -> tuple[int, set[s
     return doc["exit"], set(doc["modules"])
 
 
+@pytest.mark.slow
 def test_lint_imports_no_heavy_library(tmp_path):
     code, modules = _run(["lint", str(ROOT / "examples" / "farm.mod")], tmp_path)
     assert code in (0, None)
@@ -47,6 +49,7 @@ def test_lint_imports_no_heavy_library(tmp_path):
     assert "typer" not in modules  # its pydantic-based parameter handling cost every command ~40 ms
 
 
+@pytest.mark.slow
 def test_compile_imports_no_trimesh_and_a_cached_compile_no_pinocchio(tmp_path):
     src = ROOT / "examples" / "farm.mod"
     code, first = _run([str(src), "-o", str(tmp_path / "a")], tmp_path / "cache")

@@ -235,6 +235,7 @@ def visuals(path: Path, model: pin.Model, q: np.ndarray) -> list[tuple[str, str,
 # every example and hand-picked chain
 
 
+@pytest.mark.slow
 def test_expansion_passes_check_urdf(pairs):
     exe = Path(sys.executable).parent / "check_urdf"
     assert exe.is_file(), f"check_urdf is expected next to {sys.executable}"
@@ -471,6 +472,7 @@ def test_two_instances_of_one_arm(farm, tmp_path):
     two_arm_case(tmp_path, farm, farm, "two_farms")
 
 
+@pytest.mark.slow
 def test_two_different_arms_from_one_file(tmp_path):
     c = checked_ok(CHAINS["two_libraries"], "two.mod")
     planar, strict = compile_pairs(c, tmp_path / "out")
@@ -513,6 +515,7 @@ def test_library_by_hand_with_defaults(tmp_path):
 # random valid chains
 
 
+@pytest.mark.slow
 @settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(spec=robot_specs())
 def test_random_chains(spec, tmp_path_factory):

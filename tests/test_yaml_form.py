@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import jsonschema
+import pytest
 import yaml
 from conftest import ROOT
 
@@ -24,6 +25,7 @@ def test_yaml_compiles_to_the_same_urdf_as_mod():
     assert _urdf_body(build(a, ["urdf"])) == _urdf_body(build(b, ["urdf"]))
 
 
+@pytest.mark.slow
 def test_schema_validates_the_yaml_example():
     r = subprocess.run([sys.executable, "-m", "modc", "schema"], capture_output=True, text=True)
     assert r.returncode == 0
