@@ -44,7 +44,7 @@ def sim_cmd(file: str, robot: str | None, srdf_from: str | None, library: str | 
 @click.option("-o", "--out", required=True, help="PNG file to write")
 @click.option("--pose", help="named pose (default: home)")
 @click.option("--robot", help="render only this robot of the file")
-@click.option("--size", default="800x600", help="WIDTHxHEIGHT in pixels")
+@click.option("--size", default="1280x960", help="WIDTHxHEIGHT in pixels")
 @click.option("--azimuth", type=float, help="camera azimuth in degrees from +x towards +y (default: chosen)")
 @click.option("--elevation", type=float, help="camera elevation in degrees (default 30)")
 @click.option("--colors", type=int, help="quantise to a palette of this many colours (<= 256) for small files")
@@ -68,7 +68,7 @@ def render_cmd(
         width, height = (int(v) for v in size.lower().split("x"))
         assert width > 0 and height > 0
     except (ValueError, AssertionError):
-        _err(f"modc render: --size {size!r}: expected WIDTHxHEIGHT, e.g. 800x600")
+        _err(f"modc render: --size {size!r}: expected WIDTHxHEIGHT, e.g. 1280x960")
         raise SystemExit(EXIT_USAGE) from None
     if colors is not None and not 2 <= colors <= 256:
         _err(f"modc render: --colors {colors}: expected 2 to 256")
