@@ -321,6 +321,14 @@ def test_cli_engine_option(tmp_path):
     assert r.exit_code == 1 and "joint_2 sags" in r.output
     r = runner.invoke(app, ["sim", str(ROOT / "examples" / "table3_planar.mod"), "--engine", "ode"])
     assert r.exit_code == 2 and "unknown engine 'ode'" in r.output
+    traj = write(tmp_path, '{"joint_names": ["joint_1", "joint_2"], "points": [{"t": 0, "q": [0, 0]}, '
+                           '{"t": 0.2, "q": [0.2, -0.1]}]}', "t.json")
+    r = runner.invoke(app, ["play", str(ROOT / "examples" / "table3_planar.mod"), "--traj", str(traj),
+                            "--engine", "ode"])
+    assert r.exit_code == 2 and "unknown engine 'ode'" in r.output
+    r = runner.invoke(app, ["play", str(ROOT / "examples" / "table3_planar.mod"), "--traj", str(traj),
+                            "--engine", "mujoco"])
+    assert r.exit_code == 0 and "in MuJoCo" in r.output and "tracking error per joint" in r.output, r.output
 
 
 def test_home_keyframe_is_robot_home_within_narrowed_limits(tmp_path):
