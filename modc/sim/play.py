@@ -1,4 +1,6 @@
-"""`modc play FILE --traj TRAJ.json [--record OUT.gif]`: play a trajectory in PyBullet.
+"""`modc play FILE --traj TRAJ.json [--record OUT.gif] [--engine mujoco]`: play a trajectory in
+PyBullet (this module) or MuJoCo (mujoco_play.py: the MJCF scene, servos with inverse-dynamics
+feed-forward; this module reads the trajectory, reports and writes the GIF for both).
 
 The arm starts at rest at the first point and its actuators follow the trajectory (linear in
 joint space between points, trajectory.py) with the same position control as `modc sim`
@@ -10,8 +12,8 @@ otherwise headless, as fast as it goes.
 
 --record renders frames with the TinyRenderer (the `modc render` stage: ground, obstacles,
 targets, a tool0 triad) at FPS frames per second of simulated time from a camera fitted to the
-whole motion, and writes a looping GIF (one shared palette, no dithering, optimised): same
-input, same bytes.
+whole motion, captioned (robot, chain, time) with the targets labelled, and writes a looping
+GIF (one shared palette, no dithering, optimised): same input, same bytes.
 """
 from __future__ import annotations
 

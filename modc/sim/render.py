@@ -16,7 +16,12 @@ smallest at which the whole box fits inside 90 % of the frame. With no azimuth g
 rendered small, with the obstacles, and the one showing the most of the arm (of the least
 visible arm, when a file has several) and of the targets wins, a later candidate only when
 clearly (5 %) better: the farm cell's walls do not hide the arm. The chosen view is then framed
-on the rendered silhouette (centred, filling 90 % of the frame).
+on the rendered silhouette (centred, filling 90 % of the frame). One camera per file: the box,
+the scores and the framing take every pose of the file (home and each named pose), so pictures
+of two poses are taken from the same place.
+
+Captions (caption.py): a band under the scene names the robot, its chain and the pose, and each
+target carries a label beside its marker. WIDTH x HEIGHT (1280 x 960) reads on a slide.
 """
 from __future__ import annotations
 
