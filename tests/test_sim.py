@@ -252,7 +252,7 @@ def test_render_makes_a_clear_picture(tmp_path):
     ok, lines, _ = render(ROOT / "examples" / "farm.mod", out)
     assert ok and out.is_file() and "farm" in lines[0]
     img = Image.open(out)
-    assert img.size == (800, 600) and img.format == "PNG"
+    assert img.size == (1280, 960) and img.format == "PNG"
     a = np.asarray(img.convert("RGB"), dtype=int)
     colours = len(np.unique(a.reshape(-1, 3), axis=0))
     assert colours > 1000, colours
@@ -282,6 +282,34 @@ def test_render_pose_size_and_errors(tmp_path):
     with pytest.raises(scene.UsageError, match="no pose 'nope'.*home, ready"):
         render(ROOT / "examples" / "farm.mod", tmp_path / "x.png", pose="nope")
     assert not (tmp_path / "x.png").exists()
+
+
+def test_render_one_camera_per_file_captions_and_target_labels(tmp_path):
+    """Two poses of one file are seen from the same camera (framed over every pose), so the
+    static cell stays put; the picture is captioned (robot, chain, pose) and its targets labelled."""
+    from PIL import Image
+
+    from modc.sim import caption
+
+    path = ROOT / "examples" / "farm.mod"
+    pics = {}
+    for pose in ("home", "ready"):
+        out = tmp_path / f"{pose}.png"
+        ok, lines, _ = render(path, out, pose=pose, width=480, height=360)
+        assert ok
+        pics[pose] = (np.asarray(Image.open(out).convert("RGB"), dtype=int), lines[0].split("; ")[1])
+    (home, cam_home), (ready, cam_ready) = pics["home"], pics["ready"]
+    assert cam_home == cam_ready, (cam_home, cam_ready)
+    same = (np.abs(home - ready).sum(axis=2) == 0).mean()
+    assert same > 0.6, same  # the background and the cell: identical pixels
+    bare = tmp_path / "bare.png"
+    render(path, bare, pose="ready", width=480, height=360, captions=False)
+    plain = np.asarray(Image.open(bare).convert("RGB"), dtype=int)
+    band = caption.band_height(360)
+    assert (ready[-band:].min(axis=2) < 90).mean() > 0.01  # caption text on the band
+    assert (ready[-band:].min(axis=2) > 240).mean() > 0.5
+    ink = (np.abs(ready - np.array(caption.TARGET_INK)).sum(axis=2) < 40).sum()
+    assert ink > 40 and (np.abs(plain - np.array(caption.TARGET_INK)).sum(axis=2) < 40).sum() < ink / 4
 
 
 @pytest.mark.slow

@@ -179,7 +179,8 @@ def _gains_text(robot: Robot, j) -> dict:
     try:
         return {"kp": num(kp), "kv": num(kv), "forcerange": vec((-j.limits.effort, j.limits.effort))}
     except NotFinite:
-        raise NotFinite(f"the MuJoCo servo gain of {j.name} (kp = peak torque {j.limits.effort:.3g} N·m / "
+        peak = f"{j.limits.effort:.3g} N·m" if math.isfinite(j.limits.effort) else "(not finite)"
+        raise NotFinite(f"the MuJoCo servo gain of {j.name} (kp = peak torque {peak} / "
                         f"{ERROR_AT_PEAK:g} rad, kv = kp · d/p)") from None
 
 

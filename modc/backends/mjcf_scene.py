@@ -4,10 +4,10 @@ the robot file `<include>`d, as MuJoCo Menagerie's scene.xml includes its robot,
     floor       a checkered plane at the world's z = 0, lowered under the lowest point of the
                 arm in any keyframe and of the cell when something reaches below it
     light       a directional key light from above and the headlight, a gradient skybox
-    camera      "overview": fixed, framing the arm in every keyframe, the obstacles and the
-                targets at AZIMUTH / ELEVATION (sim.camera.fit_camera, the camera of `modc
-                render`), for ASPECT images; the free camera (statistic, visual/global) starts
-                on the same view
+    camera      "overview": fixed, framing the arm in every keyframe and the targets (not the
+                whole cell, which can dwarf the arm) at AZIMUTH / ELEVATION (sim.camera's
+                fit_camera, as `modc render`), for ASPECT images; the free camera (statistic,
+                visual/global) starts on the same view
     cell        each obstacle a world geom named as in the file (they collide: contype 1); each
                 target a site target_<name>, oriented when the target gives rpy; both carried
                 into the world through `base`, like `modc sim`
@@ -87,10 +87,11 @@ def scene_context(build: Build, robot: Robot) -> dict:
     T_world_base = transform(robot.base.xyz, robot.base.rpy)
     obstacles, targets = _cell(robot, T_world_base)
     pts = _keyframe_points(robot, T_world_base)
+    arm = _keyframe_points(robot.model_copy(update={"obstacles": ()}), T_world_base)
     # the floor is the cell's z = 0 unless a frame of the arm, an obstacle or a target lies below it
     lowest = float(((pts[0::2] + pts[1::2]) / 2.0)[:, 2].min())
     floor_z = 0.0 if lowest >= 0.0 else lowest - scene.MODULE_RADIUS - FLOOR_MARGIN
-    camera = _camera(pts)
+    camera = _camera(arm)  # the arm and its targets: a large cell would leave the arm small
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     centre = (lo + hi) / 2.0
     return {

@@ -56,7 +56,7 @@ def _angle(limit: float):
 @click.option("-o", "--out", required=True, help="PNG file to write")
 @click.option("--pose", help="named pose (default: home)")
 @click.option("--robot", help="render only this robot of the file")
-@click.option("--size", default="800x600", help="WIDTHxHEIGHT in pixels")
+@click.option("--size", default="1280x960", help="WIDTHxHEIGHT in pixels")
 @click.option("--azimuth", type=float, callback=_angle(360.0),
               help="camera azimuth in degrees from +x towards +y (default: chosen)")
 @click.option("--elevation", type=float, callback=_angle(90.0), help="camera elevation in degrees (default 30)")
@@ -81,7 +81,7 @@ def render_cmd(
         width, height = (int(v) for v in size.lower().split("x"))
         assert 0 < width <= MAX_PIXELS and 0 < height <= MAX_PIXELS
     except (ValueError, AssertionError):
-        _err(f"modc render: --size {size[:40]!r}: expected WIDTHxHEIGHT, each 1 to {MAX_PIXELS}, e.g. 800x600")
+        _err(f"modc render: --size {size[:40]!r}: expected WIDTHxHEIGHT, each 1 to {MAX_PIXELS}, e.g. 1280x960")
         raise SystemExit(EXIT_USAGE) from None
     if colors is not None and not 2 <= colors <= 256:
         _err(f"modc render: --colors {colors}: expected 2 to 256")

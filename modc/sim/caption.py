@@ -18,6 +18,21 @@ def _font(px: int):
     return ImageFont.load_default(size=max(10, px))
 
 
+def band_height(height: int) -> int:
+    """Pixels the caption band takes at the bottom of a picture this tall."""
+    size = round(height * CAPTION_SHARE)
+    return size + 2 * max(4, size // 2)
+
+
+def below(img, height: int):
+    """img on a white canvas `height` tall (img at the top): room for the band under the scene."""
+    from PIL import Image
+
+    canvas = Image.new("RGB", (img.width, height), (255, 255, 255))
+    canvas.paste(img, (0, 0))
+    return canvas
+
+
 def draw(img, title: str, detail: str = "", labels=()):
     """img (PIL RGB) with a translucent band at the bottom holding `title` (bold-ish: drawn
     twice, offset a pixel) and `detail`, and labels: (text, (u, v) pixel of the marker) drawn
@@ -31,7 +46,7 @@ def draw(img, title: str, detail: str = "", labels=()):
     overlay = Image.new("RGBA", img.size, (0, 0, 0, 0))
     pen = ImageDraw.Draw(overlay)
     pad = max(4, size // 2)
-    band_h = size + pad * 2
+    band_h = band_height(h)
     pen.rectangle((0, h - band_h, w, h), fill=BAND)
     x, y = pad * 2, h - band_h + pad
     pen.text((x, y), title, font=font, fill=INK)

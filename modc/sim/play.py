@@ -1,4 +1,6 @@
-"""`modc play FILE --traj TRAJ.json [--record OUT.gif]`: play a trajectory in PyBullet.
+"""`modc play FILE --traj TRAJ.json [--record OUT.gif] [--engine mujoco]`: play a trajectory in
+PyBullet (this module) or MuJoCo (mujoco_play.py: the MJCF scene, servos with inverse-dynamics
+feed-forward; this module reads the trajectory, reports and writes the GIF for both).
 
 The arm starts at rest at the first point and its actuators follow the trajectory (linear in
 joint space between points, trajectory.py) with the same position control as `modc sim`
@@ -10,8 +12,8 @@ otherwise headless, as fast as it goes.
 
 --record renders frames with the TinyRenderer (the `modc render` stage: ground, obstacles,
 targets, a tool0 triad) at FPS frames per second of simulated time from a camera fitted to the
-whole motion, and writes a looping GIF (one shared palette, no dithering, optimised): same
-input, same bytes.
+whole motion, captioned (robot, chain, time) with the targets labelled, and writes a looping
+GIF (one shared palette, no dithering, optimised): same input, same bytes.
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ from .render import Stage
 from .smoke import TIME_STEP
 
 FPS = 12.5  # frames per second of simulated time (80 ms: a whole number of GIF centiseconds)
-GIF_SIZE = (480, 360)
+GIF_SIZE = (640, 480)
 GIF_SUPERSAMPLE = 1.5  # rendered at 720x540 and downsampled: smooth edges at half the cost of 2x
 HOLD_AFTER = 0.5  # s at the last point after the motion
 LAST_FRAME_MS = 1000  # the GIF rests on its last frame before looping
@@ -156,10 +158,30 @@ def _frame(client, stage, r, traj, size: tuple[int, int], azimuth: float | None)
         per_sample.append(stage.points())
     pts = np.concatenate(per_sample)
     stage.add_ground(pts)
-    cam = stage.choose_camera(pts, size[0], size[1], azimuth, poses=[{r.name: q} for q in samples])
+    cam = stage.choose_camera(pts, size[0], _scene_height(size), azimuth, poses=[{r.name: q} for q in samples])
     if client.gui:
         client.resetDebugVisualizerCamera(float(np.linalg.norm(np.subtract(cam.eye, cam.target))),
                                           cam.azimuth + 90.0, -cam.elevation, list(cam.target))
+
+
+def _scene_height(size: tuple[int, int]) -> int:
+    """Pixels of a frame above its caption band."""
+    from . import caption
+
+    return size[1] - caption.band_height(size[1])
+
+
+def _captioned(stage, r, traj, t: float, size: tuple[int, int]):
+    """One GIF frame: the scene from the stage's camera, the caption band below, targets labelled."""
+    from . import caption
+    from .camera import project
+
+    h = _scene_height(size)
+    img = caption.below(stage.shoot(stage.camera, size[0], h, supersample=GIF_SUPERSAMPLE), size[1])
+    s = stage.scenes[r.name]
+    labels = [(name, tuple(project(stage.camera, stage.client.getBasePositionAndOrientation(body)[0], size[0], h)[0]))
+              for name, body in s.targets.items()]
+    return caption.draw(img, f"{r.name}  {r.sequence}", f"t = {t:.2f} s of {traj.duration:.2f} s  (PyBullet)", labels)
 
 
 @dataclass
@@ -195,7 +217,7 @@ def _run(client, stage, r, traj, recording: bool, fps: float, size: tuple[int, i
             next_check += 1.0 / CHECK_HZ
         if recording and t + 1e-12 >= next_frame:
             stage.place_axes()
-            run.frames.append(stage.shoot(stage.camera, size[0], size[1], supersample=GIF_SUPERSAMPLE))
+            run.frames.append(_captioned(stage, r, traj, t0 + t, size))
             next_frame += 1.0 / fps
         if k == steps:
             break

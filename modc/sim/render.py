@@ -16,7 +16,12 @@ smallest at which the whole box fits inside 90 % of the frame. With no azimuth g
 rendered small, with the obstacles, and the one showing the most of the arm (of the least
 visible arm, when a file has several) and of the targets wins, a later candidate only when
 clearly (5 %) better: the farm cell's walls do not hide the arm. The chosen view is then framed
-on the rendered silhouette (centred, filling 90 % of the frame).
+on the rendered silhouette (centred, filling 90 % of the frame). One camera per file: the box,
+the scores and the framing take every pose of the file (home and each named pose), so pictures
+of two poses are taken from the same place.
+
+Captions (caption.py): a band under the scene names the robot, its chain and the pose, and each
+target carries a label beside its marker. WIDTH x HEIGHT (1280 x 960) reads on a slide.
 """
 from __future__ import annotations
 
@@ -32,7 +37,7 @@ from .camera import FILL, Camera, fit_camera, vec3
 if TYPE_CHECKING:
     import numpy as np
 
-WIDTH, HEIGHT = 800, 600
+WIDTH, HEIGHT = 1280, 960  # reads on a slide
 SUPERSAMPLE = 2
 GRID = 0.1  # m, ground grid spacing
 GRID_LINE = 0.004  # m, width of a grid line
@@ -326,13 +331,16 @@ def pose_of(robot, pose: str | None) -> tuple[float, ...]:
 
 def render(path, out_png, pose: str | None = None, robot: str | None = None, library: str | None = None,
            width: int = WIDTH, height: int = HEIGHT, azimuth: float | None = None, elevation: float | None = None,
-           colors: int | None = None):
+           colors: int | None = None, captions: bool = True):
     """`modc render FILE -o OUT.png`. Returns (ok, report lines, checked).
 
     Every robot of the file (or the one named) at `pose` (default home), with its obstacles and
-    targets. ok is False only when the file has errors (checked.diagnostics say which; nothing is
-    written). Raises modc.compiler.InputError (unreadable file), RobotChoiceError (unknown robot),
-    scene.UsageError (unknown pose) and OSError (cannot write OUT.png).
+    targets, seen by the file's one camera (chosen and framed over every pose, so that the
+    pictures of two poses of one file match), captioned (robot, chain, pose) with target labels
+    unless captions=False. ok is False only when the file has errors (checked.diagnostics say
+    which; nothing is written). Raises modc.compiler.InputError (unreadable file),
+    RobotChoiceError (unknown robot), scene.UsageError (unknown pose) and OSError (cannot write
+    OUT.png).
     """
     checked = scene.load_checked(path, library)
     if not checked.ok:
@@ -340,7 +348,8 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
     robots = scene.select_robots(checked, robot)
     qs = {r.name: pose_of(r, pose) for r in robots}
     with scene.compiled(checked) as urdfs, scene.connect() as client:
-        img, cam = picture(client, robots, urdfs, qs, width, height, azimuth, elevation)
+        img, cam = picture(client, robots, urdfs, qs, width, height, azimuth, elevation,
+                           frame=file_poses(robots), caption_pose=pose or "home" if captions else None)
     save_png(img, out_png, colors)
     who = ", ".join(f"{r.name} ({r.sequence}) at {pose or 'home'}" for r in robots)
     return (
@@ -353,13 +362,53 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
     )
 
 
+def file_poses(robots) -> list[dict]:
+    """Every configuration a picture of these robots may show: home, then each pose name any of
+    them has (a robot without it at home), as {robot name: q}."""
+    names = []
+    for r in robots:
+        names += [p.name for p in r.poses if p.name != "home" and p.name not in names]
+    out = [{r.name: r.home() for r in robots}]
+    for n in names:
+        out.append({r.name: (tuple(r.pose(n).q) if r.pose(n) is not None else r.home()) for r in robots})
+    return out
+
+
 def picture(client, robots, urdfs, qs, width: int = WIDTH, height: int = HEIGHT,
-            azimuth: float | None = None, elevation: float | None = None):
-    """(PIL image, camera) of the robots at qs in a fresh stage on this client."""
+            azimuth: float | None = None, elevation: float | None = None, frame: list[dict] | None = None,
+            caption_pose: str | None = None):
+    """(PIL image, camera) of the robots at qs in a fresh stage on this client. frame: the
+    configurations the camera is chosen and framed for (default: qs alone). caption_pose: caption
+    the picture (robots, chains, this pose name) and label the targets; None: no caption."""
+    import numpy as np
+
+    from . import caption
+
     stage = Stage.build(client, robots, urdfs, qs)
     stage.add_tool_axes()
+    frame = frame or [qs]
+    pts = []
+    for f in frame:
+        stage.set(f)
+        pts.append(stage.points())
+    stage.add_ground(np.concatenate(pts))
+    scene_h = height - caption.band_height(height) if caption_pose is not None else height  # the band goes below
+    cam = stage.choose_camera(np.concatenate(pts), width, scene_h, azimuth, elevation, poses=frame)
     stage.set(qs)
-    pts = stage.points()
-    stage.add_ground(pts)
-    cam = stage.choose_camera(pts, width, height, azimuth, elevation)
-    return stage.shoot(cam, width, height), cam
+    img = stage.shoot(cam, width, scene_h)
+    if caption_pose is not None:
+        img = _captioned(stage, caption.below(img, height), cam, robots, caption_pose, scene_h)
+    return img, cam
+
+
+def _captioned(stage: Stage, img, cam: Camera, robots, pose: str, scene_h: int):
+    from . import caption
+    from .camera import project
+
+    title = ", ".join(f"{r.name}  {r.sequence}" for r in robots)
+    labels = []
+    for s in stage.scenes.values():
+        for name, body in s.targets.items():
+            xyz = stage.client.getBasePositionAndOrientation(body)[0]
+            labels.append((name, tuple(project(cam, xyz, img.width, scene_h)[0])))
+    return caption.draw(img, title, f"pose {pose}", labels)
