@@ -1,4 +1,4 @@
-"""MJCF backend: mjcf/mod<n>_<name>.xml per robot (SPEC section 5), a MuJoCo model of the arm in
+"""MJCF backend: mjcf/mod<n>_<name>.xml per robot (docs/outputs.md), a MuJoCo model of the arm in
 its cell, made from the same description as the URDF (physical.assembly), never from URDF text.
 
     bodies      base_link (welded to the world at `base`), link_1 … link_n with hinge joints

@@ -8,9 +8,9 @@ trajectory playback (`modc play`).
     verdict.py     the smoke test's checks and messages from what an engine measured (engine-neutral)
     render.py      render(path, out_png, pose=None, ...) -> (ok, report lines, checked)
     play.py        play(path, traj_json, record=None, ...) -> (ok, report lines, checked)
-    trajectory.py  the trajectory file of `plan --json` / `play --traj` (SPEC section 6): load, validate
+    trajectory.py  the trajectory file of `plan --json` / `play --traj` (docs/conventions.md): load, validate
 
-Frames: the world is the cell frame of `base …` (SPEC section 4): each robot's base_link is put at
+Frames: the world is the cell frame of `base …` (docs/language.md): each robot's base_link is put at
 robot.base, gravity is -z of the world, and obstacles and targets, which the file gives in
 base_link, are carried into the world through that same placement. With no `base` line the world
 is base_link. Heavy libraries (pybullet, numpy, PIL) are imported inside functions.
