@@ -44,7 +44,7 @@ from .registry import register
 from .ros_target import IK_PLUGINS, PLACEHOLDER_LICENSE, PLACEHOLDER_MAINTAINER, Target, resolve
 from .templates import comment, render, scene_token
 
-# --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
+# --- documented choices (docs/ros.md) -------------------------------------------------------------
 
 PACKAGE_VERSION = "0.1.0"
 
