@@ -1,4 +1,4 @@
-# SPEC section 4's environment example: an arm next to a shelf with one target.
+# The environment statements (docs/language.md): an arm next to a shelf with one target.
 robot cellarm {
     chain H1 - H4(pivot=-90deg) - L3(port=45deg)
     box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.25) m  # axis-aligned, centre position

@@ -1,4 +1,4 @@
-"""The paper's modular kinematics (section 3.1; SPEC section 2, normative), in numpy.
+"""The paper's modular kinematics (section 3.1; docs/conventions.md), in numpy.
 
 Per unit i, with the library's constants (x01, z01, z12, x23) and the unit's twists:
 

@@ -33,7 +33,8 @@ def _rule_comments(grammar: str) -> dict[str, str]:
     comment: list[str] = []
     for line in grammar.splitlines():
         if line.startswith("//"):
-            comment.append(line[2:].strip())
+            if not line[2:].startswith("    "):  # indented lines are examples, shown in the table instead
+                comment.append(line[2:].strip())
             continue
         m = re.match(r"([a-z_]+)\s*:", line)
         if m and comment:
@@ -52,7 +53,7 @@ def language_page() -> str:
              "The `.mod` grammar, statement by statement, read from `grammar/modc.lark` (the parser's own "
              "grammar; the editors' keyword lists are checked against it too). The guide to what each "
              "statement means is [The .mod language](../language.md).\n\n"]
-    for block in sorted(keywords.declaration_keywords()):
+    for block in sorted(keywords.declaration_keywords(), key=lambda b: (b != "robot", b)):
         lines.append(f"## `{block} NAME {{ … }}`\n\n")
         if notes.get(block):
             lines.append(f"{notes[block]}\n\n")

@@ -1,4 +1,4 @@
-"""Hypothesis strategies for valid .mod robots (SPEC sections 1 and 4), shared by property tests.
+"""Hypothesis strategies for valid .mod robots (docs/conventions.md, docs/language.md), shared by property tests.
 
     from strategies import valid_chains, valid_chains_with_dof, robot_specs
 

@@ -1,4 +1,4 @@
-"""The emitted URDF loads in the real consumers and means what SPEC section 2 says (SPEC section 7).
+"""The emitted URDF loads in the real consumers and means what docs/conventions.md says.
 
 Consumers: `check_urdf` (urdfdom, shipped with `pin`), pinocchio (+ coal for meshes), yourdfpy,
 PyBullet. Every example in examples/ is covered automatically, plus a few hand-picked chains that
@@ -6,8 +6,8 @@ reach the corners of the library (all unit kinds, +-90 deg pivots, 180 deg ports
 longest links, tool offset, payload, two robots in one file) and a property test over random valid
 chains (tests/strategies.py).
 
-Reference for kinematics: `modc.kinematics.Chain` (the normative product of SPEC section 2); the
-property test also checks `Chain` itself against an independent transcription of the SPEC.
+Reference for kinematics: `modc.kinematics.Chain` (the product stated in docs/conventions.md); the
+property test also checks `Chain` itself against an independent transcription of the paper's equations.
 """
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ from modc.kinematics import Chain
 from modc.model import Robot
 from modc.physical.assembly import FRAME_MASS, library_mass
 
-FK_TOL = 1e-9  # SPEC section 7: FK from the URDF equals section 2 to 1e-9
+FK_TOL = 1e-9  # FK from the URDF equals the paper's product to 1e-9
 # The pip wheel of PyBullet is built in single precision (btScalar = float): getLinkState returns
 # float32-rounded poses. Measured over every example and 300 random q each: positions off by up to
 # 3e-8 m, rotation-matrix entries by up to 5e-7 (float32 quaternions composed along the chain).
@@ -232,13 +232,13 @@ def check_fk_yourdfpy(arm: Arm, qs, tol: float = FK_TOL) -> None:
 
 
 def test_fk_pinocchio_matches_spec(arms):
-    """Pinocchio's FK of tool0 and of every joint_i / link_i frame equals SPEC section 2 to 1e-9."""
+    """Pinocchio's FK of tool0 and of every joint_i / link_i frame equals docs/conventions.md to 1e-9."""
     for k, arm in enumerate(arms):
         check_fk_pinocchio(arm, random_qs(arm.robot, N_RANDOM_Q, seed=k))
 
 
 def test_fk_yourdfpy_matches_spec(arms):
-    """yourdfpy's FK of tool0 and every link_i equals SPEC section 2 to 1e-9."""
+    """yourdfpy's FK of tool0 and every link_i equals docs/conventions.md to 1e-9."""
     for k, arm in enumerate(arms):
         check_fk_yourdfpy(arm, random_qs(arm.robot, N_RANDOM_Q, seed=k))
 
@@ -273,7 +273,7 @@ def bullet_link_pose(client, body: int, link: int, T_world_base: np.ndarray) -> 
 
 
 def test_fk_pybullet_matches_spec(arms, bullet):
-    """PyBullet's link frames of tool0 and every link_i match SPEC section 2 (to float32 precision)."""
+    """PyBullet's link frames of tool0 and every link_i match docs/conventions.md (to float32 precision)."""
     for k, arm in enumerate(arms):
         body = bullet.loadURDF(str(arm.urdf), useFixedBase=True, flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
         try:
@@ -314,7 +314,7 @@ def test_fk_pybullet_matches_spec(arms, bullet):
 
 
 def test_mesh_paths_are_relative_and_inside_the_output(arms):
-    """Every mesh the URDF names is a relative path to a file in OUT/meshes (SPEC section 5)."""
+    """Every mesh the URDF names is a relative path to a file in OUT/meshes (docs/outputs.md)."""
     for arm in arms:
         out = arm.urdf.parent.parent.resolve()
         for tag in ("visual", "collision"):
@@ -435,7 +435,7 @@ def test_inertias_are_physical(arms):
 
 
 def spec_T_base_tool(spec: RobotSpec, q) -> np.ndarray:
-    """SPEC section 2 transcribed independently of modc (constants from the SPEC section 1 table)."""
+    """The paper's product transcribed independently of modc (constants from the paper's Table 1 and section 3.1)."""
     table = {1: (0.0, 0.074, 0.073), 2: (-0.0297, 0.075, 0.073), 3: (0.0, 0.074, 0.073), 4: (-0.0297, 0.075, 0.073)}
 
     def H(R, p):
@@ -466,14 +466,14 @@ def spec_T_base_tool(spec: RobotSpec, q) -> np.ndarray:
 @given(spec=robot_specs(), seed=st.integers(0, 2**32 - 1))
 def test_random_valid_chains_load_with_spec_kinematics(spec: RobotSpec, seed: int):
     """Any valid chain compiles to a URDF that check_urdf accepts and whose FK in pinocchio and
-    yourdfpy equals SPEC section 2 (checked against modc's Chain and an independent transcription)."""
+    yourdfpy equals docs/conventions.md (checked against modc's Chain and an independent transcription)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out"
         (arm,) = compile_arms(spec.text, out, "fuzz.mod")
         assert arm.robot.sequence == spec.sequence and arm.urdf.name == f"{spec.file_stem}.urdf"
         qs = random_qs(arm.robot, 3, seed)[1:]
         for q in qs:
-            assert_close(Chain(arm.robot).T_base_tool(q), spec_T_base_tool(spec, q), FK_TOL, "Chain vs SPEC")
+            assert_close(Chain(arm.robot).T_base_tool(q), spec_T_base_tool(spec, q), FK_TOL, "Chain vs transcription")
         check_fk_pinocchio(arm, qs)
         check_fk_yourdfpy(arm, qs)
         assert_check_urdf_accepts(arm)

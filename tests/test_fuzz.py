@@ -1,4 +1,4 @@
-"""Robustness: whatever the input, checking it yields diagnostics, never an exception (SPEC §7).
+"""Robustness: whatever the input, checking it yields diagnostics, never an exception (docs/reliability.md).
 
 (a) grammar-aware inputs built from .mod fragments, valid and invalid (unknown units such as H5
     or X1, parameters with and without units, 1e999, nan, junk tokens, unclosed blocks, …);

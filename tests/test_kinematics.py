@@ -1,4 +1,4 @@
-"""The paper's three-frame kinematics (SPEC section 2), checked against the equations as printed."""
+"""The paper's three-frame kinematics (docs/conventions.md), checked against the equations as printed."""
 from __future__ import annotations
 
 import math

@@ -147,6 +147,7 @@ def test_the_wheel_installs_and_compiles_outside_the_checkout(tmp_path):
     deps = _deps_dir(tmp_path)
     # addsitedir also runs the dependencies' own .pth files (pinocchio's cmeel prefix)
     (site / "zz_reused_deps.pth").write_text(f"import site; site.addsitedir({str(deps)!r})\n", encoding="utf-8")
+    # pip itself comes from the reused packages; it installs into the fresh venv (its sys.prefix)
     subprocess.run([str(py), "-m", "pip", "install", "--no-index", "--find-links", str(dist), "modc"],
                    check=True, capture_output=True, text=True, env=env, cwd=tmp_path)
 

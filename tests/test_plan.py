@@ -6,7 +6,7 @@ The properties that matter are checked independently of the code under test:
     obstacles are rebuilt from the file's model, and coal is called directly (no pinocchio, no
     modc.plan code); the motion is sampled as `modc play` interpolates it (linearly between
     points), at most 0.25 deg per joint and 1 mm of tool0 motion apart;
-  - the target: tool0 by modc.kinematics.Chain (SPEC section 2), not by the planner's pinocchio;
+  - the target: tool0 by modc.kinematics.Chain (docs/conventions.md), not by the planner's pinocchio;
   - the velocity limits: read from the URDF's <limit velocity=…>.
 """
 from __future__ import annotations
@@ -243,7 +243,7 @@ def test_farm_timing(farm, plant_plan):
 
 def test_farm_json(plant_plan):
     doc = json.loads(plant_plan.dumps())
-    assert list(doc) == ["joint_names", "points"]  # SPEC section 6, a single robot in the file
+    assert list(doc) == ["joint_names", "points"]  # docs/conventions.md, a single robot in the file
     assert doc["joint_names"] == ["joint_1", "joint_2", "joint_3"]
     assert len(doc["points"]) == len(plant_plan.t)
     for pt in doc["points"]:

@@ -97,7 +97,7 @@ def test_layout_is_the_setup_assistants(packages):
         else:
             assert ros_files(files) == ROS1_LAYOUT | {f"launch/{s}_moveit_controller_manager.launch.xml",
                                                       f"launch/{s}_moveit_sensor_manager.launch.xml"}, stem
-        # SPEC section 5's normative paths stay where they were
+        # the documented paths (docs/outputs.md) stay where they were
         assert {f"urdf/{s}.urdf", f"config/{s}.srdf", f"urdf/{s}_ros.urdf", f"urdf/{s}.urdf.xacro"} <= set(files)
         assert (f"config/{s}.scene" in files) == bool(robot.obstacles)
         # exactly one file for MoveIt's trajectory execution among *_controllers.yaml (ROS 2)

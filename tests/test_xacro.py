@@ -4,7 +4,7 @@ Equivalent means, in pinocchio (which merges fixed joints, so the xacro form's e
 not matter): the same joints (joint_1..n, limits), the same frames (base_link, link_i, tool0,
 payload) at random q, the same rigid bodies per joint (mass, centre of mass, inertia), hence the
 same subtree masses, total mass, mass matrix, gravity torques and inverse dynamics; and the same
-meshes at the same places. Tolerance 1e-9 (SPEC section 7); both files carry 12 significant
+meshes at the same places. Tolerance 1e-9 (the consumers' tolerance); both files carry 12 significant
 digits, so the measured differences are ~1e-13.
 
 Also: the expansion passes check_urdf; the extra links are the paper's frames (unit base,

@@ -1,4 +1,4 @@
-"""MJCF backend: mjcf/mod<n>_<name>.xml per robot (SPEC section 5), a MuJoCo model of the arm, and
+"""MJCF backend: mjcf/mod<n>_<name>.xml per robot (docs/outputs.md), a MuJoCo model of the arm, and
 mjcf/scene_mod<n>_<name>.xml, the arm in its cell, both made from the same description as the URDF
 (physical.assembly), never from URDF text.
 

@@ -1,5 +1,5 @@
 """ROS backend: OUT/ is a MoveIt configuration package, file for file as the MoveIt Setup
-Assistant of the target distro writes it (SPEC section 5), for ROS 2 or for ROS 1.
+Assistant of the target distro writes it (docs/outputs.md), for ROS 2 or for ROS 1.
 
 ROS 2 (humble, jazzy; templates/ros/ros2), the layout MoveItConfigsBuilder reads by default:
 
@@ -44,7 +44,7 @@ from .registry import register
 from .ros_target import IK_PLUGINS, PLACEHOLDER_LICENSE, PLACEHOLDER_MAINTAINER, Target, resolve
 from .templates import comment, render, scene_token
 
-# --- documented choices (README: "Use in ROS 2 / ROS 1") ------------------------------------------
+# --- documented choices (docs/ros.md) -------------------------------------------------------------
 
 PACKAGE_VERSION = "0.1.0"
 

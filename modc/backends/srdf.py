@@ -1,4 +1,4 @@
-"""SRDF backend: config/mod<n>_<name>.srdf per robot (SPEC section 5), the MoveIt semantic
+"""SRDF backend: config/mod<n>_<name>.srdf per robot (docs/outputs.md), the MoveIt semantic
 description of the URDF the urdf backend emits.
 
     virtual_joint   fixed, world -> base_link ("virtual_joint")

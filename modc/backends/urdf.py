@@ -1,4 +1,4 @@
-"""URDF backend: urdf/mod<n>_<name>.urdf per robot (SPEC sections 2 and 5)."""
+"""URDF backend: urdf/mod<n>_<name>.urdf per robot (docs/conventions.md, docs/outputs.md)."""
 from __future__ import annotations
 
 from .build import Build

@@ -1,4 +1,4 @@
-"""xacro backend: a module macro library and a xacro form of every robot (SPEC section 5).
+"""xacro backend: a module macro library and a xacro form of every robot (docs/outputs.md).
 
     urdf/modc_modules.xacro          the macro library: one macro per unit type (1..4) of every
                                      module library the file's robots use, parameterised by variant

@@ -31,7 +31,7 @@ from .app import (
 @click.option("--smoke", is_flag=True, help="also run `modc sim` (PyBullet) before writing OUT")
 @click.option("--torque", type=click.Choice(["error", "warning", "off"]),
               help="how a joint that cannot hold the arm at peak torque is reported")
-# ROS package options (README "Use in ROS 2 / ROS 1"; precedence in modc.backends.ros_target.distro_for)
+# ROS package options (docs/ros.md; precedence in modc.backends.ros_target.distro_for)
 @click.option("--ros", type=int,
               help="ROS package for ROS 1 (noetic) or ROS 2 (jazzy); default: $ROS_DISTRO, $ROS_VERSION, else 2")
 @click.option("--ros-distro", help="target distro: noetic, humble or jazzy (overrides --ros)")
@@ -123,7 +123,7 @@ def compile_cmd(
 def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface,
                  package_license=None, maintainer=None) -> dict:
     """Build fields of the ROS backend. The environment ($ROS_DISTRO, $ROS_VERSION) is read here
-    and only here, below the command-line options (README "Use in ROS 2 / ROS 1")."""
+    and only here, below the command-line options (docs/ros.md)."""
     import os
 
     from ..backends import Build

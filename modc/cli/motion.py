@@ -138,7 +138,7 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
 @app.command("plan")
 @argument("file", help=".mod file (or its YAML form)")
 @click.option("--to", required=True, help="target to move tool0 to (a `target` of the robot)")
-@click.option("--json", "json_out", is_flag=True, help="print the trajectory as JSON on stdout (SPEC section 6)")
+@click.option("--json", "json_out", is_flag=True, help="print the trajectory as JSON on stdout (docs/conventions.md)")
 @click.option("--robot", help="robot of the file (default: the one that has the target)")
 @click.option("--seed", type=click.IntRange(min=0), default=0,
               help="seed of IK starts, RRT-Connect and shortcuts: same file and seed, same motion")

@@ -1,4 +1,4 @@
-"""SPEC section 2's kinematics for many candidate chains and many joint vectors at once (numpy).
+"""The paper's kinematics (docs/conventions.md) for many candidate chains and many joint vectors at once (numpy).
 
 Per unit, A_t1(pivot) . A_J(theta) . A_t2(port) = PRE . Rz(theta) . POST with PRE = A_t1 . Tz(z12)
 and POST = A_t2 (identity for units 1/2), so one forward pass is two fixed 4x4 products and a

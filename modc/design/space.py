@@ -4,7 +4,7 @@ Paper rules (section 3): a chain is H^k L^(n-k) - the first unit H, the last L, 
 H - with k <= eps(H) and n - k <= eps(L); each position is one of the unit types 1-4.
 
 Reductions that lose nothing:
-- H and L units of one type share their geometry (SPEC section 1: x01, z01, z12, x23 belong to the
+- H and L units of one type share their geometry (docs/conventions.md: x01, z01, z12, x23 belong to the
   type), so kinematics - reach, IK, the obstacle screen - depend on the types only. The search
   runs once per *shape* (types and link lengths) and the variant splits H^k L^(n-k) are only
   re-weighed (mass, torque) afterwards.

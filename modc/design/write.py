@@ -1,4 +1,4 @@
-"""What `modc design FILE -o DIR` writes: DIR/ranking.json (SPEC section 6), one complete robot
+"""What `modc design FILE -o DIR` writes: DIR/ranking.json (docs/conventions.md), one complete robot
 file per design (DIR/<name>_<rank>.mod: the chain, the cell, the targets and a pose per target,
 compilable as it is) and DIR/report.html."""
 from __future__ import annotations

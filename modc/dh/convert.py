@@ -6,7 +6,7 @@ The paper's rules, for row i = (a, alpha, d, theta) of a standard DH table:
   3. a != 0, alpha != 0 -> the twist is set at unit i's connection port (skew axes);
   4. d != 0            -> a unit without a link module (type 1 or 2), unless rule 1 applies.
 
-Policy for the rest (documented in the README; reproduces every published sequence the rules
+Policy for the rest (documented in docs/language.md; reproduces every published sequence the rules
 decide — Example B, and Table 3's planar, spatial and skew rows):
   * Ip1 or Ip2: unit 1 sits on the base through Ip1; later units connect through Ip2, as in the
     paper's results — except after a row with a = 0 and alpha = 0, where Ip2's 29.7 mm offset

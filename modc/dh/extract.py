@@ -1,4 +1,4 @@
-"""The realised standard DH table of a chain, read off its joint axes (SPEC section 3).
+"""The realised standard DH table of a chain, read off its joint axes (paper section 4.2; docs/language.md).
 
 Standard DH (Rz(theta) Tz(d) Tx(a) Rx(alpha)); row i relates axis i to axis i+1, and the last
 row relates axis n to the tool0 z axis. a is the length of the common normal, alpha the angle

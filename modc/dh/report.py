@@ -1,4 +1,4 @@
-"""Requested vs realised DH, as tables for people and as JSON (SPEC section 6, dh2mod --json)."""
+"""Requested vs realised DH, as tables for people and as JSON (docs/conventions.md, dh2mod --json)."""
 from __future__ import annotations
 
 import math

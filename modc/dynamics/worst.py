@@ -38,7 +38,7 @@ class JointWorst:
         return (self.tau_max - self.tau) / self.tau_max
 
     def to_json(self) -> dict:
-        """SPEC section 6's per-joint record (rounded so that reports are stable across machines)."""
+        """The torque report's per-joint record (docs/conventions.md), rounded so that reports are stable."""
         return {"name": self.name, "unit": self.variant, "tau_gravity_max": round(self.tau, 6), "tau_nom": self.tau_nom,
                 "tau_max": self.tau_max, "margin": round(self.margin, 6),
                 "pose": [round(float(np.degrees(x)), 1) + 0.0 for x in self.q], "status": self.level}

@@ -1,4 +1,4 @@
-"""The module library: a validated data file (SPEC section 1), never code.
+"""The module library: a validated data file (docs/conventions.md), never code.
 
 All lengths in metres, masses in kilograms, torques in N·m; fields ending in _deg are degrees.
 """

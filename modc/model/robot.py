@@ -139,7 +139,7 @@ class Robot(_M):
 
     @property
     def file_stem(self) -> str:
-        """SPEC section 1: the URDF for the Kinova bring-up is named mod<n>_<name>."""
+        """docs/conventions.md: the URDF for the Kinova bring-up is named mod<n>_<name>."""
         return f"mod{self.dof}_{self.name}"
 
     def link_length(self, u: UnitSpec) -> float:

@@ -1,4 +1,4 @@
-"""Pivot and port twists must be settable on the library's hardware (SPEC section 1)."""
+"""Pivot and port twists must be settable on the library's hardware (docs/conventions.md)."""
 from __future__ import annotations
 
 import math

@@ -170,7 +170,7 @@ def _link_inertials(units: list[_Unit], frames: list[np.ndarray]) -> list[Inerti
 
 
 def describe(robot: Robot) -> Description:
-    """The assembled arm as links and joints (kinematics: modc.kinematics, SPEC section 2)."""
+    """The assembled arm as links and joints (kinematics: modc.kinematics, docs/conventions.md)."""
     lib = robot.library
     assert lib is not None
     n = robot.dof

@@ -1,5 +1,5 @@
 """`modc plan FILE --to TARGET`: a collision-free motion of the arm from a pose (home) to a named
-target (SPEC section 6).
+target (docs/conventions.md).
 
     from modc.plan import plan, PlanError
     result = plan("examples/farm.mod", "plant", seed=0)     # -> Plan, or raises PlanError
@@ -64,14 +64,14 @@ class Plan:
 
     @property
     def trajectory(self) -> Trajectory:
-        """The motion as a trajectory file (SPEC section 6), naming the robot in several-robot files."""
+        """The motion as a trajectory file (docs/conventions.md), naming the robot in several-robot files."""
         return Trajectory(self.joint_names, self.t, self.q, self.robot if self.with_robot_name else None)
 
     def to_json(self) -> dict:
         return self.trajectory.to_json()
 
     def dumps(self) -> str:
-        """SPEC section 6 JSON, one point per line, fixed number formatting."""
+        """docs/conventions.md JSON, one point per line, fixed number formatting."""
         return self.trajectory.dumps()
 
     def summary(self) -> str:

@@ -11,9 +11,9 @@ trajectory playback (`modc play`).
     caption.py     caption bands and target labels on renders and GIF frames
     play.py        play(path, traj_json, record=None, engine=...) -> (ok, report lines, checked)
     mujoco_engine.py, mujoco_play.py   `sim` and `play` with --engine mujoco, on the MJCF scene
-    trajectory.py  the trajectory file of `plan --json` / `play --traj` (SPEC section 6): load, validate
+    trajectory.py  the trajectory file of `plan --json` / `play --traj` (docs/conventions.md): load, validate
 
-Frames: the world is the cell frame of `base …` (SPEC section 4): each robot's base_link is put at
+Frames: the world is the cell frame of `base …` (docs/language.md): each robot's base_link is put at
 robot.base, gravity is -z of the world, and obstacles and targets, which the file gives in
 base_link, are carried into the world through that same placement. With no `base` line the world
 is base_link. Heavy libraries (pybullet, numpy, PIL) are imported inside functions.

@@ -8,7 +8,7 @@ The checks and messages are verdict.py's, as for PyBullet; what differs is the m
             and principal moments, and there is one hinge joint and one servo per module.
   per pose  home, then every other named pose:
     FK          the tool0 site in base_link against modc.kinematics to FK_TOL: MuJoCo computes in
-                double precision, so 1e-9 as the URDF's consumers (SPEC section 7), not PyBullet's 1e-6.
+                double precision, so 1e-9 as the URDF's consumers (the consumers' tolerance), not PyBullet's 1e-6.
     self        signed distances between the collision geoms of link pairs (mj_geomDistance on
                 the parts' primitives; the visual meshes never collide), pairs adjacent
                 (contacts.py's rule) or allowed by an SRDF skipped, deeper than CONTACT_TOL. The

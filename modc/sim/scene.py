@@ -12,7 +12,7 @@ the targets. Shared by `modc sim`, `modc render`, `modc play` (and `modc plan`).
 Frames. The world is the cell frame: base_link is placed at robot.base (identity when the file
 has no `base` line), gravity points along -z of the world, so a tilted base is felt by the
 joints exactly as the torque analysis assumes. The file gives obstacles and targets in base_link
-(SPEC section 4); they are carried into the world through the same placement,
+(docs/language.md); they are carried into the world through the same placement,
 T_world_obstacle = T_world_base · T_base_obstacle. Results are reported in base_link.
 
 Collision queries (Scene.self_collisions, environment_collisions, ...) live in contacts.py.

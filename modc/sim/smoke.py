@@ -8,7 +8,7 @@ static bodies), then:
             failure, quoted), every URDF link has an <inertial> with positive mass and principal
             moments, and PyBullet sees one revolute joint per module.
   per pose  `home` (Robot.home: the pose named home, else MoveIt's default values), then every other named pose:
-    FK          PyBullet's tool0 frame equals modc.kinematics (SPEC section 2) to FK_POS_TOL /
+    FK          PyBullet's tool0 frame equals modc.kinematics (docs/conventions.md) to FK_POS_TOL /
                 FK_ROT_TOL: the pip wheel of PyBullet computes in single precision, so 1e-6 m and
                 1e-5 (rotation-matrix entries), not the 1e-9 the double-precision consumers meet.
     self        no two links collide, except adjacent ones (parent-child, and neighbours of a

@@ -1,4 +1,4 @@
-"""The trajectory file (SPEC section 6): what `modc plan --json` prints (Trajectory.dumps, the one
+"""The trajectory file (docs/conventions.md): what `modc plan --json` prints (Trajectory.dumps, the one
 writer) and `modc play --traj` and `modc check --traj` read (load, the one reader).
 
     {"joint_names": ["joint_1", …, "joint_n"],

@@ -156,7 +156,7 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
     if label == "expected-robot":
         return codes.EXPECTED_ROBOT.at(span, found=found)
     expected = e.accepts or e.expected
-    hint = next((HINTS[n] for n in sorted(expected) if n in HINTS), "see the .mod language reference in the README")
+    hint = next((HINTS[n] for n in sorted(expected) if n in HINTS), "see the .mod language guide, docs/language.md")
     return codes.SYNTAX_ERROR.at(span, found=found, expected=_expected(expected), hint=hint)
 
 

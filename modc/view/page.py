@@ -109,7 +109,7 @@ def read_trajectory(path: str) -> trajectory.Trajectory:
 
 
 class Ranking:
-    """The designs of a `modc design` ranking.json (SPEC section 6), best first; their files
+    """The designs of a `modc design` ranking.json (docs/conventions.md), best first; their files
     lie next to ranking.json."""
 
     def __init__(self, path: str | os.PathLike):
