@@ -44,7 +44,7 @@ import math
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..kinematics import matrix_rpy, transform
 from ..model import Robot
 from ..physical.assembly import Description

@@ -5,7 +5,7 @@ the robot file `<include>`d, as MuJoCo Menagerie's scene.xml includes its robot,
                 arm in any keyframe and of the cell when something reaches below it
     light       a directional key light from above and the headlight, a gradient skybox
     camera      "overview": fixed, framing the arm in every keyframe and the targets (not the
-                whole cell, which can dwarf the arm) at AZIMUTH / ELEVATION (sim.camera's
+                whole cell, which can dwarf the arm) at AZIMUTH / ELEVATION (physical.camera's
                 fit_camera, as `modc render`), for ASPECT images; the free camera (statistic,
                 visual/global) starts on the same view
     cell        each obstacle a world geom named as in the file (they collide: contype 1); each
@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..kinematics import matrix_rpy, rpy_matrix, transform
 from ..model import Robot
 from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
@@ -58,14 +58,14 @@ def _cell(robot: Robot, T_world_base) -> tuple[list[dict], list[dict]]:
 
 def _keyframe_points(robot: Robot, T_world_base):
     """World points bounding the arm in every keyframe, the obstacles and the targets."""
-    from ..sim.scene import extent_points  # points in pairs: a centre widened by its radius either way
+    from ..physical.cell import extent_points  # points in pairs: a centre widened by its radius either way
 
     poses = [robot.home()] + [p.q for p in robot.poses if p.name != "home"]
     return np.concatenate([extent_points(robot, q, T_world_base) for q in poses])
 
 
 def _camera(points) -> dict:
-    from ..sim.camera import fit_camera
+    from ..physical.camera import fit_camera
 
     cam = fit_camera(points, AZIMUTH, ELEVATION, ASPECT)
     eye, target = np.array(cam.eye), np.array(cam.target)
@@ -82,7 +82,7 @@ def _camera(points) -> dict:
 
 
 def scene_context(build: Build, robot: Robot) -> dict:
-    from ..sim import scene
+    from ..physical import cell as scene
 
     T_world_base = transform(robot.base.xyz, robot.base.rpy)
     obstacles, targets = _cell(robot, T_world_base)

@@ -7,7 +7,6 @@ trajectory playback (`modc play`).
     smoke.py       run_sim(path, ...) -> (ok, report lines, checked): PyBullet measures each pose
     verdict.py     the smoke test's checks and messages from what an engine measured (engine-neutral)
     render.py      render(path, out_png, pose=None, ...) -> (ok, report lines, checked)
-    camera.py      the pictures' camera (fit_camera, project): pure numpy, also the MJCF scene's
     caption.py     caption bands and target labels on renders and GIF frames
     play.py        play(path, traj_json, record=None, engine=...) -> (ok, report lines, checked)
     mujoco_engine.py, mujoco_play.py   `sim` and `play` with --engine mujoco, on the MJCF scene

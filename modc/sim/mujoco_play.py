@@ -29,7 +29,7 @@ push the arm; self and environment contacts are looked for play.CHECK_HZ times a
 geometrically (mujoco_engine's queries) and reported.
 
 --record renders with MuJoCo's offscreen renderer (EGL without a display; MUJOCO_GL chooses)
-from one camera fitted to the whole motion (sim.camera, as `modc render`), captioned, and writes
+from one camera fitted to the whole motion (physical.camera, as `modc render`), captioned, and writes
 the GIF with play.save_gif.
 """
 from __future__ import annotations
@@ -37,8 +37,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..physical.camera import FOV, fit_camera, project
 from . import caption
-from .camera import FOV, fit_camera, project
 
 GIF_SIZE = (800, 600)
 SMOOTH = 0.01  # s: the servos are fed the trajectory averaged over this window (see above)

@@ -173,8 +173,8 @@ def _scene_height(size: tuple[int, int]) -> int:
 
 def _captioned(stage, r, traj, t: float, size: tuple[int, int]):
     """One GIF frame: the scene from the stage's camera, the caption band below, targets labelled."""
+    from ..physical.camera import project
     from . import caption
-    from .camera import project
 
     h = _scene_height(size)
     img = caption.below(stage.shoot(stage.camera, size[0], h, supersample=GIF_SUPERSAMPLE), size[1])

@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..physical.camera import FILL, Camera, fit_camera, vec3
 from . import scene
-from .camera import FILL, Camera, fit_camera, vec3
 
 if TYPE_CHECKING:
     import numpy as np
@@ -402,8 +402,8 @@ def picture(client, robots, urdfs, qs, width: int = WIDTH, height: int = HEIGHT,
 
 
 def _captioned(stage: Stage, img, cam: Camera, robots, pose: str, scene_h: int):
+    from ..physical.camera import project
     from . import caption
-    from .camera import project
 
     title = ", ".join(f"{r.name}  {r.sequence}" for r in robots)
     labels = []

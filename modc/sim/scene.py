@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..model import Robot
-from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
+from ..physical.cell import MODULE_RADIUS, OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA, extent_points  # noqa: F401  (one home: physical/)
 from .contacts import CollisionQueries
 
 if TYPE_CHECKING:
@@ -226,40 +226,6 @@ def matrix_pose(T) -> tuple[tuple[float, float, float], tuple[float, float, floa
     p = np.asarray(T)[:3, 3]
     return (float(p[0]), float(p[1]), float(p[2])), (float(x), float(y), float(z), float(w))
 
-
-MODULE_RADIUS = 0.06  # m: a joint module reaches about this far from its frames
-
-
-def extent_points(robot: Robot, q=None, T_world_base=None):
-    """Points (world) that bound what a picture of the robot shows at q: every frame of the
-    chain widened by a module's radius, each obstacle's bounding sphere, each target."""
-    import numpy as np
-
-    from ..kinematics import Chain
-
-    T = transform(robot.base.xyz, robot.base.rpy) if T_world_base is None else T_world_base
-    chain = Chain(robot)
-    q = robot.home() if q is None else q
-    pts, radii = [np.zeros(3)], [MODULE_RADIUS]
-    for f in chain.frames(q):
-        for k in ("T_base_twist1", "T_base_joint", "T_base_end"):
-            pts.append(f[k][:3, 3])
-            radii.append(MODULE_RADIUS)
-    pts.append(chain.T_base_tool(q)[:3, 3])
-    radii.append(MODULE_RADIUS)
-    for ob in robot.obstacles:
-        half = {"box": lambda s: float(np.linalg.norm(s)) / 2.0, "sphere": lambda s: s[0],
-                "cylinder": lambda s: float(np.hypot(s[0], s[1] / 2.0))}[ob.shape](ob.size)
-        pts.append(np.array(ob.origin.xyz))
-        radii.append(half)
-    for t in robot.targets:
-        pts.append(np.array(t.xyz))
-        radii.append(TARGET_RADIUS)
-    out = []
-    for p, r in zip(pts, radii, strict=True):
-        w = (T @ np.array([*p, 1.0]))[:3]
-        out += [w - r, w + r]
-    return np.array(out)
 
 
 LAYOUT_GAP = 0.15  # m between robots laid out side by side
