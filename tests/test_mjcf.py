@@ -363,9 +363,30 @@ def test_a_number_mujoco_cannot_hold_is_a_diagnostic_not_inf(tmp_path):
     mod = write(tmp_path, 'robot a {\n  library "lib.yaml"\n  chain H1 - H4(pivot=-90deg) - L3(port=45deg)\n}\n')
     res = CliRunner().invoke(app, ["compile", str(mod), "-o", str(tmp_path / "out")])
     assert res.exit_code == 1, res.output
-    assert "error[not-finite]" in res.output and "kp = peak torque" in res.output and ":2:3:" in res.output
+    # the library's own range check (out-of-range, at the YAML line) catches it first; the MJCF's
+    # not-finite check below is the backstop for any number that still overflows
+    assert "error[out-of-range]" in res.output or "error[not-finite]" in res.output, res.output
     assert "inf" not in res.output.replace("infinite", "") and "Traceback" not in res.output
     assert not (tmp_path / "out").exists()
+
+
+def test_the_mjcf_refuses_a_number_that_overflows(tmp_path):
+    """Whatever the library check lets through, a number MuJoCo cannot hold is a not-finite
+    diagnostic at the robot's library statement, never kp="inf" in the file."""
+    from modc.backends import mjcf
+    from modc.diagnostics.errors import InputError
+
+    mod = write(tmp_path, 'robot a {\n  chain H1 - L3\n}\n')
+    checked = check_file(mod)
+    (robot,) = checked.design.robots
+
+    def overflowing():
+        return mjcf.num(float("inf"))
+
+    with pytest.raises(InputError) as e:
+        mjcf._finite(robot, overflowing)
+    assert e.value.diagnostic.code == "not-finite"
+    assert "inf" not in e.value.diagnostic.message.replace("infinite", "")
 
 
 def test_library_name_goes_through_the_comment_sanitiser(tmp_path):
