@@ -67,9 +67,10 @@ def label_lifts(targets, cam: Camera, T_world_base: np.ndarray) -> list[np.ndarr
     return out
 
 
-def cell(scene, base: str, arm: Arm, cam: Camera) -> list:
-    """Obstacles and targets under base (base_link), labels placed for the view cam; returns the handles."""
-    out = []
+def cell(scene, base: str, arm: Arm, cam: Camera) -> tuple[list, dict]:
+    """Obstacles and targets under base (base_link), labels placed for the view cam; returns the
+    handles, and the labels' by target name."""
+    out, labels = [], {}
     for ob in arm.robot.obstacles:
         T_ob = transform(ob.origin.xyz, ob.origin.rpy)
         kw = dict(color=OBSTACLE_RGB, opacity=0.6, position=T_ob[:3, 3], wxyz=wxyz(T_ob))
@@ -91,9 +92,10 @@ def cell(scene, base: str, arm: Arm, cam: Camera) -> list:
         if t.position_tolerance > TARGET_RADIUS:
             scene.add_icosphere(f"{name}/tolerance", radius=t.position_tolerance, color=TARGET_RGB, opacity=0.2)
         # the label stays upright whatever the target's orientation: placed in base_link
-        out.append(scene.add_label(f"{base}/target_labels/{t.name}", target_label(t), anchor="bottom-center",
-                                   position=np.asarray(t.xyz) + lift, font_screen_scale=1.2))
-    return out
+        labels[t.name] = scene.add_label(f"{base}/target_labels/{t.name}", target_label(t), anchor="bottom-center",
+                                         position=np.asarray(t.xyz) + lift, font_screen_scale=1.2)
+        out.append(labels[t.name])
+    return out, labels
 
 
 def tool_and_payload(scene, base: str, arm: Arm) -> list:

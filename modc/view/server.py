@@ -57,6 +57,7 @@ class View:
         self._gui: list = []
         self._links: dict = {}
         self._meshes: list = []  # (Shape, handle, colour shown)
+        self.labels: dict = {}  # target name -> its label's handle
         self._sliders: list = []
         self.camera: Camera | None = None  # the framing camera of the arm on view
         self.contacts: list = []  # what touches at the pose shown (plan.collision.Contact)
@@ -103,7 +104,8 @@ class View:
         base = f"/arm{self._shown}"  # fresh names for every arm: browsers never see a name removed and re-added
         self._nodes.append(scene.add_frame(base, show_axes=False, position=T[:3, 3], wxyz=draw.wxyz(T)))
         cam = self._camera(arm)
-        self._nodes += draw.cell(scene, base, arm, cam)
+        nodes, self.labels = draw.cell(scene, base, arm, cam)
+        self._nodes += nodes
         for link in arm.description.links:
             self._links[link.name] = scene.add_frame(f"{base}/{link.name}", show_axes=link.name == "tool0",
                                                      axes_length=draw.AXES, axes_radius=0.003)
