@@ -178,7 +178,8 @@ def cli_items():
         *[[*plan, opt, "{v}"] for opt in ("--start", "--seed", "--robot")],
         ["sim", "IN/farm.mod", "--engine", "{v}"], ["play", "IN/farm.mod", "--headless", "--traj", "{v}"],
     ]
-    values = st.one_of(st.sampled_from(VALUES), st.sampled_from(EXTREME), st.integers(-10**25, 10**25).map(str),
+    curated = st.sampled_from(VALUES + EXTREME)  # drawn 3 times in 5: the values that found crashes
+    values = st.one_of(curated, curated, curated, st.integers(-10**25, 10**25).map(str),
                        st.floats().map(repr), st.text(st.characters(blacklist_categories=["Cs"],
                                                                     blacklist_characters="\x00"), max_size=20))
     return st.tuples(st.sampled_from(templates), values)
