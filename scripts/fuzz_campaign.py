@@ -43,6 +43,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "scripts")]
+FORMS = ("mod", "yaml", "bytes", "dir", "fifo", "zero", "raw", "text", "msg")  # (form, input) items
 NUMERIC_OUTPUTS = (".urdf", ".xml", ".srdf", ".xacro", ".yaml", ".json")
 
 BATCH = 100
@@ -261,13 +262,12 @@ def compile_one(text: str, samples: int) -> dict | None:
 
 
 def _shown(item) -> str:
-    """The input of a finding as text: hostile and file items are (form, input), cli (argv, value)."""
-    if isinstance(item, tuple) and len(item) == 2 and isinstance(item[0], list):
-        return json.dumps(item)
-    payload = item[1] if isinstance(item, tuple) else item
-    if isinstance(payload, dict):
-        return json.dumps(payload, default=repr)
-    return payload if isinstance(payload, str) else payload.decode("latin-1")
+    """The input of a finding as text: hostile and file items are (form, input); anything else
+    (cli (argv, value), plan (text, fractions), ws frames) as JSON."""
+    payload = item[1] if isinstance(item, tuple) and isinstance(item[0], str) and item[0] in FORMS else item
+    if isinstance(payload, bytes):
+        return payload.decode("latin-1")
+    return payload if isinstance(payload, str) else json.dumps(payload, default=repr)
 
 
 def _signature(e: BaseException) -> str:

@@ -168,7 +168,7 @@ def run_check_urdf(path: Path) -> subprocess.CompletedProcess:
     env = dict(os.environ)
     if "cmeel.prefix" in exe[0]:  # the raw binary needs the prefix's libraries (the wrapper sets this)
         env["LD_LIBRARY_PATH"] = str(Path(exe[0]).parent.parent / "lib") + os.pathsep + env.get("LD_LIBRARY_PATH", "")
-    return subprocess.run([*exe, str(path)], capture_output=True, text=True, env=env, timeout=60)
+    return subprocess.run([*exe, str(path)], capture_output=True, text=True, env=env, timeout=300)  # a hang guard
 
 
 def assert_check_urdf_accepts(arm: Arm) -> None:

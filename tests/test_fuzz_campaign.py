@@ -55,7 +55,10 @@ def test_a_seeded_slice_of_the_new_generators_finds_nothing(tmp_path):
                         "--inputs", "14", "--compiles", "1", "--kinds", ISSUE_21], capture_output=True, text=True,
                        timeout=1800)
     findings = tmp_path / "findings.jsonl"
-    assert r.returncode == 0, findings.read_text()[-4000:] if findings.exists() else r.stderr[-3000:]
+    if findings.exists():
+        found = [json.loads(line) for line in findings.read_text().splitlines()]
+        pytest.fail("\n".join(f"{f['kind']}: {f['type']}: {f['detail']}" for f in found))
+    assert r.returncode == 0, r.stderr[-3000:]
     state = json.loads(r.stdout)
     assert state["by_kind"] == {k: 2 for k in ISSUE_21.split(",")} and state["findings"] == 0
 

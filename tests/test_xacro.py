@@ -240,7 +240,7 @@ def test_expansion_passes_check_urdf(pairs):
     exe = Path(sys.executable).parent / "check_urdf"
     assert exe.is_file(), f"check_urdf is expected next to {sys.executable}"
     for p in pairs:
-        res = subprocess.run([str(exe), str(p.xacro_urdf)], capture_output=True, text=True, timeout=60)
+        res = subprocess.run([str(exe), str(p.xacro_urdf)], capture_output=True, text=True, timeout=300)
         assert res.returncode == 0, (
             f"check_urdf rejects the expansion of {p.robot.file_stem}:\n{res.stdout}\n{res.stderr}"
         )
@@ -339,7 +339,7 @@ def test_xacro_cli(farm, tmp_path):
     exe = Path(sys.executable).parent / "xacro"
     assert exe.is_file()
     x = farm.urdf.parent / f"{farm.robot.file_stem}.urdf.xacro"
-    res = subprocess.run([str(exe), str(x), "prefix:=r_"], capture_output=True, text=True, timeout=60)
+    res = subprocess.run([str(exe), str(x), "prefix:=r_"], capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr
     assert res.stdout == expand(x, prefix="r_")
 
