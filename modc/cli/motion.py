@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import click
 
@@ -146,7 +147,7 @@ def plan_cmd(
             if start is not None:
                 _err("modc plan: --start does not apply to --task (a task starts from the home pose)")
                 raise SystemExit(EXIT_USAGE)
-            result = plan_task(file, task, robot=robot, seed=seed, library=library, timeout=timeout)
+            result: Any = plan_task(file, task, robot=robot, seed=seed, library=library, timeout=timeout)
         else:
             assert to is not None
             result = plan(file, to, robot=robot, seed=seed, start=start, library=library, timeout=timeout)

@@ -136,18 +136,18 @@ def _at_scale(traj, limits: Limits, k: float) -> Timed:
 def _concat(pieces: list[Timed], limits: Limits, q0) -> Timed:
     if not pieces:
         z = np.zeros((1, len(q0)))
-        q = np.asarray(q0, float)[None, :]
-        return Timed(np.zeros(1), q, z, z.copy(), np.array([limits.rnea(q[0], z[0], z[0])]), limits)
-    t, q, qd, qdd, tau = [pieces[0].t], [pieces[0].q], [pieces[0].qd], [pieces[0].qdd], [pieces[0].tau]
+        q0 = np.asarray(q0, float)[None, :]
+        return Timed(np.zeros(1), q0, z, z.copy(), np.array([limits.rnea(q0[0], z[0], z[0])]), limits)
+    ts, qs, qds, qdds, taus = [pieces[0].t], [pieces[0].q], [pieces[0].qd], [pieces[0].qdd], [pieces[0].tau]
     offset = pieces[0].duration
     for p in pieces[1:]:  # each piece starts where (and at rest as) the previous one ended: drop its first sample
-        t.append(p.t[1:] + offset)
-        q.append(p.q[1:])
-        qd.append(p.qd[1:])
-        qdd.append(p.qdd[1:])
-        tau.append(p.tau[1:])
+        ts.append(p.t[1:] + offset)
+        qs.append(p.q[1:])
+        qds.append(p.qd[1:])
+        qdds.append(p.qdd[1:])
+        taus.append(p.tau[1:])
         offset += p.duration
-    return Timed(np.concatenate(t), np.vstack(q), np.vstack(qd), np.vstack(qdd), np.vstack(tau), limits)
+    return Timed(np.concatenate(ts), np.vstack(qs), np.vstack(qds), np.vstack(qdds), np.vstack(taus), limits)
 
 
 def time_polyline(path, limits: Limits) -> Timed:

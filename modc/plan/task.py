@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -102,8 +103,7 @@ class TaskPlan:
                f"{self.cycle_time:.3f} s, energy {self.energy:.2f} J, peak torque {self.peak_share:.0%} of peak"]
         width = max(len(f"{s.start} -> {s.end}") for s in self.segments)
         for i, s in enumerate(self.segments):
-            label = "approach" if s.kind == "approach" else f"{i if self.segments[0].kind == 'approach' else i + 1:>2} "\
-                f"{s.kind}"
+            label = "approach" if s.kind == "approach" else f"{i:>2} {s.kind}"
             out.append(f"  {label:<11} {f'{s.start} -> {s.end}':<{width}}  {s.duration:7.3f} s  {s.energy:7.2f} J  "
                        f"torque {s.peak_share:4.0%}  speed {s.speed_share:4.0%}")
         out.append(f"  trajectory  {len(self.t)} points, {self.t[-1]:.3f} s with the approach; "
@@ -163,9 +163,8 @@ def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_na
     checker = CollisionChecker(robot)
     limits = Limits.of(robot)
     job = _Job(robot, item, kind, seed, sources, checker, limits, timeout)
-    home, q = start_pose(robot, None)[:2], None
-    q = np.array(home[1], float)
-    where = home[0]
+    where, q_home, _span = start_pose(robot, None)
+    q = np.array(q_home, float)
     pieces, segments, t0 = [], [], 0.0
     steps = [("approach", where, visits[0])]
     steps += [("motion" if kind == "task" else "straight", a, b) for a, b in zip(visits, visits[1:], strict=False)]
@@ -193,23 +192,23 @@ def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_na
 
 @dataclass(frozen=True)
 class _Job:
-    robot: object
-    item: object
+    robot: Any  # modc.model.Robot
+    item: Any  # its Task or StraightPath
     kind: str
     seed: int
     sources: dict
-    checker: object
-    limits: object
+    checker: Any  # modc.plan.collision.CollisionChecker
+    limits: Any  # modc.plan.retime.Limits
     timeout: float | None
 
     def fail(self, number: int, a: str, b: str, detail: str, hint: str, exit_code: int = EXIT_FAILED) -> PlanError:
         seg = "approach" if number == 0 else str(number)
-        d = codes.TASK_SEGMENT_FAILED.at(self.item.span, kind=self.kind, task=self.item.name,  # type: ignore[attr-defined]
+        d = codes.TASK_SEGMENT_FAILED.at(self.item.span, kind=self.kind, task=self.item.name,
                                          segment=f"{seg} ({a} -> {b})", detail=detail, hint=hint)
         return PlanError([d], self.sources, exit_code)
 
     def target(self, name: str):
-        t = self.robot.task_target(name)  # type: ignore[attr-defined]
+        t = self.robot.task_target(name)
         assert t is not None, name  # lowering resolved every name of the task
         return t
 
@@ -221,10 +220,10 @@ class _Job:
         from .retime import time_polyline
 
         robot = self.robot
-        start = Pose.model_construct(name=START, q=tuple(float(v) for v in q), span=self.item.span)  # type: ignore
-        targets = tuple(t for t in robot.targets if t.name != b) + (self.target(b),)  # type: ignore[attr-defined]
-        poses = tuple(p for p in robot.poses if p.name != START) + (start,)  # type: ignore[attr-defined]
-        seg_robot = robot.model_copy(update={"targets": targets, "poses": poses})  # type: ignore[attr-defined]
+        start = Pose.model_construct(name=START, q=tuple(float(v) for v in q), span=self.item.span)
+        targets = tuple(t for t in robot.targets if t.name != b) + (self.target(b),)
+        poses = tuple(p for p in robot.poses if p.name != START) + (start,)
+        seg_robot = robot.model_copy(update={"targets": targets, "poses": poses})
         try:
             result = plan_robot(seg_robot, b, seed=self.seed, start=START, sources=self.sources, timeout=self.timeout)
         except PlanError as e:
@@ -276,7 +275,7 @@ class _Job:
         path = [np.asarray(q, float)]
         for k in range(1, len(positions)):
             x, R = positions[k], rotations[k] if tol_o < math.inf else None
-            solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper, R)  # type: ignore[attr-defined]
+            solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper, R)
             qn, _ = solver.run(path[-1], x)
             pe, oe = solver.errors(qn, x)
             at = f"{k / (len(positions) - 1):.0%} of the way"
@@ -289,8 +288,8 @@ class _Job:
                 raise self.fail(number, ta.name, tb.name, f"the joints jump by {math.degrees(jump):.0f} deg {at} "
                                 "(the arm passes a singular or limit pose)",
                                 "move the segment away from the arm's singular poses and joint limits")
-            if not ch.motion_valid(path[-1], qn):  # type: ignore[attr-defined]
-                contacts = "; ".join(c.describe() for c in ch.contacts(qn, 0.0)) or "closer than the margin"  # type: ignore
+            if not ch.motion_valid(path[-1], qn):
+                contacts = "; ".join(c.describe() for c in ch.contacts(qn, 0.0)) or "closer than the margin"
                 raise self.fail(number, ta.name, tb.name, f"the arm collides {at}: {contacts}",
                                 "move the segment or the obstacle")
             path.append(qn)
@@ -302,12 +301,12 @@ class _Job:
         from .ik import PositionIK
 
         ch = self.checker
-        solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper)  # type: ignore[attr-defined]
+        solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper)
         pa, pb = np.asarray(ta.xyz, float), np.asarray(tb.xyz, float)
         tol_p = self._tolerance(ta, tb)[0]
         for q in qs:
             if distance_to_segment(solver.position(q), pa, pb) > tol_p or np.any(q < ch.lower - 1e-9) or \
-                    np.any(q > ch.upper + 1e-9) or ch.contacts(q, 0.0):  # type: ignore[attr-defined]
+                    np.any(q > ch.upper + 1e-9) or ch.contacts(q, 0.0):
                 raise self.fail(number, ta.name, tb.name, "the timed motion leaves the segment, a joint limit or "
                                 "the free space between the waypoints", "move the segment away from obstacles")
 
