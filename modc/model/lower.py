@@ -214,6 +214,8 @@ class _Lowerer:
                 reg = region(self, st)
                 if reg is not None:
                     acc["regions"].append(reg)
+                else:  # reported already: tasks naming it are not reported again
+                    acc["bad_regions"].add(st.name.text)
             case ast.Task() | ast.StraightPath():
                 acc["task_statements"].append(st)  # resolved once every target and region is known
             case ast.BaseWithin():
@@ -229,7 +231,8 @@ class _Lowerer:
     @staticmethod
     def _acc(source_dir: str | None) -> dict:
         return {"poses": [], "limits": [], "obstacles": [], "targets": [], "allow": set(), "source_dir": source_dir,
-                "named": True, "regions": [], "task_statements": [], "base_within": []}
+                "named": True, "regions": [], "task_statements": [], "base_within": [],
+                "bad_regions": set()}
 
     @staticmethod
     def _lists(acc: dict) -> dict:
@@ -240,7 +243,8 @@ class _Lowerer:
     def _tasks(self, acc: dict, block: str) -> None:
         from .lower_task import tasks
 
-        acc["tasks"], acc["paths"] = tasks(self, acc["task_statements"], acc["targets"], acc["regions"], block)
+        acc["tasks"], acc["paths"] = tasks(self, acc["task_statements"], acc["targets"], acc["regions"], block,
+                                          acc["bad_regions"])
 
     def robot(self, r: ast.Robot, source_dir: str | None) -> Robot | None:
         """The robot, or None when its name or a unit's is invalid (its statements are still checked)."""

@@ -122,12 +122,14 @@ def _known(targets, regions) -> str:
     return "targets: " + ", ".join(names) if names else "declare it first: `target NAME at (x, y, z) m`"
 
 
-def _resolve(low, ref: ast.PointRef, kind: str, name: str, targets, regions) -> list[str] | None:
+def _resolve(low, ref: ast.PointRef, kind: str, name: str, targets, regions, bad=frozenset()) -> list[str] | None:
     """The point names a reference stands for: a target, a region's points, or one point."""
     text = ref.name.text
     r = next((r for r in regions if r.name == text), None)
     t = next((t for t in targets if t.name == text), None)
     why = None
+    if r is None and t is None and text in bad:  # a region with errors of its own
+        return None
     if ref.index is None and t is not None:
         return [t.name]
     if ref.index is None and r is not None:
@@ -145,7 +147,8 @@ def _resolve(low, ref: ast.PointRef, kind: str, name: str, targets, regions) -> 
     return None
 
 
-def tasks(low, statements: list, targets, regions, block: str) -> tuple[tuple[Task, ...], tuple[StraightPath, ...]]:
+def tasks(low, statements: list, targets, regions, block: str,
+          bad=frozenset()) -> tuple[tuple[Task, ...], tuple[StraightPath, ...]]:
     """Tasks and paths with every reference resolved; names unique among targets, regions,
     tasks and paths (duplicates among targets alone are check_names' business)."""
     seen = {t.name for t in targets}
@@ -161,12 +164,12 @@ def tasks(low, statements: list, targets, regions, block: str) -> tuple[tuple[Ta
             continue
         seen.add(st.name.text)
         if isinstance(st, ast.Task):
-            visits = [_resolve(low, ref, "task", st.name.text, targets, regions) for ref in st.visits]
+            visits = [_resolve(low, ref, "task", st.name.text, targets, regions, bad) for ref in st.visits]
             if low.name(st.name, "task") and None not in visits:
                 out_tasks.append(Task(name=st.name.text, visits=tuple(p for v in visits if v for p in v),
                                       span=st.span))
         else:
-            ends = [_resolve(low, ref, "path", st.name.text, targets, regions) for ref in (st.start, st.end)]
+            ends = [_resolve(low, ref, "path", st.name.text, targets, regions, bad) for ref in (st.start, st.end)]
             for ref, e in zip((st.start, st.end), ends, strict=True):
                 if e is not None and len(e) != 1:
                     low.error(codes.UNKNOWN_TASK_TARGET.at(ref.span, kind="path", name=st.name.text, ref=ref.text,
