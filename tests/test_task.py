@@ -218,7 +218,7 @@ def urdf_model(tmp_path_factory):
     with pytest.raises(SystemExit) as e:
         main([str(EXAMPLE), "-o", str(out)])
     assert e.value.code == 0
-    (urdf,) = (out / "urdf").glob("*.urdf")
+    urdf = out / "urdf" / "mod3_farm.urdf"
     model = pin.buildModelFromUrdf(str(urdf))
     return model, model.createData()
 
@@ -341,3 +341,16 @@ def test_plan_needs_to_or_task(capsys):
     with pytest.raises(SystemExit) as e:
         main(["plan", str(EXAMPLE)])
     assert e.value.code == 2 and "--to TARGET or --task NAME" in capsys.readouterr().err
+
+
+def test_lsp_outline_and_definition():
+    from modc.lsp.document import Analysis
+    from modc.lsp.symbols import definition, symbols
+
+    text = EXAMPLE.read_text(encoding="utf-8")
+    an = Analysis(text, str(EXAMPLE))
+    outline = {s.name: s.detail for s in symbols(an)[0].children}
+    assert outline["tray"] == "region" and outline["serve"] == "task" and outline["seam"] == "path"
+    at = text.index("visit plant, tray") + len("visit plant, ") + 1
+    (loc,) = definition(an, at, EXAMPLE.as_uri())
+    assert loc.range.start.line == text[: text.index("region tray")].count("\n")
