@@ -35,9 +35,10 @@ __all__ = ["ModLexer"]
 DECLARATIONS = ("design", "robot")
 #: Keywords that start a statement inside a robot block (`row` starts a row of a `dh` block).
 STATEMENTS = ("allow", "base", "box", "chain", "cylinder", "dh", "library", "limit", "links", "modules",
-              "payload", "pose", "rank", "row", "sphere", "target", "tool", "units")
+              "path", "payload", "pose", "rank", "region", "row", "sphere", "target", "task", "tool", "units")
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
-CLAUSES = ("at", "fit-links", "length", "radius", "rpy", "size", "step", "to", "within")
+CLAUSES = ("at", "fit-links", "from", "grid", "length", "radius", "rpy", "size", "step", "straight", "to",
+           "visit", "within", "x", "yaw")
 #: Every keyword of the language.
 KEYWORDS = frozenset(DECLARATIONS + STATEMENTS + CLAUSES)
 #: Units of measure (modc.model.quantities.ALL).
@@ -80,12 +81,16 @@ class ModLexer(RegexLexer):
         "body": [
             include("common"),
             (r"\}", Punctuation, "#pop"),
+            (r"\{", Punctuation, "body"),  # task NAME { visit … }
+            (r"[\[\]]", Punctuation),  # a region point: tray[1,0,0]
             (r"chain\b", Keyword, "chain"),
             (r"dh\b", Keyword, "dh"),
             (r"allow\b", Keyword, "allow"),
             (r'(library)(\s+)("[^"\n]*")', bygroups(Keyword, Whitespace, String.Double)),
             (r"(library)(\s+)([A-Za-z_][A-Za-z0-9_.-]*)", bygroups(Keyword, Whitespace, Name.Namespace)),
             (r"(pose|target)(\s+)(" + _NAME + r")", bygroups(Keyword, Whitespace, Name.Function)),
+            (r"(region|task|path)(\s+)(" + _NAME + r")", bygroups(Keyword, Whitespace, Name.Function)),
+            (r"(box)(\s+)(size)\b", bygroups(Keyword, Whitespace, Keyword)),  # region r box size, base within box size
             (r"(box|sphere|cylinder|limit)(\s+)(" + _NAME + r")", bygroups(Keyword, Whitespace, Name.Variable)),
             (words(DECLARATIONS, suffix=r"\b"), Keyword.Declaration),
             (words(STATEMENTS + CLAUSES, suffix=_WORD_END), Keyword),

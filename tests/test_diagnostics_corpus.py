@@ -83,6 +83,8 @@ FUNCTION_CASES = {
     "bad-payload": "test_bad_payload",
     "traj-invalid": "test_traj_invalid",
     "no-design": "test_no_design",
+    "task-unknown": "test_task_plan_errors",
+    "task-segment-failed": "test_task_plan_errors",
     **{
         code: "test_plan_errors"
         for code in (
@@ -723,3 +725,28 @@ def test_no_design(tmp_path, capsys):
     assert f"{src}:1:8: error[no-design]" in err, err
     assert "target 'far': no design gets closer than 1.88 m" in err and "= hint:" in err and "Traceback" not in err
     assert not out.exists() and stdout == ""
+
+
+TASK_CELL = """robot farm {
+    chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)
+    pose home (0, 0, 0) deg
+    target plant at (0.30, 0, 0.25) m
+    target far at (2, 0, 0.25) m
+    task serve { visit plant, far }
+}
+"""
+
+
+def test_task_plan_errors(tmp_path, capsys):
+    """`modc plan --task`: an unknown task (exit 2) and a segment that cannot be planned (exit 1,
+    naming the segment) are diagnostics with a hint, never a traceback."""
+    cell = tmp_path / "cell.mod"
+    cell.write_text(TASK_CELL, encoding="utf-8")
+    for args, rc_want, code, where, words in [
+        (["--task", "harvest"], 2, "task-unknown", "<command line>:1:1", "no task or path 'harvest'"),
+        (["--task", "serve"], 1, "task-segment-failed", f"{cell}:6:5", "segment 1 (plant -> far)"),
+    ]:
+        rc, out, err = run_cli(capsys, "plan", str(cell), *args)
+        assert rc == rc_want, (args, err)
+        assert f"{where}: error[{code}]" in err and words in err, err
+        assert "= hint:" in err and "Traceback" not in err and out == ""

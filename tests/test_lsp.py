@@ -697,15 +697,20 @@ def test_keyword_classes_are_read_from_the_grammar():
         "sphere",
         "cylinder",
         "target",
+        "region",
+        "task",
+        "path",
         "allow",
     )
     assert language.statements("dh") == ("row",)
-    assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links", "within", "to", "step"}
+    assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links", "within", "to", "step",
+                                          "grid", "x", "visit", "from", "straight", "yaw"}
     assert language.statements("design") == (
-        "library", "base", "tool", "payload", "box", "sphere", "cylinder", "target", "allow", "units", "modules",
-        "links", "rank",
+        "library", "base", "tool", "payload", "box", "sphere", "cylinder", "target", "allow", "region", "task", "path",
+        "units", "modules", "links", "rank",
     )
-    assert language.name_takers() == {"robot", "design", "pose", "limit", "box", "sphere", "cylinder", "target", "rank"}
+    assert language.name_takers() == {"robot", "design", "pose", "limit", "box", "sphere", "cylinder", "target", "rank",
+                                      "region", "task", "path"}
     assert language.syntax_of("cylinder") == "cylinder NAME radius QUANTITY length QUANTITY at (…) rpy (…)"
 
 

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import click
 
@@ -137,7 +138,8 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
 
 @app.command("plan")
 @argument("file", help=".mod file (or its YAML form)")
-@click.option("--to", required=True, help="target to move tool0 to (a `target` of the robot)")
+@click.option("--to", help="target to move tool0 to (a `target` of the robot)")
+@click.option("--task", help="plan and time this task or path of the robot (`task`, `path`), as one trajectory")
 @click.option("--json", "json_out", is_flag=True, help="print the trajectory as JSON on stdout (docs/conventions.md)")
 @click.option("--robot", help="robot of the file (default: the one that has the target)")
 @click.option("--seed", type=click.IntRange(min=0), default=0,
@@ -147,7 +149,8 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
 @library_option
 def plan_cmd(
     file: str,
-    to: str,
+    to: str | None,
+    task: str | None,
     json_out: bool,
     robot: str | None,
     seed: int,
@@ -155,11 +158,24 @@ def plan_cmd(
     timeout: float,
     library: str | None,
 ) -> None:
-    """Plan a collision-free motion from the home pose (or --start) to a named target (exit 1 if none)."""
+    """Plan a collision-free motion from the home pose (or --start) to a named target (exit 1 if none);
+    with --task, plan and time a whole task from the home pose."""
     from ..plan import PlanError, plan
 
+    if (to is None) == (task is None):
+        _err("modc plan: give one of --to TARGET or --task NAME")
+        raise SystemExit(EXIT_USAGE)
     try:
-        result = plan(file, to, robot=robot, seed=seed, start=start, library=library, timeout=timeout)
+        if task is not None:
+            from ..plan.task import plan_task
+
+            if start is not None:
+                _err("modc plan: --start does not apply to --task (a task starts from the home pose)")
+                raise SystemExit(EXIT_USAGE)
+            result: Any = plan_task(file, task, robot=robot, seed=seed, library=library, timeout=timeout)
+        else:
+            assert to is not None
+            result = plan(file, to, robot=robot, seed=seed, start=start, library=library, timeout=timeout)
     except PlanError as e:
         _print_diagnostics(e.diagnostics, e.sources)
         raise SystemExit(e.exit_code) from None

@@ -270,6 +270,19 @@ NONPOSITIVE_SIZE = _register("nonpositive-size", E, "an obstacle size, radius or
 UNKNOWN_ALLOW = _register("unknown-allow", E, "`allow` naming a code that cannot be silenced",
     "'{name}' cannot be allowed", "allowable codes: {allowable}")
 
+# --- tasks (region, task, path, base within; SPEC section 4) -----------------------------------
+REGION_GRID = _register("region-grid", E, "a region's grid that gives no points, or absurdly many",
+    "{what}", "{hint}")
+UNKNOWN_TASK_TARGET = _register("unknown-task-target", E, "a task or path naming no target or region point",
+    "{kind} '{name}' names '{ref}', {why}", "{known}")
+BASE_WITHIN_ROBOT = _register("base-within-robot", E, "`base within` in a robot block",
+    "`base within` belongs in design blocks: robot '{robot}' stands at one base pose",
+    "write the pose as `base at (x, y, z) m [rpy (r, p, y) deg]`, or move the statement into a `design` block")
+TASK_UNKNOWN = _register("task-unknown", E, "`plan --task` naming a task the robot does not declare",
+    "robot {robot} has no task or path '{task}'", "{known}")
+TASK_SEGMENT_FAILED = _register("task-segment-failed", E, "a segment of a task that cannot be planned or timed",
+    "{kind} '{task}', segment {segment}: {detail}", "{hint}")
+
 # --- design problems (`design NAME { … }`, modc design) -----------------------------------------
 DESIGN_BOUND = _register("design-bound", E, "a search bound of a design block that cannot be searched",
     "{what}", "{hint}")

@@ -175,8 +175,9 @@ def joint_number(text: str) -> int | None:
 # --- the analysis of one document version ---------------------------------------------------------
 
 # The AST statements that declare a name, by the kind the token view gives them.
-DECL_KINDS = {ast.Pose: "pose", ast.Target: "target", ast.Box: "box", ast.Sphere: "sphere", ast.Cylinder: "cylinder"}
-DECLARING = (ast.Pose, ast.Target, ast.Box, ast.Sphere, ast.Cylinder)
+DECL_KINDS = {ast.Pose: "pose", ast.Target: "target", ast.Box: "box", ast.Sphere: "sphere", ast.Cylinder: "cylinder",
+              ast.Region: "region", ast.Task: "task", ast.StraightPath: "path"}
+DECLARING = (ast.Pose, ast.Target, ast.Box, ast.Sphere, ast.Cylinder, ast.Region, ast.Task, ast.StraightPath)
 
 
 @dataclass

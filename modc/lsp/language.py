@@ -54,6 +54,7 @@ QUANTITY_KINDS = {
     "links": "a length",
     "to": "a length",  # `links 150 mm to 300 mm` (`units 1 to 3` takes plain numbers)
     "step": "a length",
+    "yaw": "an angle",  # `base within … yaw 0 to 90 deg step 45 deg`
 }
 # Name-taking statements whose name refers to something (a joint) rather than declaring one.
 REFERS = frozenset({"limit", "rank"})  # rank names objectives, not things it declares
@@ -96,6 +97,16 @@ KEYWORDS = {
     "to": "`… to …` — the upper end of a range (`units 1 to 3`, `links 150 mm to 300 mm`).",
     "step": "`step 50 mm` — the spacing of the link lengths a design search tries.",
     "within": "`within 5 mm, 2 deg` — a target's position (and orientation) tolerance (default 5 mm, 2°).",
+    "region": "`region NAME box size (x, y, z) m at (x, y, z) m grid NX x NY x NZ [rpy (…) deg] [within 5 mm, 2 deg]` "
+    "— targets evenly spaced over a box, faces included, named NAME[i,j,k] (0-based).",
+    "task": "`task NAME { visit a, tray, tray[1,0,0] }` — collision-free joint-space motions through the targets (a "
+    "region: its points in order); `modc plan FILE --task NAME` plans and times it.",
+    "path": "`path NAME from a to b straight` — tool0 along the straight segment a -> b (orientation interpolated), "
+    "within the targets' tolerances.",
+    "grid": "`grid 3 x 2 x 1` — a region's number of points along x, y and z.",
+    "visit": "`visit a, b, …` — the targets (or region points) a task goes through, in order.",
+    "straight": "`straight` — the path is the straight segment between its ends.",
+    "yaw": "`yaw 0 to 90 deg step 45 deg` — (design) the base yaws to try.",
 }
 
 # What each parameter does, in words; their names and kinds are the lowering's (model/lower.py).

@@ -23,6 +23,9 @@ SYMBOL_KIND = {
     "box": types.SymbolKind.Struct,
     "sphere": types.SymbolKind.Struct,
     "cylinder": types.SymbolKind.Struct,
+    "region": types.SymbolKind.Variable,
+    "task": types.SymbolKind.Event,
+    "path": types.SymbolKind.Event,
 }
 
 

@@ -208,6 +208,18 @@ class _Lowerer:
                 t = self.target(st)
                 if t is not None:
                     acc["targets"].append(t)
+            case ast.Region():
+                from .lower_task import region
+
+                reg = region(self, st)
+                if reg is not None:
+                    acc["regions"].append(reg)
+                else:  # reported already: tasks naming it are not reported again
+                    acc["bad_regions"].add(st.name.text)
+            case ast.Task() | ast.StraightPath():
+                acc["task_statements"].append(st)  # resolved once every target and region is known
+            case ast.BaseWithin():
+                acc["base_within"].append(st)
             case ast.Allow():
                 for c in st.codes:
                     if c.text in REGISTRY and REGISTRY[c.text].allowable:
@@ -219,12 +231,20 @@ class _Lowerer:
     @staticmethod
     def _acc(source_dir: str | None) -> dict:
         return {"poses": [], "limits": [], "obstacles": [], "targets": [], "allow": set(), "source_dir": source_dir,
-                "named": True}
+                "named": True, "regions": [], "task_statements": [], "base_within": [],
+                "bad_regions": set()}
 
     @staticmethod
     def _lists(acc: dict) -> dict:
         return {"poses": tuple(acc["poses"]), "limits": tuple(acc["limits"]), "obstacles": tuple(acc["obstacles"]),
-                "targets": tuple(acc["targets"]), "allow": frozenset(acc["allow"])}
+                "targets": tuple(acc["targets"]), "allow": frozenset(acc["allow"]),
+                "regions": tuple(acc["regions"]), "tasks": acc["tasks"], "paths": acc["paths"]}
+
+    def _tasks(self, acc: dict, block: str) -> None:
+        from .lower_task import tasks
+
+        acc["tasks"], acc["paths"] = tasks(self, acc["task_statements"], acc["targets"], acc["regions"], block,
+                                          acc["bad_regions"])
 
     def robot(self, r: ast.Robot, source_dir: str | None) -> Robot | None:
         """The robot, or None when its name or a unit's is invalid (its statements are still checked)."""
@@ -235,6 +255,9 @@ class _Lowerer:
         acc = self._acc(source_dir)
         for st in r.body:
             self.cell_statement(st, rname, fields, seen, acc)
+        self._tasks(acc, rname)
+        for st in acc["base_within"]:
+            self.error(codes.BASE_WITHIN_ROBOT.at(st.span, robot=rname))
         if "chain" in seen and "dh" in seen:
             self.error(codes.CHAIN_AND_DH.at(seen["dh"].span, robot=rname))
             fields.pop("dh")
@@ -258,9 +281,16 @@ class _Lowerer:
                 search.append(st)
             else:
                 self.cell_statement(st, _say(d.name), fields, seen, acc)
-        if not acc["targets"] and not any(isinstance(st, ast.Target) for st in d.body):
+        if not acc["targets"] and not any(isinstance(st, ast.Target | ast.Region) for st in d.body):
             self.error(codes.DESIGN_NO_TARGETS.at(d.name.span, name=_say(d.name)))
         bounds = lower_bounds(self, search, _say(d.name))
+        self._tasks(acc, _say(d.name))
+        if len(acc["base_within"]) > 1:
+            self.error(codes.DUPLICATE_STATEMENT.at(acc["base_within"][1].span, what="base within", robot=_say(d.name)))
+        elif acc["base_within"]:
+            from .lower_task import base_grid
+
+            bounds["base_grid"] = base_grid(self, acc["base_within"][0])
         if not (named and acc["named"]):
             return None
         cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)

@@ -9,7 +9,7 @@ import math
 
 from ..diagnostics import codes
 from ..syntax import ast
-from .robot import RANK_KEYS
+from .robot import RANK_KEYS, TASK_RANK_KEYS
 
 MAX_LINK_LENGTHS = 12  # per link unit: beyond this the search space is not worth enumerating
 
@@ -86,8 +86,9 @@ def lower_bounds(low, statements: list, block: str) -> dict:
             case ast.Rank():
                 keys = []
                 for k in st.keys:
-                    if k.text not in RANK_KEYS:
-                        low.error(codes.UNKNOWN_OBJECTIVE.at(k.span, name=k.text, known=", ".join(RANK_KEYS)))
+                    if k.text not in RANK_KEYS + TASK_RANK_KEYS:
+                        known = ", ".join(RANK_KEYS + TASK_RANK_KEYS)
+                        low.error(codes.UNKNOWN_OBJECTIVE.at(k.span, name=k.text, known=known))
                     elif k.text not in keys:
                         keys.append(k.text)
                 # objectives not named keep their default order after the named ones

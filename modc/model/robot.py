@@ -102,6 +102,82 @@ class Target(_M):
     span: SpanField = NOWHERE
 
 
+MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; beyond this, a typo
+
+
+class Region(_M):
+    """`region NAME box size … at … grid nx x ny x nz`: targets evenly spaced over an axis-aligned
+    box, faces included; an axis with one point holds it at the box's centre."""
+
+    name: Name
+    size: Vec3  # m, full extents
+    center: Vec3  # m, in base_link
+    grid: tuple[int, int, int]
+    rpy: Vec3 | None = None  # every point's tool0 orientation
+    position_tolerance: float = POSITION_TOLERANCE
+    orientation_tolerance: float = ORIENTATION_TOLERANCE
+    span: SpanField = NOWHERE
+
+    def indices(self) -> list[tuple[int, int, int]]:
+        """Every point's (i, j, k), in order: k fastest, then j, then i."""
+        nx, ny, nz = self.grid
+        return [(i, j, k) for i in range(nx) for j in range(ny) for k in range(nz)]
+
+    def point_name(self, index: tuple[int, int, int]) -> str:
+        return f"{self.name}[{index[0]},{index[1]},{index[2]}]"
+
+    def point(self, index: tuple[int, int, int]) -> Target:
+        """The point as a target (its name, `tray[i,j,k]`, is not an identifier: built unvalidated)."""
+        xyz = []
+        for c, s, n, i in zip(self.center, self.size, self.grid, index, strict=True):
+            xyz.append(c if n == 1 else c - s / 2 + s * i / (n - 1))
+        return Target.model_construct(name=self.point_name(index), xyz=(xyz[0], xyz[1], xyz[2]), rpy=self.rpy,
+                                      position_tolerance=self.position_tolerance,
+                                      orientation_tolerance=self.orientation_tolerance, span=self.span)
+
+    def points(self) -> list[Target]:
+        return [self.point(ix) for ix in self.indices()]
+
+
+class Task(_M):
+    """`task NAME { visit … }`: the targets tool0 visits in order (region names expanded to their
+    points), joined by collision-free joint-space motions."""
+
+    name: Name
+    visits: tuple[str, ...]  # target names and region point names (`tray[0,1,0]`)
+    span: SpanField = NOWHERE
+
+
+class StraightPath(_M):
+    """`path NAME from a to b straight`: tool0 along the segment a -> b, orientation interpolated."""
+
+    name: Name
+    start: str
+    end: str
+    span: SpanField = NOWHERE
+
+
+class BaseGrid(_M):
+    """`base within box size … at … step … [yaw lo to hi step s]` (design blocks): the base
+    positions (and yaws) to try, in the cell frame."""
+
+    size: Vec3
+    center: Vec3
+    step: float  # m
+    yaws: tuple[float, ...] = (0.0,)  # rad
+    span: SpanField = NOWHERE
+
+    def positions(self) -> list[Vec3]:
+        axes = []
+        for c, s in zip(self.center, self.size, strict=True):
+            n = int(s / self.step + 1e-9) + 1 if s > 0 else 1
+            axes.append([c] if n == 1 else [c - s / 2 + k * self.step for k in range(n)])
+        return [(x, y, z) for x in axes[0] for y in axes[1] for z in axes[2]]
+
+    def poses(self) -> list[Transform]:
+        return [Transform(xyz=p, rpy=(0.0, 0.0, yaw)) for p in self.positions() for yaw in self.yaws]
+
+
 def default_position(lower: float, upper: float) -> float:
     """MoveIt's default value of a revolute joint with these bounds (moveit_core,
     RevoluteJointModel::getVariableDefaultPositions): 0 inside the bounds, else their middle."""
@@ -124,6 +200,9 @@ class Robot(_M):
     obstacles: tuple[Obstacle, ...] = ()
     targets: tuple[Target, ...] = ()
     allow: frozenset[str] = frozenset()
+    regions: tuple[Region, ...] = ()
+    tasks: tuple[Task, ...] = ()
+    paths: tuple[StraightPath, ...] = ()
     torque: tuple | None = Field(default=None, exclude=True, repr=False)  # set by check_torque
     span: SpanField = NOWHERE
     name_span: SpanField = NOWHERE
@@ -148,6 +227,21 @@ class Robot(_M):
         if not t.link:
             return 0.0
         return t.x23 if u.link is None else u.link
+
+    def task_target(self, name: str) -> Target | None:
+        """A target, or a region's point (`tray[1,0,0]`), by name."""
+        t = next((t for t in self.targets if t.name == name), None)
+        if t is not None or "[" not in name:
+            return t
+        region, _, rest = name.partition("[")
+        r = next((r for r in self.regions if r.name == region), None)
+        try:
+            index = tuple(int(v) for v in rest.rstrip("]").split(","))
+        except ValueError:
+            return None
+        if r is None or len(index) != 3 or not all(0 <= i < n for i, n in zip(index, r.grid, strict=True)):
+            return None
+        return r.point((index[0], index[1], index[2]))
 
     def pose(self, name: str) -> Pose | None:
         return next((p for p in self.poses if p.name == name), None)
@@ -181,6 +275,7 @@ class Robot(_M):
 
 
 RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest torque margin
+TASK_RANK_KEYS = ("cycle_time", "energy", "coverage")  # objectives of tasks: ranked only when named
 
 
 class Problem(_M):
@@ -194,6 +289,7 @@ class Problem(_M):
     modules: tuple[str, ...] | None = None  # allowed unit names; None: every unit of the library
     links: tuple[float, ...] | None = None  # m, link-module lengths to try; None: the library's default
     rank: tuple[str, ...] = RANK_KEYS
+    base_grid: BaseGrid | None = None  # `base within …`: base poses to try (cell frame); None: the base as written
     span: SpanField = NOWHERE
     name_span: SpanField = NOWHERE
     # where each bound was written ("units", "links", "module:H9"), for the library checks

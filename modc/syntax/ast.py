@@ -189,7 +189,79 @@ class Rank:
     span: Span
 
 
-Statement = Chain | DH | Library | Placement | Payload | Pose | Limit | Box | Sphere | Cylinder | Target | Allow
+@dataclass(frozen=True, slots=True)
+class PointRef:
+    """A target or region named in a task or path: `plant`, `tray`, `tray[1,0,0]` (index 0-based)."""
+
+    name: Name
+    index: tuple[Quantity, Quantity, Quantity] | None
+    span: Span
+
+    @property
+    def text(self) -> str:
+        if self.index is None:
+            return self.name.text
+        return self.name.text + "[" + ",".join(f"{q.value:g}" for q in self.index) + "]"
+
+
+@dataclass(frozen=True, slots=True)
+class Region:
+    """`region tray box size (…) m at (…) m grid 3 x 2 x 1 [rpy …] [within …]`: a grid of targets."""
+
+    name: Name
+    size: Vector
+    at: Vector
+    grid: tuple[Quantity, Quantity, Quantity]
+    span: Span
+    rpy: Vector | None = None
+    within: Within | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Task:
+    """`task serve { visit plant, tray, plant }`: joint-space motions through the targets in order."""
+
+    name: Name
+    visits: tuple[PointRef, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class StraightPath:
+    """`path seam from a to b straight`: tool0 along the segment a -> b."""
+
+    name: Name
+    start: PointRef
+    end: PointRef
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Range:
+    """`yaw 0 to 90 deg step 45 deg`: an evenly stepped range (the low end may share the high's unit)."""
+
+    low: Quantity
+    high: Quantity
+    step: Quantity
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class BaseWithin:
+    """`base within box size (…) m at (…) m step 50 mm [yaw …]` (design blocks): the base's grid."""
+
+    size: Vector
+    at: Vector
+    step: Quantity
+    span: Span
+    yaw: Range | None = None
+
+
+TaskStatement = Region | Task | StraightPath | BaseWithin
+
+Statement = (
+    Chain | DH | Library | Placement | Payload | Pose | Limit | Box | Sphere | Cylinder | Target | Allow | TaskStatement
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -201,6 +273,7 @@ class Robot:
 
 DesignStatement = (
     Library | Placement | Payload | Box | Sphere | Cylinder | Target | Allow | Units | Modules | Links | Rank
+    | TaskStatement
 )
 
 

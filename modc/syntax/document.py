@@ -73,6 +73,34 @@ class TargetDoc(_Doc):
 TargetValue = Vector | TargetDoc
 
 
+class RegionDoc(_Doc):
+    """A grid of targets over a box (SPEC section 4: `region`)."""
+
+    size: Vector
+    at: Vector
+    grid: str | list[int] = Field(description='points per axis: "3 x 2 x 1" or [3, 2, 1]')
+    rpy: Vector | None = None
+    within: str | None = Field(None, description='tolerances: "5 mm" or "5 mm, 2 deg"')
+
+
+class PathDoc(_Doc):
+    """tool0 along the straight segment between two targets (or region points)."""
+
+    model_config = ConfigDict(extra="forbid", populate_by_name=True)
+    start: str = Field(alias="from", description='a target or region point, e.g. "tray[1,0,0]"')
+    to: str
+    straight: bool = Field(True, description="the only kind of path: a straight segment")
+
+
+class BaseWithinDoc(_Doc):
+    """The base's placements to try (design blocks)."""
+
+    size: Vector
+    at: Vector
+    step: Quantity
+    yaw: str | None = Field(None, description='"0 to 90 deg step 45 deg"')
+
+
 class RobotDoc(_Doc):
     name: Name
     library: str | None = Field(None, description="built-in library name, or a path to a library YAML file")
@@ -94,6 +122,12 @@ class RobotDoc(_Doc):
         json_schema_extra=_KEYS,
     )
     allow: list[str] = Field(default_factory=list, description="assembly-rule codes to silence, e.g. first-variant")
+    regions: dict[str, RegionDoc] = Field(default_factory=dict, description="name -> {size, at, grid, rpy, within}",
+                                          json_schema_extra=_KEYS)
+    tasks: dict[str, list[str]] = Field(default_factory=dict, json_schema_extra=_KEYS,
+                                        description='name -> targets to visit in order: [plant, tray, "tray[1,0,0]"]')
+    paths: dict[str, PathDoc] = Field(default_factory=dict, json_schema_extra=_KEYS,
+                                      description="name -> {from, to}: tool0 along a straight segment")
 
 
 class DesignDoc(_Doc):
@@ -107,10 +141,15 @@ class DesignDoc(_Doc):
     obstacles: list[BoxDoc | SphereDoc | CylinderDoc] = Field(default_factory=list)
     targets: dict[str, TargetValue] = Field(default_factory=dict)
     allow: list[str] = Field(default_factory=list)
+    regions: dict[str, RegionDoc] = Field(default_factory=dict, json_schema_extra=_KEYS)
+    tasks: dict[str, list[str]] = Field(default_factory=dict, json_schema_extra=_KEYS)
+    paths: dict[str, PathDoc] = Field(default_factory=dict, json_schema_extra=_KEYS)
+    base_within: BaseWithinDoc | None = Field(None, description="base positions (and yaws) to try")
     units: int | str | None = Field(None, description='number of units: 3 or "2 to 4"')
     modules: list[str] | None = Field(None, description="unit types a chain may use, e.g. [H1, H3, L3, L4]")
     links: str | None = Field(None, description='link lengths to try: "220 mm" or "150 mm to 300 mm step 50 mm"')
-    rank: list[str] | None = Field(None, description="objectives in order: modules, mass, margin")
+    rank: list[str] | None = Field(
+        None, description="objectives in order: modules, mass, margin, cycle_time, energy, coverage")
 
 
 class Document(_Doc):

@@ -17,7 +17,8 @@ Canonical layout
   an empty block is written `robot a {` / `}` on two lines;
 - single spaces between words; `a - b` between the units of a chain; `, ` in lists;
   no spaces inside parentheses or around `=`; `H4(pivot=-90deg)` (no space before a unit's
-  parameter list); one space before a vector: `at (0.3, 0, 0.25) m`, `pose home (0, 0) deg`;
+  parameter list); a region point is one word, `tray[1,0,0]`; one space before a vector:
+  `at (0.3, 0, 0.25) m`, `pose home (0, 0) deg`;
 - a unit of measure is attached to its number inside `key=value` parameters (unit parameters
   and dh rows: `pivot=-90deg`, `link=180mm`, `d=0.148m`); everywhere else it follows after one
   space (`payload 50 g`, `radius 0.04 m`, and after every vector: `(0.3, 0, 0.25) m`).
@@ -136,6 +137,8 @@ def _statement(tree, level: int, out: list[_Tok]) -> None:
             t.level = level
         if t.type == "MEASURE" and parents[-1] == "quantity" and len(parents) > 1 and parents[-2] == "param":
             t.attach = t.text[:1] not in ("e", "E")
+        if "point_index" in parents:  # tray[1,0,0]: a point's name is written as one word
+            t.attach = True
         if tree.data == "chain":
             t.unit_start, after_dash = after_dash, t.type == "MINUS"
         out.append(t)

@@ -151,3 +151,28 @@ class ToAst:
 
     def allow(self, meta, items):
         return ast.Allow(tuple(self._name(t) for t in items), self._span(meta))
+
+    def point_index(self, meta, items):
+        return tuple(self._count(t) for t in items)
+
+    def point_ref(self, meta, items):
+        return ast.PointRef(self._name(items[0]), items[1] if len(items) > 1 else None, self._span(meta))
+
+    def region(self, meta, items):
+        name, size, at, nx, ny, nz, *rest = items
+        opt = dict(rest)
+        grid = (self._count(nx), self._count(ny), self._count(nz))
+        return ast.Region(self._name(name), size, at[1], grid, self._span(meta), opt.get("rpy"), opt.get("within"))
+
+    def task(self, meta, items):
+        return ast.Task(self._name(items[0]), tuple(items[1:]), self._span(meta))
+
+    def path(self, meta, items):
+        return ast.StraightPath(self._name(items[0]), items[1], items[2], self._span(meta))
+
+    def yaw(self, meta, items):
+        return ("yaw", ast.Range(items[0], items[1], items[2], self._span(meta)))
+
+    def base_within(self, meta, items):
+        size, at, step, *rest = items
+        return ast.BaseWithin(size, at[1], step, self._span(meta), dict(rest).get("yaw"))

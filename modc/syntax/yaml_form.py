@@ -130,6 +130,10 @@ class _Reader:
             if all(q is not None for q in qs):
                 qs += [None] * (3 - len(qs))
                 body.append(ast.Links(qs[0], qs[1], qs[2], self.span(p)))
+        if d.base_within is not None:
+            bw = self._base_within(d.base_within, path + ("base_within",))
+            if bw is not None:
+                body.append(bw)
         if d.rank is not None:
             p = path + ("rank",)
             body.append(ast.Rank(tuple(ast.Name(k, self.span(p + (i,))) for i, k in enumerate(d.rank)), self.span(p)))
@@ -212,7 +216,100 @@ class _Reader:
         if r.allow:
             names = tuple(ast.Name(c, self.span(path + ("allow", i))) for i, c in enumerate(r.allow))
             body.append(ast.Allow(names, self.span(path + ("allow",))))
+        body += self._tasks(r, path)
         return body
+
+    def _tasks(self, r, path: tuple) -> list:
+        """regions, tasks and paths, as the .mod statements."""
+        body: list = []
+        for name, reg in r.regions.items():
+            p = path + ("regions", name)
+            size, at = self._vec(reg.size, p + ("size",)), self._vec(reg.at, p + ("at",))
+            rpy = self._vec(reg.rpy, p + ("rpy",))
+            grid = self._grid(reg.grid, p + ("grid",))
+            within = self._within(reg.within, p + ("within",))
+            if size is not None and at is not None and grid is not None and (reg.rpy is None or rpy is not None):
+                body.append(ast.Region(ast.Name(name, self.span(p + ("__key__",))), size, at, grid, self.span(p), rpy,
+                                       within))
+        for name, visits in r.tasks.items():
+            p = path + ("tasks", name)
+            refs = [self._ref(v, p + (i,)) for i, v in enumerate(visits)]
+            if not visits:
+                self.diags.append(codes.YAML_SCHEMA.at(self.span(p), detail=f"{_dotted(p)}: list the targets to visit"))
+            elif None not in refs:
+                body.append(ast.Task(ast.Name(name, self.span(p + ("__key__",))), tuple(refs), self.span(p)))
+        for name, doc in r.paths.items():
+            p = path + ("paths", name)
+            a, b = self._ref(doc.start, p + ("from",)), self._ref(doc.to, p + ("to",))
+            if not doc.straight:
+                self.diags.append(codes.YAML_SCHEMA.at(self.span(p + ("straight",)),
+                                                       detail=f"{_dotted(p)}: only straight paths are supported"))
+            elif a is not None and b is not None:
+                body.append(ast.StraightPath(ast.Name(name, self.span(p + ("__key__",))), a, b, self.span(p)))
+        return body
+
+    def _within(self, text, p: tuple):
+        if text is None:
+            return None
+        qs = [self._sub("quantity_text", x.strip(), p) for x in str(text).split(",")[:2]]
+        if any(q is None for q in qs):
+            return None
+        return ast.Within(qs[0], qs[1] if len(qs) > 1 else None, self.span(p))
+
+    def _grid(self, grid, p: tuple):
+        import re
+
+        parts = [float(v) for v in grid] if isinstance(grid, list) else None
+        if parts is None:
+            m = re.fullmatch(r"\s*(\S+)\s*x\s*(\S+)\s*x\s*(\S+)\s*", str(grid))
+            try:
+                parts = [float(v) for v in m.groups()] if m else None
+            except ValueError:
+                parts = None
+        if parts is None or len(parts) != 3:
+            self.diags.append(codes.YAML_SCHEMA.at(self.span(p), detail=f'{_dotted(p)}: expected "NX x NY x NZ" such '
+                                                                        f"as \"3 x 2 x 1\", got {grid!r}"))
+            return None
+        span = self.span(p)
+        return (ast.Quantity(parts[0], None, span), ast.Quantity(parts[1], None, span),
+                ast.Quantity(parts[2], None, span))
+
+    def _ref(self, text, p: tuple):
+        """A target or region point: `plant`, `tray`, `tray[1,0,0]`."""
+        import re
+
+        span = self.span(p)
+        m = re.fullmatch(r"([^\[\]\s]+)(?:\[\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)\s*\])?", str(text).strip())
+        if m is None:
+            self.diags.append(codes.YAML_SCHEMA.at(span, detail=f"{_dotted(p)}: expected a target or region point "
+                                                                f"such as tray[1,0,0], got {text!r}"))
+            return None
+        index = None
+        if m.group(2) is not None:
+            v = [ast.Quantity(float(m.group(i)), None, span) for i in (2, 3, 4)]
+            index = (v[0], v[1], v[2])
+        return ast.PointRef(ast.Name(m.group(1), span), index, span)
+
+    def _base_within(self, doc, p: tuple):
+        size, at = self._vec(doc.size, p + ("size",)), self._vec(doc.at, p + ("at",))
+        step = self._sub("quantity_text", doc.step, p + ("step",))
+        yaw = None
+        if doc.yaw is not None:
+            import re
+
+            parts = re.split(r"\s+(?:to|step)\s+", str(doc.yaw).strip())
+            qs = [self._sub("quantity_text", x, p + ("yaw",)) for x in parts] if len(parts) == 3 else None
+            if qs is None:
+                self.diags.append(codes.YAML_SCHEMA.at(self.span(p + ("yaw",)), detail=f"{_dotted(p + ('yaw',))}: "
+                                                       f'expected "LOW to HIGH step STEP" such as "0 to 90 deg step '
+                                                       f'45 deg", got {doc.yaw!r}'))
+                return None
+            if any(q is None for q in qs):
+                return None
+            yaw = ast.Range(qs[0], qs[1], qs[2], self.span(p + ("yaw",)))
+        if size is None or at is None or step is None:
+            return None
+        return ast.BaseWithin(size, at, step, self.span(p), yaw)
 
     def _vec(self, text, path):
         return None if text is None else self._sub("vector_text", text, path)

@@ -1,0 +1,320 @@
+"""`modc plan FILE --task NAME`: plan and time a robot's whole task (SPEC sections 4 and 6).
+
+    from modc.plan.task import plan_task
+    result = plan_task("examples/farm_task.mod", "serve")     # -> TaskPlan, or raises PlanError
+    sys.stdout.write(result.dumps())                           # one trajectory, SPEC section 6
+    print(result.summary())
+
+A `task NAME { visit a, b, … }` is an approach from the home pose to a, then one segment per
+consecutive pair: each a collision-free joint-space motion within the joint limits, planned by
+modc.plan.plan_robot (IK, the collision-free goal closest to where the arm is, RRT-Connect,
+certified edges) from where the previous segment ended. A `path NAME from a to b straight` is
+an approach to a, then tool0 along the segment a -> b: positions linearly interpolated,
+orientation slerped, IK at waypoints STRAIGHT_STEP apart, each seeded from the previous
+solution; every waypoint within the targets' tolerances, joints moving at most MAX_JOINT_STEP
+between waypoints (no jump to another IK branch), every motion between waypoints certified
+collision-free.
+
+Every segment is then timed time-optimally from rest to rest under the speed and peak-torque
+limits (modc.plan.retime, toppra + RNEA). The cycle time and energy are the sums over the
+task's segments (the approach from home is reported, and in the trajectory, but not counted).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..diagnostics import codes
+from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
+from ..sim.trajectory import Trajectory
+from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
+
+STRAIGHT_STEP = 0.002  # m between IK waypoints along a straight path
+STRAIGHT_ANGLE_STEP = math.radians(1.0)  # and at most this much rotation of tool0
+MAX_JOINT_STEP = 0.1  # rad: more between neighbouring waypoints is a jump (the IK changed branch)
+START = "task start"  # the name the pose each segment starts from is given (in plan_robot's messages)
+
+
+@dataclass(frozen=True)
+class Segment:
+    kind: str  # approach | motion | straight
+    start: str
+    end: str
+    t0: float  # s, when it starts in the task's trajectory
+    duration: float  # s
+    energy: float  # J
+    peak_share: float  # max |τ_i| / τ_peak,i along it
+    speed_share: float  # max |q̇_i| / v_max,i along it
+    waypoints: tuple[tuple[float, ...], ...]  # the geometric path it follows
+
+    def to_json(self) -> dict:
+        return {"kind": self.kind, "from": self.start, "to": self.end, "t_start_s": round(self.t0, 9),
+                "duration_s": round(self.duration, 9), "energy_j": round(self.energy, 9),
+                "peak_torque_share": round(self.peak_share, 6), "peak_speed_share": round(self.speed_share, 6)}
+
+
+@dataclass(frozen=True)
+class TaskPlan:
+    robot: str
+    task: str
+    kind: str  # task | path
+    joint_names: tuple[str, ...]
+    t: tuple[float, ...]
+    q: tuple[tuple[float, ...], ...]
+    segments: tuple[Segment, ...]
+    with_robot_name: bool = False
+
+    @property
+    def counted(self) -> list[Segment]:
+        return [s for s in self.segments if s.kind != "approach"]
+
+    @property
+    def cycle_time(self) -> float:
+        return sum(s.duration for s in self.counted)
+
+    @property
+    def energy(self) -> float:
+        return sum(s.energy for s in self.counted)
+
+    @property
+    def peak_share(self) -> float:
+        return max((s.peak_share for s in self.segments), default=0.0)
+
+    @property
+    def trajectory(self) -> Trajectory:
+        return Trajectory(self.joint_names, self.t, self.q, self.robot if self.with_robot_name else None)
+
+    def dumps(self) -> str:
+        """SPEC section 6 plan JSON for the whole task, with the task's figures as extra keys."""
+        import json
+
+        text = self.trajectory.dumps()
+        extra = {"task": self.task, "cycle_time_s": round(self.cycle_time, 9), "energy_j": round(self.energy, 9),
+                 "peak_torque_share": round(self.peak_share, 6), "segments": [s.to_json() for s in self.segments]}
+        lines = "".join(f"  {json.dumps(k)}: {json.dumps(v)},\n" for k, v in extra.items())
+        head, _, rest = text.partition('  "points": [')
+        return head + lines + '  "points": [' + rest
+
+    def summary(self) -> str:
+        out = [f"robot {self.robot}: {self.kind} '{self.task}', {len(self.counted)} segment(s): cycle time "
+               f"{self.cycle_time:.3f} s, energy {self.energy:.2f} J, peak torque {self.peak_share:.0%} of peak"]
+        width = max(len(f"{s.start} -> {s.end}") for s in self.segments)
+        for i, s in enumerate(self.segments):
+            label = "approach" if s.kind == "approach" else f"{i:>2} {s.kind}"
+            out.append(f"  {label:<11} {f'{s.start} -> {s.end}':<{width}}  {s.duration:7.3f} s  {s.energy:7.2f} J  "
+                       f"torque {s.peak_share:4.0%}  speed {s.speed_share:4.0%}")
+        out.append(f"  trajectory  {len(self.t)} points, {self.t[-1]:.3f} s with the approach; "
+                   "each segment time-optimal from rest to rest (speed: library RPM, torque: peak, with the payload)")
+        return "\n".join(out)
+
+
+def plan_task(path, task: str, robot: str | None = None, seed: int = 0, library: str | None = None,
+              timeout: float | None = None) -> TaskPlan:
+    """Read a .mod (or YAML) file and plan and time the robot's task or path `task`. Raises PlanError."""
+    from ..compiler import InputError, check_file
+
+    try:
+        checked = check_file(path, library)
+    except InputError as e:
+        raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
+    if not checked.ok:
+        raise PlanError([d for d in checked.diagnostics if d.is_error], checked.sources, EXIT_FAILED)
+    robots = list(checked.design.robots)
+    has = [r for r in robots if _find(r, task) is not None]
+    if robot is None and len(robots) > 1 and not has:
+        raise _unknown(robots, task, checked.sources)
+    try:
+        chosen = choose_robot(checked.design, robot, has if robot is None and len(robots) > 1 else None,
+                              why=f"have a task '{task}'")
+    except RobotChoiceError as e:
+        raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
+    return plan_task_robot(chosen, task, seed=seed, sources=checked.sources, with_robot_name=len(robots) > 1,
+                           timeout=timeout)
+
+
+def _find(robot, name: str):
+    return next((t for t in (*robot.tasks, *robot.paths) if t.name == name), None)
+
+
+def _unknown(robots, task: str, sources) -> PlanError:
+    names = [f"{r.name}: {', '.join(t.name for t in (*r.tasks, *r.paths)) or 'none'}" for r in robots]
+    known = ("tasks and paths per robot: " + "; ".join(names)) if any(r.tasks or r.paths for r in robots) else \
+        "the robot declares no tasks: add `task NAME { visit a, b }` or `path NAME from a to b straight`"
+    d = codes.TASK_UNKNOWN.at(COMMAND_LINE, robot=" or ".join(r.name for r in robots), task=task, known=known)
+    return PlanError([d], sources, EXIT_USAGE)
+
+
+def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_name: bool = False,
+                    timeout: float | None = None) -> TaskPlan:
+    """Plan and time one checked robot's task or path. Raises PlanError."""
+    from . import start_pose
+    from .collision import CollisionChecker
+    from .retime import Limits, TimingError, join
+
+    sources = sources or {}
+    item = _find(robot, task)
+    if item is None:
+        raise _unknown([robot], task, sources)
+    kind = "task" if item in robot.tasks else "path"
+    visits = list(item.visits) if kind == "task" else [item.start, item.end]
+    checker = CollisionChecker(robot)
+    limits = Limits.of(robot)
+    job = _Job(robot, item, kind, seed, sources, checker, limits, timeout)
+    where, q_home, _span = start_pose(robot, None)
+    q = np.array(q_home, float)
+    pieces, segments, t0 = [], [], 0.0
+    steps = [("approach", where, visits[0])]
+    steps += [("motion" if kind == "task" else "straight", a, b) for a, b in zip(visits, visits[1:], strict=False)]
+    for number, (what, a, b) in enumerate(steps):
+        if what != "approach" and a == b:
+            continue
+        try:
+            if what == "straight":
+                path, timed = job.straight(number, a, b, q)
+            else:
+                path, timed = job.motion(number, what, a, b, q)
+        except TimingError as e:
+            raise job.fail(number, a, b, str(e), "lighten the payload, or choose a stronger module") from None
+        pieces.append(timed)
+        segments.append(Segment(what, a, b, t0, timed.duration, timed.energy, timed.peak_share, timed.speed_share,
+                                tuple(tuple(float(v) for v in p) for p in path)))
+        t0 += timed.duration
+        q = np.array(path[-1], float)
+    whole = join(pieces, limits, q)
+    t_rows = tuple(round(float(t), 9) for t in whole.t)
+    q_rows = tuple(tuple(round(float(v), 12) + 0.0 for v in row) for row in whole.q)
+    return TaskPlan(robot.name, task, kind, tuple(f"joint_{i}" for i in range(1, robot.dof + 1)), t_rows, q_rows,
+                    tuple(segments), with_robot_name)
+
+
+@dataclass(frozen=True)
+class _Job:
+    robot: Any  # modc.model.Robot
+    item: Any  # its Task or StraightPath
+    kind: str
+    seed: int
+    sources: dict
+    checker: Any  # modc.plan.collision.CollisionChecker
+    limits: Any  # modc.plan.retime.Limits
+    timeout: float | None
+
+    def fail(self, number: int, a: str, b: str, detail: str, hint: str, exit_code: int = EXIT_FAILED) -> PlanError:
+        seg = "approach" if number == 0 else str(number)
+        d = codes.TASK_SEGMENT_FAILED.at(self.item.span, kind=self.kind, task=self.item.name,
+                                         segment=f"{seg} ({a} -> {b})", detail=detail, hint=hint)
+        return PlanError([d], self.sources, exit_code)
+
+    def target(self, name: str):
+        t = self.robot.task_target(name)
+        assert t is not None, name  # lowering resolved every name of the task
+        return t
+
+    def motion(self, number: int, what: str, a: str, b: str, q):
+        """A collision-free joint-space motion from q (at a) to target b: plan_robot on the robot
+        with b among its targets and q as its start pose."""
+        from ..model.robot import Pose
+        from . import plan_robot
+        from .retime import time_polyline
+
+        robot = self.robot
+        start = Pose.model_construct(name=START, q=tuple(float(v) for v in q), span=self.item.span)
+        targets = tuple(t for t in robot.targets if t.name != b) + (self.target(b),)
+        poses = tuple(p for p in robot.poses if p.name != START) + (start,)
+        seg_robot = robot.model_copy(update={"targets": targets, "poses": poses})
+        try:
+            result = plan_robot(seg_robot, b, seed=self.seed, start=START, sources=self.sources, timeout=self.timeout)
+        except PlanError as e:
+            first = next((d for d in e.diagnostics if d.is_error), None)
+            detail = first.message if first is not None else e.message
+            raise self.fail(number, a, b, f"{detail} [{e.code}]", first.hint if first is not None else "",
+                            e.exit_code) from None
+        path = [np.array(p, float) for p in result.waypoints]
+        return path, time_polyline(path, self.limits)
+
+    def straight(self, number: int, a: str, b: str, q):
+        """tool0 along a -> b from q (the arm at a); then timed, and the timed motion checked."""
+        from .retime import time_smooth
+
+        ta, tb = self.target(a), self.target(b)
+        path = self._waypoints(number, ta, tb, q)
+        timed = time_smooth(path, self.limits)
+        self._check_timed(number, ta, tb, timed.q)
+        return path, timed
+
+    def _frames(self, ta, tb):
+        """(positions, rotations or None) along a -> b at the waypoints."""
+        import pinocchio as pin
+
+        from ..kinematics import rpy_matrix
+
+        pa, pb = np.asarray(ta.xyz, float), np.asarray(tb.xyz, float)
+        Ra = None if ta.rpy is None else np.asarray(rpy_matrix(ta.rpy), float)
+        Rb = None if tb.rpy is None else np.asarray(rpy_matrix(tb.rpy), float)
+        w = np.asarray(pin.log3(Ra.T @ Rb)) if Ra is not None and Rb is not None else np.zeros(3)
+        n = max(1, math.ceil(max(np.linalg.norm(pb - pa) / STRAIGHT_STEP, np.linalg.norm(w) / STRAIGHT_ANGLE_STEP)))
+        s = np.linspace(0.0, 1.0, n + 1)
+        positions = [pa + x * (pb - pa) for x in s]
+        if Ra is None or Rb is None:
+            return positions, [Ra if Ra is not None else Rb] * len(s)
+        return positions, [Ra @ np.asarray(pin.exp3(x * w)) for x in s]
+
+    def _tolerance(self, ta, tb) -> tuple[float, float]:
+        both = ta.rpy is not None and tb.rpy is not None
+        return (min(ta.position_tolerance, tb.position_tolerance),
+                min(ta.orientation_tolerance, tb.orientation_tolerance) if both else math.inf)
+
+    def _waypoints(self, number: int, ta, tb, q) -> list[np.ndarray]:
+        from .ik import PositionIK
+
+        ch = self.checker
+        positions, rotations = self._frames(ta, tb)
+        tol_p, tol_o = self._tolerance(ta, tb)
+        path = [np.asarray(q, float)]
+        for k in range(1, len(positions)):
+            x, R = positions[k], rotations[k] if tol_o < math.inf else None
+            solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper, R)
+            qn, _ = solver.run(path[-1], x)
+            pe, oe = solver.errors(qn, x)
+            at = f"{k / (len(positions) - 1):.0%} of the way"
+            if pe > tol_p or oe > tol_o:
+                raise self.fail(number, ta.name, tb.name, f"tool0 cannot stay on the segment: {at}, it is "
+                                f"{pe * 1000:.1f} mm and {math.degrees(oe):.1f} deg off",
+                                "move the targets, or loosen their tolerances (`within`)")
+            jump = float(np.max(np.abs(qn - path[-1])))
+            if jump > MAX_JOINT_STEP:
+                raise self.fail(number, ta.name, tb.name, f"the joints jump by {math.degrees(jump):.0f} deg {at} "
+                                "(the arm passes a singular or limit pose)",
+                                "move the segment away from the arm's singular poses and joint limits")
+            if not ch.motion_valid(path[-1], qn):
+                contacts = "; ".join(c.describe() for c in ch.contacts(qn, 0.0)) or "closer than the margin"
+                raise self.fail(number, ta.name, tb.name, f"the arm collides {at}: {contacts}",
+                                "move the segment or the obstacle")
+            path.append(qn)
+        return path
+
+    def _check_timed(self, number: int, ta, tb, qs) -> None:
+        """The spline through the waypoints stays within the tolerance of the segment, the joint
+        limits, and free of collisions, at every sample."""
+        from .ik import PositionIK
+
+        ch = self.checker
+        solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper)
+        pa, pb = np.asarray(ta.xyz, float), np.asarray(tb.xyz, float)
+        tol_p = self._tolerance(ta, tb)[0]
+        for q in qs:
+            if distance_to_segment(solver.position(q), pa, pb) > tol_p or np.any(q < ch.lower - 1e-9) or \
+                    np.any(q > ch.upper + 1e-9) or ch.contacts(q, 0.0):
+                raise self.fail(number, ta.name, tb.name, "the timed motion leaves the segment, a joint limit or "
+                                "the free space between the waypoints", "move the segment away from obstacles")
+
+
+def distance_to_segment(p, a, b) -> float:
+    d = b - a
+    s = float(np.clip(np.dot(p - a, d) / max(float(np.dot(d, d)), 1e-18), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + s * d)))
+
+
+__all__ = ["Segment", "TaskPlan", "distance_to_segment", "plan_task", "plan_task_robot"]
