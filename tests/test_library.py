@@ -195,3 +195,18 @@ def test_the_smallest_accepted_sizes_still_build(tmp_path):
     (tmp_path / "lib.yaml").write_text(MARK2.replace("diameter: 0.075 ", f"diameter: {library.SMALLEST_LENGTH}", 1))
     c = checked_ok('robot r { library "lib.yaml" chain H1 - L4(port=45deg) - L1 }', str(tmp_path / "a.mod"))
     assert "urdf/mod3_r.urdf" in build(c, only=["urdf", "srdf"])
+
+
+@pytest.mark.parametrize("field, value, code", [
+    ("step_deg: 15}", "step_deg: 1e-320}", "library-invalid"),  # design's twist enumeration: OverflowError
+    ("step_deg: 15}", "step_deg: 1e-300}", "library-invalid"),  # … and 1e302 values: memory exhausted
+    ("step_deg: 15}", "step_deg: 0.5}", "library-invalid"),
+    ("min_deg: -90,", "min_deg: -1e308,", "library-invalid"),
+    ("max_deg: 90,", "max_deg: 1e308,", "out-of-range"),
+])
+def test_twist_sets_have_a_range(tmp_path, field, value, code):
+    """`modc design` enumerates every realisable twist: a step of at least 1° within ±360°."""
+    (tmp_path / "lib.yaml").write_text(MARK2.replace(field, value, 1))
+    c = check_text('design c { library "lib.yaml"\n    target t at (0.2, 0.1, 0.2) m\n}\n', str(tmp_path / "a.mod"))
+    assert [d.code for d in c.diagnostics] == [code], [(d.code, d.message) for d in c.diagnostics]
+    assert "twists.pivot." in c.diagnostics[0].message
