@@ -264,6 +264,8 @@ def compile_one(text: str, samples: int) -> dict | None:
 def _shown(item) -> str:
     """The input of a finding as text: hostile and file items are (form, input); anything else
     (cli (argv, value), plan (text, fractions), ws frames) as JSON."""
+    if isinstance(item, tuple) and item[0] in ("dir", "fifo", "zero"):
+        return f"<{item[0]}>"  # a special file in place of the input file
     payload = item[1] if isinstance(item, tuple) and isinstance(item[0], str) and item[0] in FORMS else item
     if isinstance(payload, bytes):
         return payload.decode("latin-1")
