@@ -215,8 +215,10 @@ def _check_new(kind: str, item, work: Path, ctx: dict):
     shutil.rmtree(sub, ignore_errors=True)
     sub.mkdir()
     if kind == "ws":
+        import fuzz_ws
+
         if "ws" not in ctx:
-            ctx["ws"] = S.ViewServer(work)
+            ctx["ws"] = fuzz_ws.ViewServer(work)
         ctx["ws"].send(item)
         return None
     if kind == "cli":
