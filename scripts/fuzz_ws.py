@@ -35,6 +35,17 @@ def ws_frames():
                      st.tuples(st.sampled_from(CLIENT_TYPES), fields).map(lambda t: ("msg", {"type": t[0], **t[1]})))
 
 
+def _die_with_parent() -> None:
+    """In the server's process: end it when the campaign ends, even by SIGKILL (Linux)."""
+    import ctypes
+    import signal
+
+    try:
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
 class ViewServer:
     """One `modc view FARM --no-browser --port 0` for the campaign, on 127.0.0.1 only; its URL
     (with the token it may carry) is the one it prints."""
@@ -46,7 +57,8 @@ class ViewServer:
                "DISPLAY": "", "WAYLAND_DISPLAY": ""}
         with open(self.log, "wb") as f:
             self.proc = subprocess.Popen([sys.executable, "-m", "modc", "view", str(FARM), "--no-browser", "--port",
-                                          "0"], stdout=subprocess.PIPE, stderr=f, env=env, text=True)
+                                          "0"], stdout=subprocess.PIPE, stderr=f, env=env, text=True,
+                                         preexec_fn=_die_with_parent)
         line = self.proc.stdout.readline()  # a hang here is the campaign's wall-clock alarm
         m = re.search(r"http://127\.0\.0\.1:(\d+)(/\S*)?", line)
         if not m:
