@@ -342,7 +342,7 @@ def run(args) -> int:
                     signal.setitimer(signal.ITIMER_REAL, 0)
                     signal.setitimer(signal.ITIMER_PROF, 0)
                 state["inputs"] += 1
-                state["by_kind"][kind] += 1
+                state["by_kind"][kind] = state["by_kind"].get(kind, 0) + 1  # (a state from before --kinds)
                 if finding:
                     state["findings"] += 1
                     key = FINDING_TYPES[str(finding["type"])]
