@@ -215,8 +215,10 @@ def _check_new(kind: str, item, work: Path, ctx: dict):
     shutil.rmtree(sub, ignore_errors=True)
     sub.mkdir()
     if kind == "ws":
+        import fuzz_ws
+
         if "ws" not in ctx:
-            ctx["ws"] = S.ViewServer(work)
+            ctx["ws"] = fuzz_ws.ViewServer(work)
         ctx["ws"].send(item)
         return None
     if kind == "cli":
@@ -264,6 +266,8 @@ def compile_one(text: str, samples: int) -> dict | None:
 def _shown(item) -> str:
     """The input of a finding as text: hostile and file items are (form, input); anything else
     (cli (argv, value), plan (text, fractions), ws frames) as JSON."""
+    if isinstance(item, tuple) and item[0] in ("dir", "fifo", "zero"):
+        return f"<{item[0]}>"  # a special file in place of the input file
     payload = item[1] if isinstance(item, tuple) and isinstance(item[0], str) and item[0] in FORMS else item
     if isinstance(payload, bytes):
         return payload.decode("latin-1")
@@ -338,7 +342,7 @@ def run(args) -> int:
                     signal.setitimer(signal.ITIMER_REAL, 0)
                     signal.setitimer(signal.ITIMER_PROF, 0)
                 state["inputs"] += 1
-                state["by_kind"][kind] += 1
+                state["by_kind"][kind] = state["by_kind"].get(kind, 0) + 1  # (a state from before --kinds)
                 if finding:
                     state["findings"] += 1
                     key = FINDING_TYPES[str(finding["type"])]

@@ -129,3 +129,22 @@ def test_a_process_pool_over_the_cap_is_a_finding_not_a_fork(tmp_path):
         "from modc.cli import main", "from concurrent.futures import ProcessPoolExecutor; ProcessPoolExecutor(10**6)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert r.returncode == mod.fuzz_surfaces.UNCAPPED_EXIT and "1000000 workers" in r.stderr
+
+
+def test_a_non_finite_number_in_an_output_is_a_finding(monkeypatch):
+    """A library with a huge peak torque once wrote kp="inf" into the MJCF: the campaign scans every
+    compiled URDF, MJCF, SRDF and YAML file for inf and nan."""
+    import modc.compiler
+
+    mod = _module()
+    real = modc.compiler.build
+
+    def build(*a, **kw):
+        files = real(*a, **kw)
+        return {**files, "mjcf/arm.xml": '<mujoco><position kp="inf"/></mujoco>\n'}
+
+    text = (ROOT / "examples" / "quickstart.mod").read_text(encoding="utf-8")
+    assert mod.compile_one(text, 0) is None
+    monkeypatch.setattr(modc.compiler, "build", build)
+    found = mod.compile_one(text, 0)
+    assert found["type"] == "nonfinite" and "'inf' in arm.xml" in found["detail"] and 'kp="inf"' in found["line"]
