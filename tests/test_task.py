@@ -354,3 +354,20 @@ def test_lsp_outline_and_definition():
     at = text.index("visit plant, tray") + len("visit plant, ") + 1
     (loc,) = definition(an, at, EXAMPLE.as_uri())
     assert loc.range.start.line == text[: text.index("region tray")].count("\n")
+
+
+@pytest.mark.slow
+def test_straight_path_through_the_shelf_is_refused(tmp_path, capsys):
+    from modc.cli import main
+
+    text = EXAMPLE.read_text(encoding="utf-8").replace(
+        "    path seam",
+        "    target over at (0.05, -0.40, 0.25) m\n    path cross from plant to over straight\n    path seam")
+    cell = tmp_path / "cell.mod"
+    cell.write_text(text, encoding="utf-8")
+    with pytest.raises(SystemExit) as e:
+        main(["plan", str(cell), "--task", "cross"])
+    err = capsys.readouterr().err
+    assert e.value.code == 1 and "error[task-segment-failed]" in err
+    assert "path 'cross', segment 1 (plant -> over): the arm collides" in err and "box 'shelf'" in err
+    assert "Traceback" not in err

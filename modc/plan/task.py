@@ -289,11 +289,19 @@ class _Job:
                                 "(the arm passes a singular or limit pose)",
                                 "move the segment away from the arm's singular poses and joint limits")
             if not ch.motion_valid(path[-1], qn):
-                contacts = "; ".join(c.describe() for c in ch.contacts(qn, 0.0)) or "closer than the margin"
-                raise self.fail(number, ta.name, tb.name, f"the arm collides {at}: {contacts}",
+                raise self.fail(number, ta.name, tb.name, f"the arm collides {at}: {self._contacts(qn)}",
                                 "move the segment or the obstacle")
             path.append(qn)
         return path
+
+    def _contacts(self, q) -> str:
+        ch = self.checker
+        contacts = ch.contacts(q, 0.0)
+        if contacts:
+            return "; ".join(c.describe() for c in contacts)
+        clearance, pair = ch.clearance(q)
+        what = pair.describe() if pair is not None else "two bodies"
+        return f"{what}, {clearance * 1000:.1f} mm apart (the planner keeps {ch.margin * 1000:.1f} mm)"
 
     def _check_timed(self, number: int, ta, tb, qs) -> None:
         """The spline through the waypoints stays within the tolerance of the segment, the joint
