@@ -354,3 +354,64 @@ def test_lsp_outline_and_definition():
     at = text.index("visit plant, tray") + len("visit plant, ") + 1
     (loc,) = definition(an, at, EXAMPLE.as_uri())
     assert loc.range.start.line == text[: text.index("region tray")].count("\n")
+
+
+@pytest.mark.slow
+def test_straight_path_through_the_shelf_is_refused(tmp_path, capsys):
+    from modc.cli import main
+
+    text = EXAMPLE.read_text(encoding="utf-8").replace(
+        "    path seam",
+        "    target over at (0.05, -0.40, 0.25) m\n    path cross from plant to over straight\n    path seam")
+    cell = tmp_path / "cell.mod"
+    cell.write_text(text, encoding="utf-8")
+    with pytest.raises(SystemExit) as e:
+        main(["plan", str(cell), "--task", "cross"])
+    err = capsys.readouterr().err
+    assert e.value.code == 1 and "error[task-segment-failed]" in err
+    assert "path 'cross', segment 1 (plant -> over): the arm collides" in err and "box 'shelf'" in err
+    assert "Traceback" not in err
+
+
+ORIENTED = ("    target a at (0.30, 0, 0.25) m rpy (109.0, 34.6, 62.9) deg within 5 mm, 2 deg\n"
+            "    target b at (0.30, 0.10, 0.25) m rpy (111.4, 31.0, 79.3) deg within 5 mm, 2 deg\n"
+            "    path turn from a to b straight\n")
+
+
+@pytest.mark.slow
+def test_oriented_straight_path_follows_the_slerp(tmp_path, capsys):
+    """tool0's orientation is interpolated along the segment (slerp), within the targets'
+    tolerance at every sample; a constant orientation the arm cannot hold is refused."""
+    import pinocchio as pin
+
+    from modc.kinematics import rpy_matrix
+    from modc.plan.collision import CollisionChecker
+    from modc.plan.task import plan_task
+
+    text = EXAMPLE.read_text(encoding="utf-8").replace("    path seam", ORIENTED + "    path seam")
+    cell = tmp_path / "cell.mod"
+    cell.write_text(text, encoding="utf-8")
+    result = plan_task(cell, "turn")
+    robot = check_file(cell).design.robots[0]
+    checker = CollisionChecker(robot)
+    a, b = robot.task_target("a"), robot.task_target("b")
+    Ra, Rb = np.array(rpy_matrix(a.rpy)), np.array(rpy_matrix(b.rpy))
+    seg = result.segments[-1]
+    t, q = _samples(result)
+    on = t >= seg.t0 - 1e-9
+    pa, pb = np.array(a.xyz), np.array(b.xyz)
+    for row in q[on]:
+        pin.forwardKinematics(checker.model, checker.data, row)
+        M = pin.updateFramePlacement(checker.model, checker.data, checker.tool_frame)
+        x = float(np.clip(np.dot(M.translation - pa, pb - pa) / np.dot(pb - pa, pb - pa), 0, 1))
+        R = Ra @ pin.exp3(x * pin.log3(Ra.T @ Rb))
+        assert np.linalg.norm(pin.log3(R.T @ M.rotation)) <= math.radians(2) + 1e-9
+        assert np.linalg.norm(M.translation - (pa + x * (pb - pa))) <= 0.005
+    # the same segment with tool0 held at a's orientation all the way: the 3-joint arm cannot
+    from modc.cli import main
+
+    cell.write_text(text.replace("rpy (111.4, 31.0, 79.3) deg", "rpy (109.0, 34.6, 62.9) deg"), encoding="utf-8")
+    with pytest.raises(SystemExit) as e:
+        main(["plan", str(cell), "--task", "turn"])
+    err = capsys.readouterr().err
+    assert e.value.code == 1 and "path 'turn', segment 1 (a -> b): tool0 cannot stay on the segment" in err

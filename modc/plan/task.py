@@ -289,26 +289,47 @@ class _Job:
                                 "(the arm passes a singular or limit pose)",
                                 "move the segment away from the arm's singular poses and joint limits")
             if not ch.motion_valid(path[-1], qn):
-                contacts = "; ".join(c.describe() for c in ch.contacts(qn, 0.0)) or "closer than the margin"
-                raise self.fail(number, ta.name, tb.name, f"the arm collides {at}: {contacts}",
+                raise self.fail(number, ta.name, tb.name, f"the arm collides {at}: {self._contacts(qn)}",
                                 "move the segment or the obstacle")
             path.append(qn)
         return path
 
+    def _contacts(self, q) -> str:
+        ch = self.checker
+        contacts = ch.contacts(q, 0.0)
+        if contacts:
+            return "; ".join(c.describe() for c in contacts)
+        clearance, pair = ch.clearance(q)
+        what = pair.describe() if pair is not None else "two bodies"
+        return f"{what}, {clearance * 1000:.1f} mm apart (the planner keeps {ch.margin * 1000:.1f} mm)"
+
     def _check_timed(self, number: int, ta, tb, qs) -> None:
-        """The spline through the waypoints stays within the tolerance of the segment, the joint
-        limits, and free of collisions, at every sample."""
+        """The spline through the waypoints stays within the tolerances of the segment (position,
+        and orientation against the slerp at the same fraction of the way), the joint limits, and
+        free of collisions, at every sample."""
+        import pinocchio as pin
+
+        from ..kinematics import rpy_matrix
         from .ik import PositionIK
 
         ch = self.checker
         solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper)
         pa, pb = np.asarray(ta.xyz, float), np.asarray(tb.xyz, float)
-        tol_p = self._tolerance(ta, tb)[0]
+        tol_p, tol_o = self._tolerance(ta, tb)
+        Ra = np.asarray(rpy_matrix(ta.rpy), float) if tol_o < math.inf else None
+        w = np.asarray(pin.log3(Ra.T @ np.asarray(rpy_matrix(tb.rpy), float))) if Ra is not None else None
         for q in qs:
-            if distance_to_segment(solver.position(q), pa, pb) > tol_p or np.any(q < ch.lower - 1e-9) or \
-                    np.any(q > ch.upper + 1e-9) or ch.contacts(q, 0.0):
-                raise self.fail(number, ta.name, tb.name, "the timed motion leaves the segment, a joint limit or "
-                                "the free space between the waypoints", "move the segment away from obstacles")
+            M = solver.placement(q)
+            p = np.array(M.translation)
+            off = distance_to_segment(p, pa, pb) > tol_p
+            if Ra is not None and w is not None and not off:
+                d = pb - pa
+                x = float(np.clip(np.dot(p - pa, d) / max(float(np.dot(d, d)), 1e-18), 0.0, 1.0))
+                R = Ra @ np.asarray(pin.exp3(x * w))
+                off = float(np.linalg.norm(pin.log3(R.T @ np.array(M.rotation)))) > tol_o
+            if off or np.any(q < ch.lower - 1e-9) or np.any(q > ch.upper + 1e-9) or ch.contacts(q, 0.0):
+                raise self.fail(number, ta.name, tb.name, "the timed motion leaves the segment's tolerances, a joint "
+                                "limit or the free space between the waypoints", "move the segment away from obstacles")
 
 
 def distance_to_segment(p, a, b) -> float:
