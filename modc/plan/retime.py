@@ -85,7 +85,6 @@ class Timed:
 
 def _toppra_piece(path, limits: Limits, grid_points: int = GRID_POINTS):
     """toppra's time-optimal trajectory along path (a toppra interpolator), rest to rest."""
-    import toppra
     import toppra.algorithm as algo
     import toppra.constraint as constraint
 
