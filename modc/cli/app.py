@@ -177,6 +177,7 @@ HEAVY = {
     "cma": "cma",
     "dask": "dask",
     "distributed": "distributed",
+    "toppra": "toppra",
 }
 SOURCE_SUFFIXES = (".mod", ".yaml", ".yml")
 

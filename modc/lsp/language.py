@@ -69,7 +69,9 @@ KEYWORDS = {
     "fit-links": "`dh fit-links { … }` — print link modules whose length realises each row's `a` exactly.",
     "library": '`library mark2` | `library mark2-strict` | `library "path.yaml"` — '
     "the module library this robot is built from (default mark2).",
-    "base": "`base at (x, y, z) m rpy (r, p, y) deg` — where base_link sits in the cell (for simulation and planning).",
+    "base": "`base at (x, y, z) m rpy (r, p, y) deg` — where base_link sits in the cell (for simulation and planning); "
+    "in a design block, `base within box size (…) m at (…) m step 50 mm [yaw 0 to 90 deg step 45 deg]` lets the "
+    "search place it.",
     "tool": "`tool at (x, y, z) m rpy (r, p, y) deg` — tool0 relative to the last unit's last frame.",
     "payload": "`payload 0.2 kg at (x, y, z) m` — a payload's mass and its centre of mass in tool0.",
     "pose": "`pose NAME (q1, …, qn) deg` — a named joint pose, one angle per joint; `home` is the robot's home pose.",

@@ -113,7 +113,26 @@ def robot_file_text(robot: Robot, comments: Sequence[str] = ()) -> str:
         lines.append(f"    pose {p.name} " + vec([_num(math.degrees(x), 6) for x in p.q], "deg"))
     lines += [_obstacle(o) for o in robot.obstacles]
     lines += [target_text(t) for t in robot.targets]
+    lines += task_lines(robot)
     if robot.allow:
         lines.append("    allow " + ", ".join(sorted(robot.allow)))
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def task_lines(robot: Robot) -> list[str]:
+    """The robot's regions, tasks and paths as .mod statements (a task lists its region points one by one)."""
+    from .robot import ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+
+    lines = []
+    for r in robot.regions:
+        s = (f"    region {r.name} box size {vec([_num(v) for v in r.size], 'm')} at "
+             f"{vec([_num(v) for v in r.center], 'm')} grid {r.grid[0]} x {r.grid[1]} x {r.grid[2]}")
+        if r.rpy is not None:
+            s += " rpy " + vec([_num(math.degrees(v)) for v in r.rpy], "deg")
+        if r.position_tolerance != POSITION_TOLERANCE or r.orientation_tolerance != ORIENTATION_TOLERANCE:
+            s += f" within {_num(r.position_tolerance * 1000, 6)} mm, {_num(math.degrees(r.orientation_tolerance))} deg"
+        lines.append(s)
+    lines += [f"    task {t.name} {{ visit {', '.join(t.visits)} }}" for t in robot.tasks]
+    lines += [f"    path {p.name} from {p.start} to {p.end} straight" for p in robot.paths]
+    return lines

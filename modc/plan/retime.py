@@ -19,6 +19,7 @@ energy = ∫|τ·q̇| dt (trapezoidal rule over the samples), peak share = max |
 from __future__ import annotations
 
 import itertools
+import logging
 from dataclasses import dataclass
 
 import numpy as np
@@ -84,11 +85,11 @@ class Timed:
 
 def _toppra_piece(path, limits: Limits, grid_points: int = GRID_POINTS):
     """toppra's time-optimal trajectory along path (a toppra interpolator), rest to rest."""
-    import toppra
     import toppra.algorithm as algo
     import toppra.constraint as constraint
 
-    toppra.setup_logging("WARNING")
+    # toppra's own chatter stays quiet (its setup_logging would add a console handler per call)
+    logging.getLogger("toppra").setLevel(logging.ERROR)
     vlim = LIMIT_SHARE * limits.velocity
     tlim = LIMIT_SHARE * limits.torque
     vel = constraint.JointVelocityConstraint(np.column_stack([-vlim, vlim]))
