@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kinematics import A_t1, A_t2, homogeneous, transform
+from ..kinematics import transform
 
 
 @dataclass(frozen=True)
@@ -32,15 +32,40 @@ class Geometry:
 def geometry(units, pivots: np.ndarray, ports: np.ndarray, links, tool_xyz, tool_rpy) -> Geometry:
     """units: the library's UnitType per position; pivots, ports: (C, n) rad; links: m per position."""
     C, n = pivots.shape
-    pre = np.empty((C, n, 4, 4))
-    post = np.empty((C, n, 4, 4))
-    for i, t in enumerate(units):
-        Tz = homogeneous(np.eye(3), (0.0, 0.0, t.z12))
-        for c in range(C):
-            pre[c, i] = A_t1(pivots[c, i], t.x01, t.z01) @ Tz
-            post[c, i] = A_t2(ports[c, i], links[i]) if t.link else np.eye(4)
+    pre_R, pre_t, post_R, post_t = pre_post(units, np.asarray(pivots, float), np.asarray(ports, float), links)
+    pre = np.zeros((C, n, 4, 4))
+    post = np.zeros((C, n, 4, 4))
+    pre[..., :3, :3], pre[..., :3, 3], pre[..., 3, 3] = pre_R, pre_t, 1.0
+    post[..., :3, :3], post[..., :3, 3], post[..., 3, 3] = post_R, post_t, 1.0
     t1 = np.array([(t.x01, 0.0, t.z01) for t in units], dtype=float).reshape(n, 3)
     return Geometry(pre, post, t1, transform(tool_xyz, tool_rpy))
+
+
+def _ry(a: np.ndarray) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
+
+
+def _rx(a: np.ndarray) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
+
+
+def pre_post(units, pivots: np.ndarray, ports: np.ndarray, links) -> tuple[np.ndarray, ...]:
+    """PRE_i = A_t1(pivot) . Tz(z12) and POST_i = A_t2(port, link) of C settings at once:
+    rotations (C, n, 3, 3) and translations (C, n, 3). Units 1/2 have port 0 and no link, for
+    which A_t2 is the identity."""
+    x01 = np.array([u.x01 for u in units], float)
+    z01 = np.array([u.z01 for u in units], float)
+    z12 = np.array([u.z12 for u in units], float)
+    x23 = np.array([x if u.link else 0.0 for u, x in zip(units, links, strict=True)], float)
+    pre_R = _ry(pivots)
+    pre_t = np.stack([x01 + np.sin(pivots) * z12, np.zeros_like(pivots), z01 + np.cos(pivots) * z12], -1)
+    post_R = _rx(ports)
+    post_t = np.broadcast_to(np.stack([x23, np.zeros_like(x23), np.zeros_like(x23)], -1), pre_t.shape)
+    return pre_R, pre_t, post_R, post_t
 
 
 def forward(g: Geometry, q: np.ndarray, points: bool = False):
