@@ -22,7 +22,7 @@ from .diagnose import diagnose, why_none
 from .evaluate import Spec
 from .rank import Design, distinct, key
 from .screen import reach_bound
-from .search import STOP, Part, ShapeResult, merge, parts_of, search_chunk, size
+from .search import STOP, TICK, Part, ShapeResult, merge, parts_of, search_chunk, size
 from .verify_order import Verifier
 
 ROUND = 16  # shapes searched between two rounds of exact checks (independent of the workers)
@@ -91,15 +91,19 @@ def _stopping(deadline: float | None) -> str | None:
 
 
 def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, deadline: float | None,
-               each: Callable[[Part], None]) -> None:
+               each: Callable[[Part], None], tick: Callable[[], None]) -> None:
     """Every range of work, its Part handed to each() in submission order; stops early (the
     rest unsearched) on Ctrl-C or at the deadline."""
     if executor is None:
-        for w in work:
-            if _stopping(deadline):
-                return
-            for p in search_chunk(spec, [w], seed, deadline):
-                each(p)
+        TICK.append(tick)
+        try:
+            for w in work:
+                if _stopping(deadline):
+                    return
+                for p in search_chunk(spec, [w], seed, deadline):
+                    each(p)
+        finally:
+            TICK.remove(tick)
         return
     futures = [executor.submit(search_chunk, spec, [w], seed, deadline) for w in work]
     try:
@@ -111,7 +115,7 @@ def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, dea
                     parts = f.result(timeout=0.2)
                     break
                 except TimeoutError:
-                    continue
+                    tick()
             for p in parts:
                 each(p)
     finally:
@@ -143,7 +147,7 @@ def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float]) -> 
 
 
 def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
-           executor: Executor | None = None, progress: Callable[[Status], None] | None = None,
+           executor: Executor | None = None, progress: Callable[..., None] | None = None,
            deadline: float | None = None) -> Outcome:
     """Ranked designs for a checked problem (its library resolved).
 
@@ -172,15 +176,20 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     tally = Verifier(problem, top, out, _mass)
     state: dict = {"done": 0, "settings": 0, "best": ""}
 
-    def report() -> None:
+    def report(force: bool = False) -> None:
         if progress is None:
             return
         spent = time.perf_counter() - t0
         frac = state["settings"] / max(total_settings, 1)
         eta = spent * (1 - frac) / frac if frac > 0.01 else None
-        progress(Status(state["done"], total_shapes, out.evaluated, out.screened, state["best"], eta))
+        status = Status(state["done"], total_shapes, out.evaluated, out.screened, state["best"], eta)
+        if force:
+            progress(status, True)
+        else:
+            progress(status)
 
     searched: list[ShapeResult] = []
+    report(force=True)
     for n, splits, shapes in tiers:
         rounds = _chunks(shapes, ROUND) if early else [shapes]
         for k, batch in enumerate(rounds):
@@ -202,7 +211,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
                 report()
 
             out.shapes += len(batch)
-            _run_parts(executor, spec, work, seed, deadline, each)
+            _run_parts(executor, spec, work, seed, deadline, each, report)
             for ps in pending.values():  # shapes cut short: what their finished ranges found
                 res = merge(spec, ps[0].shape, ps)
                 _absorb(out, res, names, closest, hit, clear, searched)
@@ -238,6 +247,8 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     if not out.designs:
         out.targets = diagnose(problem, spec, names, blocked, hit, clear, closest, searched, seed, deadline)
     out.seconds = time.perf_counter() - t0
+    state["done"] = total_shapes - len(out.unfinished)
+    report(force=True)
     return out
 
 

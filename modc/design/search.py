@@ -34,6 +34,7 @@ WORK = 65536  # settings per unit of work
 KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
 
 STOP = threading.Event()  # set by Ctrl-C in this process: blocks end at the next boundary
+TICK: list = []  # callbacks after each block, in this process only (the progress display's heartbeat)
 
 
 @dataclass(frozen=True)
@@ -154,6 +155,8 @@ def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline:
         ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
         excluded += int((~ok).sum())
         upto = end
+        for tick in TICK:
+            tick()
         if not ok.any():
             continue
         k = np.flatnonzero(ok)
