@@ -66,8 +66,8 @@ def _probe(problem: Problem, spec: Spec, t: int, seed: int, until: float, free: 
     return res
 
 
-def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, searched, seed: int,
-             deadline: float | None) -> dict[str, dict]:
+def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, seed: int,
+             deadline: float | None, stopped: bool) -> dict[str, dict]:
     out: dict[str, dict] = {}
     for i, name in enumerate(names):
         entry: dict[str, Any] = {"reached_alone": bool(clear[name]), "ruled_out_by": None, "closest_m": None,
@@ -80,6 +80,9 @@ def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, 
         if clear[name]:
             continue
         h, c = hit[name], closest[name]
+        if stopped and not h:
+            entry.update(detail="not reached by the settings screened before the search stopped")
+            continue
         if not h:
             until = time.time() + PROBE_SECONDS if deadline is None else min(deadline, time.time() + PROBE_SECONDS)
             p = _probe(problem, spec, i, seed, until, free=False)
@@ -98,10 +101,19 @@ def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, 
         if h:
             entry.update(ruled_out_by="obstacles", detail="reached only in collision with the cell")
             continue
-        entry.update(ruled_out_by="reach", closest_m=_finite(c),
-                     detail=f"no design gets closer than {_length(c)}" if math.isfinite(c)
-                     else "out of reach of every twist setting (a sound reach bound)")
+        if math.isfinite(c) and c > 0:
+            detail = f"no design gets closer than {_length(c)}"
+        elif screened_any(p if not hit[name] else None):
+            detail = "no IK run within the joint limits gets within its tolerance"
+        else:
+            detail = "out of reach of every twist setting (a sound reach bound)"
+        entry.update(ruled_out_by="reach", closest_m=_finite(c) if math.isfinite(c) and c > 0 else None,
+                     detail=detail)
     return out
+
+
+def screened_any(probe: dict | None) -> bool:
+    return probe is None or bool(probe["screened"])
 
 
 def _finite(x: float) -> float | None:

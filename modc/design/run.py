@@ -61,6 +61,9 @@ class Outcome:
         return why_none(self)
 
 
+_UNIT_MASS: dict[tuple, float] = {}  # (library, variant, kind, link) -> kg: thousands of shapes share a few units
+
+
 def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> float:
     from ..physical.parts import unit_mass
 
@@ -68,7 +71,11 @@ def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> fl
     assert lib is not None
     total = 0.0
     for v, k, x in zip(variants, shape.kinds, shape.links, strict=True):
-        total += unit_mass(lib, v, k, (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0)
+        link = (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0
+        key_ = (id(lib), v, k, link)
+        if key_ not in _UNIT_MASS:
+            _UNIT_MASS[key_] = unit_mass(lib, v, k, link)
+        total += _UNIT_MASS[key_]
     return total
 
 
@@ -245,7 +252,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
     out.designs = distinct(tally.accepted, problem.rank)[:top]
     if not out.designs:
-        out.targets = diagnose(problem, spec, names, blocked, hit, clear, closest, searched, seed, deadline)
+        out.targets = diagnose(problem, spec, names, blocked, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0
     state["done"] = total_shapes - len(out.unfinished)
     report(force=True)

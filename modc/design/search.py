@@ -15,6 +15,8 @@ lies, then simplest twists first.
 """
 from __future__ import annotations
 
+import functools
+import math
 import threading
 import time
 import zlib
@@ -93,10 +95,9 @@ def order_key(f: Found) -> tuple:
     return (round(f.worst, 6), *_complexity(np.array(f.pivots), np.array(f.ports)))
 
 
-def _coarse(values: np.ndarray, stride: int) -> np.ndarray:
-    """Every stride-th value counted from the one nearest 0 (0 stays in)."""
-    i0 = int(np.argmin(np.abs(values)))
-    return values[[i for i in range(len(values)) if (i - i0) % stride == 0]]
+def _coarse_index(count: int, i0: int, stride: int) -> list[int]:
+    """Every stride-th index counted from i0 (the value nearest 0 stays in)."""
+    return [i for i in range(count) if (i - i0) % stride == 0]
 
 
 def axes(spec: Spec, shape: Shape) -> tuple[list[np.ndarray], list[int], bool]:
@@ -110,11 +111,23 @@ def axes(spec: Spec, shape: Shape) -> tuple[list[np.ndarray], list[int], bool]:
     out = [pivot_set] * shape.n + [port_set] * len(where)
     if int(np.prod([len(a) for a in out], dtype=float)) <= COMPLETE:
         return out, where, True
-    strides = [1] * len(out)
-    while np.prod([len(_coarse(a, s)) for a, s in zip(out, strides, strict=True)], dtype=float) > COARSE:
-        k = max(range(len(out)), key=lambda j: (len(_coarse(out[j], strides[j])), -j))
+    zero = [int(np.argmin(np.abs(a))) for a in out]
+    strides = _strides(tuple(len(a) for a in out), tuple(zero))
+    return [a[_coarse_index(len(a), z, s)] for a, z, s in zip(out, zero, strides, strict=True)], where, False
+
+
+@functools.lru_cache(maxsize=256)
+def _strides(lengths: tuple[int, ...], zero: tuple[int, ...]) -> tuple[int, ...]:
+    """Strides that thin the axes evenly (the longest first) until at most COARSE settings remain."""
+    strides = [1] * len(lengths)
+
+    def count(j: int) -> int:
+        return (lengths[j] - 1 - zero[j] % strides[j]) // strides[j] + 1
+
+    while math.prod(count(j) for j in range(len(lengths))) > COARSE:
+        k = max(range(len(lengths)), key=lambda j: (count(j), -j))
         strides[k] += 1
-    return [_coarse(a, s) for a, s in zip(out, strides, strict=True)], where, False
+    return tuple(strides)
 
 
 def size(spec: Spec, shape: Shape) -> int:
