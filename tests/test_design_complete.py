@@ -188,3 +188,22 @@ def test_two_target_cell_every_working_setting_is_found(monkeypatch):
     worst = [max(t["position_error_m"] for t in d.verified.targets.values()) for d in o.designs]
     assert (tuple(np.round(best.pivots, 6)), tuple(np.round(best.ports, 6))) in brute
     assert worst[0] <= min(worst) + 1e-6 or o.designs[0].mass < o.designs[1].mass
+
+
+@pytest.mark.parametrize("cell", [
+    "box floor size (6, 6, 0.03) m at (0, 0, -0.02) m\n    target a at (0.30, 0.10, -0.25) m",
+    "box machine size (0.2, 0.2, 0.2) m at (0.35, 0, 0.2) m\n    target a at (0.35, 0.0, 0.20) m",
+])
+def test_a_target_walled_off_or_buried_is_named_without_a_search(cell):
+    """Below a floor wider than any arm's reach, or deep inside a machine: no arm serves target a
+    (a sound bound, no IK), and the no-design answer names it and the obstacle, not target b."""
+    from modc.design import run
+
+    p = _problem(f"design d {{\n    {cell}\n    target b at (0.25, -0.15, 0.30) m\n    units 1 to 6\n}}\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        o = run.design(p, top=1, seed=0)
+    assert not o.designs and o.evaluated == 0
+    why = o.why_none()
+    assert "target 'a'" in why and "obstacles" in why and "target 'b'" not in why and "inf" not in why
+    assert o.targets["a"]["ruled_out_by"] == "obstacles" and o.targets["b"]["reached_alone"]

@@ -123,11 +123,42 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray) -> np.ndarray:
     return ok
 
 
-def inside_obstacle(obstacles, xyz: np.ndarray, tol: np.ndarray, tool_reach: float, radius: float) -> np.ndarray:
-    """(T,): targets no arm can serve because tool0 there puts the arm's last frame so deep in
-    an obstacle that its thinnest segment (radius) surely collides: the last frame is within
-    tool_reach + tol of the target, and a signed distance changes no faster than the distance."""
-    if len(obstacles.shape) == 0 or len(xyz) == 0:
-        return np.zeros(len(xyz), bool)
-    sd = obstacles.distance(np.asarray(xyz, float)).min(-1)
-    return sd + tool_reach + tol - radius < -1e-3
+def blocked(obstacles, xyz: np.ndarray, tol: np.ndarray, tool_reach: float, radius: float, reach: float,
+            starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Targets no arm in the bounds can serve because of an obstacle, and which obstacle ((T,)
+    bool, (T,) index or -1). Two sound reasons:
+
+    - inside: tool0 there puts the arm's last frame (within tool_reach + tol of the target) so
+      deep in an obstacle that its thinnest segment (radius) collides - a signed distance
+      changes no faster than the distance;
+    - walled off: a box lies between the arm's start and the target along one of its axes - the
+      start is base_link's origin and every unit type's twist1 origin `starts` (K, 3) (the screen
+      tests the chain from there), the target side is clear by tool_reach + tol - and the box
+      spans the whole ball of radius `reach` (the longest chain in the bounds) around the base
+      across that axis: every chain from the base to the target crosses the slab inside the box."""
+    T = len(xyz)
+    which = np.full(T, -1)
+    if len(obstacles.shape) == 0 or T == 0:
+        return np.zeros(T, bool), which
+    x = np.asarray(xyz, float)
+    sd = obstacles.distance(x)  # (T, K)
+    inside = sd + tool_reach + tol[:, None] - radius < -1e-3
+    for k in range(len(obstacles.shape)):
+        if obstacles.shape[k] != 0:
+            continue
+        s = obstacles.size[k]
+        b = -obstacles.centre[k] @ obstacles.R[k]  # base origin in the box frame
+        st = (np.vstack([np.zeros(3), starts]) - obstacles.centre[k]) @ obstacles.R[k]
+        xs = (x - obstacles.centre[k]) @ obstacles.R[k]
+        for a in range(3):
+            others = [j for j in range(3) if j != a]
+            if any(abs(b[j]) + reach > s[j] for j in others):
+                continue
+            side = float(np.sign(b[a]))
+            if side == 0.0 or not np.all(side * st[:, a] > s[a]):
+                continue
+            far = side * xs[:, a] < -(s[a] + tool_reach + tol)
+            inside[:, k] |= far
+    hit = inside.any(-1)
+    which[hit] = np.argmax(inside[hit], axis=-1)
+    return hit, which

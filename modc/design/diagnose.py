@@ -73,9 +73,11 @@ def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, 
         entry: dict[str, Any] = {"reached_alone": bool(clear[name]), "ruled_out_by": None, "closest_m": None,
                                  "detail": ""}
         out[name] = entry
-        if blocked[i]:
+        if blocked[i] >= 0:
+            wall = problem.cell.obstacles[int(blocked[i])].name
             entry.update(ruled_out_by="obstacles", closest_m=None,
-                         detail="it lies so deep in an obstacle that no arm can put tool0 there")
+                         detail=f"obstacle '{wall}' rules it out for every arm: tool0 there is inside it, or "
+                                "it stands between the base and the target across the arm's whole reach")
             continue
         if clear[name]:
             continue

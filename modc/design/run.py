@@ -17,7 +17,7 @@ import numpy as np
 
 from ..model import Problem
 from . import space
-from .bounds import inside_obstacle
+from .bounds import blocked as bounds_blocked
 from .diagnose import diagnose, why_none
 from .evaluate import Spec
 from .rank import Design, distinct, key
@@ -130,6 +130,13 @@ def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, dea
             f.cancel()
 
 
+def _longest(problem: Problem, n: int) -> list[space.Shape]:
+    """The shapes of n units with the longest links allowed (the reach bound grows with them)."""
+    if not space.variant_splits(problem, n):
+        return []
+    return space.shapes(problem, n)
+
+
 def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float]) -> list:
     lib = problem.cell.library
     assert lib is not None
@@ -174,8 +181,13 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     hit = dict.fromkeys(names, False)
     clear = dict.fromkeys(names, False)
     tg = spec.targets
-    blocked = inside_obstacle(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(problem.cell.tool.xyz)),
-                              float(spec.radii.min()))
+    longest = max((reach_bound([lib.units[k] for k in s.kinds], [x or lib.units[k].x23 for k, x in
+                                zip(s.kinds, s.links, strict=True)], problem.cell.tool.xyz)
+                   for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
+                   for s in _longest(problem, n)), default=0.0)
+    starts = np.array([(u.x01, 0.0, u.z01) for u in lib.units.values()], float)
+    blocked, walls = bounds_blocked(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(problem.cell.tool.xyz)),
+                                    float(spec.radii.min()), longest, starts)
     tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest)
     total_shapes = sum(len(s) for _, _, s in tiers)
     total_settings = sum(size(spec, s) for _, _, shapes in tiers for _, _, s in shapes)
@@ -252,7 +264,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
     out.designs = distinct(tally.accepted, problem.rank)[:top]
     if not out.designs:
-        out.targets = diagnose(problem, spec, names, blocked, hit, clear, closest, seed, deadline, bool(out.stopped))
+        out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0
     state["done"] = total_shapes - len(out.unfinished)
     report(force=True)
