@@ -98,27 +98,26 @@ def forward(g: Geometry, q: np.ndarray, points: bool = False):
 @dataclass
 class Flat:
     """Fixed transforms per run, structure of arrays (run index last, so every product is a few
-    long vector operations): rotations (n, 3, 3, B), translations (n, 3, B)."""
+    long vector operations): K_0 = PRE_1, K_i = POST_i . PRE_(i+1), K_n = POST_n . tool - the
+    transform from one joint's rotation to the next, one product per joint -, rotations
+    (n+1, 3, 3, B), translations (n+1, 3, B)."""
 
-    pre_R: np.ndarray
-    pre_t: np.ndarray
-    post_R: np.ndarray
-    post_t: np.ndarray
-    tool_R: np.ndarray  # (3, 3)
-    tool_t: np.ndarray  # (3,)
+    k_R: np.ndarray
+    k_t: np.ndarray
 
     @classmethod
     def of(cls, g: Geometry, c_idx: np.ndarray) -> Flat:
-        def soa(M, rows, cols):
-            return np.ascontiguousarray(np.moveaxis(M[c_idx][:, :, rows, cols], 0, -1))
-
-        rot, col = (slice(0, 3), slice(0, 3)), (slice(0, 3), 3)
-        return cls(soa(g.pre, *rot), soa(g.pre, *col), soa(g.post, *rot), soa(g.post, *col),
-                   g.flange_tool[:3, :3], g.flange_tool[:3, 3])
+        C, n = g.pre.shape[:2]
+        K = np.empty((C, n + 1, 4, 4))
+        K[:, 0] = g.pre[:, 0]
+        K[:, 1:n] = g.post[:, :-1] @ g.pre[:, 1:]
+        K[:, n] = g.post[:, -1] @ g.flange_tool
+        Kc = K[c_idx]
+        return cls(np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, :3], 0, -1)),
+                   np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, 3], 0, -1)))
 
     def take(self, keep: np.ndarray) -> Flat:
-        return Flat(self.pre_R[..., keep], self.pre_t[..., keep], self.post_R[..., keep], self.post_t[..., keep],
-                    self.tool_R, self.tool_t)
+        return Flat(self.k_R[..., keep], self.k_t[..., keep])
 
 
 def _rot(R, P):
@@ -136,25 +135,20 @@ def forward_flat(f: Flat, q: np.ndarray):
     """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
     and position (3, B)."""
     n, B = q.shape
-    R = np.zeros((3, 3, B))
-    R[0, 0] = R[1, 1] = R[2, 2] = 1.0
-    t = np.zeros((3, B))
     p = np.empty((n, 3, B))
     z = np.empty((n, 3, B))
     c, s = np.cos(q), np.sin(q)
+    R, t = f.k_R[0].copy(), f.k_t[0]  # base_link is the identity: K_0 needs no product
     for i in range(n):
-        t = t + _apply(R, f.pre_t[i])
-        R = _rot(R, f.pre_R[i])
+        if i:
+            t = t + _apply(R, f.k_t[i])
+            R = _rot(R, f.k_R[i])
         x, y = R[:, 0].copy(), R[:, 1]
         R[:, 0] = c[i] * x + s[i] * y
         R[:, 1] = c[i] * y - s[i] * x
         p[i] = t
         z[i] = R[:, 2]
-        t = t + _apply(R, f.post_t[i])
-        R = _rot(R, f.post_R[i])
-    t_tool = t + np.tensordot(np.moveaxis(R, -1, 0), f.tool_t, axes=1).T
-    R_tool = np.moveaxis(np.moveaxis(R, -1, 0) @ f.tool_R, 0, -1)
-    return p, z, R_tool, t_tool
+    return p, z, _rot(R, f.k_R[n]), t + _apply(R, f.k_t[n])
 
 
 def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:

@@ -99,22 +99,29 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     for t in np.argsort(-np.linalg.norm(tg.xyz, axis=1), kind="stable"):
         if live.size == 0:
             break
-        sub = Geometry(g.pre[live], g.post[live], g.t1, g.flange_tool)
-        qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0, lo, hi)
-        r = ept / max(tg.tol_p[t], 1e-12)
-        if tg.oriented[t]:
-            r = np.maximum(r, ert / max(tg.tol_r[t], 1e-12))
-        h = r <= 1.0
         tried[live, t] = True
-        ik_hit[live, t] = h[:, 0].any(-1)
-        if h.any() and len(spec.obstacles.shape):
-            # only the runs that reached their target are worth a collision test
-            c, s_ = np.nonzero(h[:, 0])
-            one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
-            _, _, _, pts = forward(one, qt[c, 0, s_][:, None, None, :], points=True)
-            h[c, 0, s_] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
-        q[live, t], ep[live, t], hit[live, t], ratio[live, t] = qt[:, 0], ept[:, 0], h[:, 0], r[:, 0]
-        live = live[h[:, 0].any(-1)]
+        # seeds one after the other: a candidate stops at its first run that reaches the target
+        # clear of the cell (whether any seed does is the same as running them all)
+        need = live
+        for s in range(SEEDS):
+            if need.size == 0:
+                break
+            sub = Geometry(g.pre[need], g.post[need], g.t1, g.flange_tool)
+            qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0[s:s + 1], lo, hi)
+            r = ept[:, 0, 0] / max(tg.tol_p[t], 1e-12)
+            if tg.oriented[t]:
+                r = np.maximum(r, ert[:, 0, 0] / max(tg.tol_r[t], 1e-12))
+            h = r <= 1.0
+            ik_hit[need, t] |= h
+            if h.any() and len(spec.obstacles.shape):
+                # only the runs that reached their target are worth a collision test
+                c = np.flatnonzero(h)
+                one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+                _, _, _, pts = forward(one, qt[c, 0, 0][:, None, None, :], points=True)
+                h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+            q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, 0], ept[:, 0, 0], h, r
+            need = need[~h]
+        live = live[hit[live, t].any(-1)]
     reached = hit.any(-1)  # (C, T)
     feasible = reached.all(-1)
     closest = ep.min(-1)

@@ -25,7 +25,8 @@ from .screen import reach_bound
 from .search import STOP, TICK, Part, ShapeResult, merge, parts_of, search_chunk, size
 from .verify_order import Verifier
 
-ROUND = 16  # shapes searched between two rounds of exact checks (independent of the workers)
+ROUND = 16  # shapes in a tier's first round of search between exact checks; rounds double up to ROUND_MAX
+ROUND_MAX = 512  # (sizes independent of the workers: where the search stops does not depend on them)
 
 
 @dataclass
@@ -85,8 +86,15 @@ def _min_mass(problem: Problem, shape: space.Shape, splits) -> float:
     return min(masses, default=float("inf"))
 
 
-def _chunks(items: list, size_: int) -> list[list]:
-    return [items[i:i + size_] for i in range(0, len(items), size_)]
+def _rounds(items: list) -> list[list]:
+    """ROUND items, then twice as many, … up to ROUND_MAX: few shapes searched past the first
+    designs on small cells, and enough units of work in flight to keep many workers busy on a
+    large tier (4,096 six-unit shapes: rounds of 512)."""
+    out, i, k = [], 0, ROUND
+    while i < len(items):
+        out.append(items[i:i + k])
+        i, k = i + k, min(2 * k, ROUND_MAX)
+    return out
 
 
 def _stopping(deadline: float | None) -> str | None:
@@ -210,7 +218,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     searched: list[ShapeResult] = []
     report(force=True)
     for n, splits, shapes in tiers:
-        rounds = _chunks(shapes, ROUND) if early else [shapes]
+        rounds = _rounds(shapes) if early else [shapes]
         for k, batch in enumerate(rounds):
             work = [(s, lo, hi_) for _, _, s in batch for lo, hi_ in parts_of(spec, s)]
             pending: dict[str, list[Part]] = {}
