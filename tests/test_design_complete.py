@@ -207,3 +207,31 @@ def test_a_target_walled_off_or_buried_is_named_without_a_search(cell):
     why = o.why_none()
     assert "target 'a'" in why and "obstacles" in why and "target 'b'" not in why and "inf" not in why
     assert o.targets["a"]["ruled_out_by"] == "obstacles" and o.targets["b"]["reached_alone"]
+
+
+def test_top_designs_are_distinct_arms_with_variant_swaps_as_alternatives():
+    """H1-H1-L3 and H1-L1-L3 are one arm (H and L units of a type share their geometry): one entry,
+    the other listed as its alternative, in ranking.json too."""
+    from modc.design import run
+    from modc.design.rank import identity
+    from modc.design.write import ranking
+
+    p = _problem("""design small {
+    payload 100 g
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    units 3
+    modules H1, L1, L3
+}
+""")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        o = run.design(p, top=2, seed=0)
+    assert len(o.designs) == 2 and o.complete
+    assert identity(o.designs[0]) != identity(o.designs[1])
+    with_alt = [d for d in o.designs if d.alternatives]
+    assert with_alt
+    d = with_alt[0]
+    assert all(identity(a) == identity(d) and a.chain() != d.chain() for a in d.alternatives)
+    entry = ranking([o])["designs"][o.designs.index(d)]
+    assert entry["alternatives"][0]["chain"] == d.alternatives[0].chain()

@@ -270,7 +270,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     out.coarse = [r.shape.label() for r in searched if r.finished and not r.complete]
     out.complete = not out.unfinished and not out.coarse
     out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
-    out.designs = distinct(tally.accepted, problem.rank)[:top]
+    out.designs = [tally.swaps(d) for d in distinct(tally.accepted, problem.rank)[:top]]
     if not out.designs:
         out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0

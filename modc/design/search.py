@@ -92,7 +92,9 @@ def _complexity(pivots, ports) -> tuple:
 
 
 def order_key(f: Found) -> tuple:
-    return (round(f.worst, 6), *_complexity(np.array(f.pivots), np.array(f.ports)))
+    """Deepest inside the tolerances first (to 1 % of a tolerance: IK runs end ~1e-7 m off a
+    reachable target, and such differences mean nothing), then simplest."""
+    return (round(f.worst, 2), *_complexity(np.array(f.pivots), np.array(f.ports)))
 
 
 def _coarse_index(count: int, i0: int, stride: int) -> list[int]:

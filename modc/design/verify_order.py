@@ -92,3 +92,23 @@ class Verifier:
                 self.accepted.append(Design(cand, v))
                 self.keys.append(k)
                 break
+
+    def swaps(self, d: Design) -> Design:
+        """d with every other H/L split of its arm that passes the exact check as an alternative."""
+        from dataclasses import replace
+
+        from .rank import order
+
+        p = self.problem
+        c = d.candidate
+        have = {a.candidate.variants for a in d.alternatives} | {c.variants}
+        found = list(d.alternatives)
+        for variants in space.variant_splits(p, c.shape.n):
+            allowed = all(space.allowed(p, v, k) for v, k in zip(variants, c.shape.kinds, strict=True))
+            if variants in have or not allowed:
+                continue
+            cand = Candidate(c.shape, variants, c.pivots, c.ports, c.solutions)
+            v = verify(p, cand)
+            if not isinstance(v, str):
+                found.append(Design(cand, v))
+        return replace(d, alternatives=tuple(order(found, p.rank)))
