@@ -209,6 +209,7 @@ def test_a_target_walled_off_or_buried_is_named_without_a_search(cell):
     assert o.targets["a"]["ruled_out_by"] == "obstacles" and o.targets["b"]["reached_alone"]
 
 
+@pytest.mark.slow
 def test_top_designs_are_distinct_arms_with_variant_swaps_as_alternatives():
     """H1-H1-L3 and H1-L1-L3 are one arm (H and L units of a type share their geometry): one entry,
     the other listed as its alternative, in ranking.json too."""
