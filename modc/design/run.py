@@ -203,12 +203,14 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     tally = Verifier(problem, top, out, _mass)
     state: dict = {"done": 0, "settings": 0, "best": ""}
 
-    def report(force: bool = False) -> None:
+    def report(force: bool = False, final: bool = False) -> None:
         if progress is None:
             return
         spent = time.perf_counter() - t0
+        # the share of every shape's settings done: an upper bound on what is left (the search
+        # may stop early once the top designs are found)
         frac = state["settings"] / max(total_settings, 1)
-        eta = spent * (1 - frac) / frac if frac > 0.01 else None
+        eta = 0.0 if final else spent * (1 - frac) / frac if frac > 0.01 else None
         status = Status(state["done"], total_shapes, out.evaluated, out.screened, state["best"], eta)
         if force:
             progress(status, True)
@@ -275,7 +277,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
         out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0
     state["done"] = total_shapes - len(out.unfinished)
-    report(force=True)
+    report(force=True, final=True)
     return out
 
 
