@@ -1,8 +1,12 @@
 """`modc design FILE -o DIR`: ranked module chains for the `design` blocks of FILE."""
 from __future__ import annotations
 
+import os
+import signal
 import sys
-from contextlib import contextmanager, nullcontext
+import time
+from contextlib import contextmanager
+from pathlib import Path
 
 import click
 
@@ -10,6 +14,46 @@ from .. import names
 from .app import EXIT_ERRORS, EXIT_USAGE, _err, _print_diagnostics, app, argument, library_option, usage_errors
 
 RENDERED = 3  # pictures of the top designs in report.html
+EXIT_INTERRUPTED = 130
+
+
+def _budget(text: str | None) -> float | None:
+    """'90s', '5m', '1h', '1.5m' or a number of seconds -> seconds."""
+    if text is None:
+        return None
+    t = text.strip().lower()
+    scale = {"s": 1.0, "m": 60.0, "h": 3600.0}.get(t[-1:], None)
+    try:
+        value = float(t[:-1] if scale else t) * (scale or 1.0)
+    except ValueError:
+        raise click.BadParameter(f"'{text}' is not a duration (e.g. 90s, 5m, 1h)") from None
+    if not value > 0 or value == float("inf"):
+        raise click.BadParameter(f"'{text}' is not a positive duration")
+    return value
+
+
+@contextmanager
+def _sigint_stops():
+    """Ctrl-C stops the search where it is (the best designs found are kept); a second one ends
+    modc at once."""
+    from ..design.search import STOP
+
+    STOP.clear()
+
+    def handler(signum, frame):
+        if STOP.is_set():
+            raise KeyboardInterrupt
+        STOP.set()
+
+    try:
+        old = signal.signal(signal.SIGINT, handler)
+    except ValueError:  # not the main thread: leave Ctrl-C alone
+        old = None
+    try:
+        yield STOP
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
 
 
 def _cap_workers(_ctx: click.Context, _param: click.Parameter, value: int) -> int:
@@ -45,32 +89,12 @@ def _executor(workers: int, scheduler: str | None):
     elif workers > 1:
         from concurrent.futures import ProcessPoolExecutor
 
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        # workers ignore Ctrl-C: the main process stops the search and keeps what was found
+        with ProcessPoolExecutor(max_workers=workers, initializer=signal.signal,
+                                 initargs=(signal.SIGINT, signal.SIG_IGN)) as pool:
             yield pool
     else:
         yield None
-
-
-@contextmanager
-def _progress(enabled: bool, name: str):
-    """A rich progress line on stderr (a TTY only): twist settings screened per second, the best design so far."""
-    if not enabled:
-        yield None
-        return
-    from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
-
-    with Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), transient=True,
-                  console=__import__("rich.console", fromlist=["Console"]).Console(stderr=True)) as bar:
-        import time
-
-        task = bar.add_task(f"design {name}", total=None)
-        start = time.perf_counter()
-
-        def update(evaluated: int, shapes: int, best: str) -> None:
-            rate = evaluated / max(time.perf_counter() - start, 1e-9)
-            bar.update(task, description=f"{name}: {evaluated:,} screened ({rate:,.0f}/s), {shapes} shapes; "
-                                         f"best {best or '—'}")
-        yield update
 
 
 def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
@@ -105,6 +129,9 @@ def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
 @click.option("--scheduler", callback=_scheduler, help="run on a Dask cluster: tcp://host:8786")
 @click.option("--json", "json_out", is_flag=True, help="print ranking.json on stdout")
 @click.option("--render/--no-render", default=True, help="pictures of the top designs")
+@click.option("--time-budget", "time_budget", metavar="DURATION",
+              help="stop after this long (90s, 5m, 1h) with the best designs found")
+@click.option("-q", "--quiet", is_flag=True, help="no progress display")
 @library_option
 @click.option("--force/--no-force", default=False, help="replace DIR even if modc did not create it")
 def design_cmd(
@@ -117,6 +144,8 @@ def design_cmd(
     scheduler: str | None,
     json_out: bool,
     render: bool,
+    time_budget: str | None,
+    quiet: bool,
     library: str | None,
     force: bool,
 ) -> None:
@@ -129,6 +158,7 @@ def design_cmd(
     from ..design.write import ranking, summary_line
     from ..diagnostics import codes
     from ..outputs import check_output_dir, write_tree
+    from .design_progress import progress as show_progress
 
     try:
         checked = check_file(file, library)
@@ -145,22 +175,32 @@ def design_cmd(
     inputs = inputs_of(file, library, checked)
     with usage_errors("design", writing=out):  # before the search: a refused DIR costs no minutes
         check_output_dir(out, inputs, force)
+    budget = _budget(time_budget)
+    deadline = None if budget is None else time.time() + budget
     outcomes, failed = [], []
-    tty = sys.stderr.isatty()
-    with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor:
+    mode = "off" if quiet else "live" if sys.stderr.isatty() else "plain"
+    with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor, \
+            _sigint_stops() as stop:
         for p in problems:
-            with _progress(tty, p.name) if tty else nullcontext() as bar:
-                o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar)
+            with show_progress(mode, p.name) as bar:
+                o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar,
+                                  deadline=deadline)
             if not o.designs:
                 assert p.cell.library is not None
                 hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
                 units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
                 failed.append(codes.NO_DESIGN.at(p.name_span, units=units, name=p.name, closest=o.why_none()))
             outcomes.append(o)
-    if failed:
+            if o.stopped:
+                break
+    interrupted = stop.is_set()
+    for o in outcomes:
+        if o.stopped:
+            _err(f"modc design: {o.problem.name}: {_stopped_text(o)}")
+    if failed or not outcomes or not any(o.designs for o in outcomes):
         _print_diagnostics(failed, checked.sources)
         _err(f"modc design: no design found; nothing written to {out}")
-        raise SystemExit(EXIT_ERRORS)
+        raise SystemExit(EXIT_INTERRUPTED if interrupted else EXIT_ERRORS)
     tree = design_files(outcomes)
     if render:
         names = [f for f in tree if f.endswith(".mod")]
@@ -173,3 +213,12 @@ def design_cmd(
     for o in outcomes:
         _err(f"modc design: {summary_line(o)}")
     _err(f"modc design: {len(tree)} files written to {out}")
+    if interrupted:
+        raise SystemExit(EXIT_INTERRUPTED)
+
+
+def _stopped_text(o) -> str:
+    why = "the time budget ran out" if o.stopped == "time budget" else "interrupted (Ctrl-C)"
+    shown = ", ".join(o.unfinished[:8]) + (f" and {len(o.unfinished) - 8} more" if len(o.unfinished) > 8 else "")
+    return (f"{why}; {len(o.unfinished)} shapes not finished" + (f": {shown}" if o.unfinished else "")
+            + f"; best designs so far: {len(o.designs)}")

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kinematics import A_t1, A_t2, homogeneous, transform
+from ..kinematics import transform
 
 
 @dataclass(frozen=True)
@@ -32,15 +32,40 @@ class Geometry:
 def geometry(units, pivots: np.ndarray, ports: np.ndarray, links, tool_xyz, tool_rpy) -> Geometry:
     """units: the library's UnitType per position; pivots, ports: (C, n) rad; links: m per position."""
     C, n = pivots.shape
-    pre = np.empty((C, n, 4, 4))
-    post = np.empty((C, n, 4, 4))
-    for i, t in enumerate(units):
-        Tz = homogeneous(np.eye(3), (0.0, 0.0, t.z12))
-        for c in range(C):
-            pre[c, i] = A_t1(pivots[c, i], t.x01, t.z01) @ Tz
-            post[c, i] = A_t2(ports[c, i], links[i]) if t.link else np.eye(4)
+    pre_R, pre_t, post_R, post_t = pre_post(units, np.asarray(pivots, float), np.asarray(ports, float), links)
+    pre = np.zeros((C, n, 4, 4))
+    post = np.zeros((C, n, 4, 4))
+    pre[..., :3, :3], pre[..., :3, 3], pre[..., 3, 3] = pre_R, pre_t, 1.0
+    post[..., :3, :3], post[..., :3, 3], post[..., 3, 3] = post_R, post_t, 1.0
     t1 = np.array([(t.x01, 0.0, t.z01) for t in units], dtype=float).reshape(n, 3)
     return Geometry(pre, post, t1, transform(tool_xyz, tool_rpy))
+
+
+def _ry(a: np.ndarray) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
+
+
+def _rx(a: np.ndarray) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    z, o = np.zeros_like(a), np.ones_like(a)
+    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
+
+
+def pre_post(units, pivots: np.ndarray, ports: np.ndarray, links) -> tuple[np.ndarray, ...]:
+    """PRE_i = A_t1(pivot) . Tz(z12) and POST_i = A_t2(port, link) of C settings at once:
+    rotations (C, n, 3, 3) and translations (C, n, 3). Units 1/2 have port 0 and no link, for
+    which A_t2 is the identity."""
+    x01 = np.array([u.x01 for u in units], float)
+    z01 = np.array([u.z01 for u in units], float)
+    z12 = np.array([u.z12 for u in units], float)
+    x23 = np.array([x if u.link else 0.0 for u, x in zip(units, links, strict=True)], float)
+    pre_R = _ry(pivots)
+    pre_t = np.stack([x01 + np.sin(pivots) * z12, np.zeros_like(pivots), z01 + np.cos(pivots) * z12], -1)
+    post_R = _rx(ports)
+    post_t = np.broadcast_to(np.stack([x23, np.zeros_like(x23), np.zeros_like(x23)], -1), pre_t.shape)
+    return pre_R, pre_t, post_R, post_t
 
 
 def forward(g: Geometry, q: np.ndarray, points: bool = False):
@@ -73,27 +98,26 @@ def forward(g: Geometry, q: np.ndarray, points: bool = False):
 @dataclass
 class Flat:
     """Fixed transforms per run, structure of arrays (run index last, so every product is a few
-    long vector operations): rotations (n, 3, 3, B), translations (n, 3, B)."""
+    long vector operations): K_0 = PRE_1, K_i = POST_i . PRE_(i+1), K_n = POST_n . tool - the
+    transform from one joint's rotation to the next, one product per joint -, rotations
+    (n+1, 3, 3, B), translations (n+1, 3, B)."""
 
-    pre_R: np.ndarray
-    pre_t: np.ndarray
-    post_R: np.ndarray
-    post_t: np.ndarray
-    tool_R: np.ndarray  # (3, 3)
-    tool_t: np.ndarray  # (3,)
+    k_R: np.ndarray
+    k_t: np.ndarray
 
     @classmethod
     def of(cls, g: Geometry, c_idx: np.ndarray) -> Flat:
-        def soa(M, rows, cols):
-            return np.ascontiguousarray(np.moveaxis(M[c_idx][:, :, rows, cols], 0, -1))
-
-        rot, col = (slice(0, 3), slice(0, 3)), (slice(0, 3), 3)
-        return cls(soa(g.pre, *rot), soa(g.pre, *col), soa(g.post, *rot), soa(g.post, *col),
-                   g.flange_tool[:3, :3], g.flange_tool[:3, 3])
+        C, n = g.pre.shape[:2]
+        K = np.empty((C, n + 1, 4, 4))
+        K[:, 0] = g.pre[:, 0]
+        K[:, 1:n] = g.post[:, :-1] @ g.pre[:, 1:]
+        K[:, n] = g.post[:, -1] @ g.flange_tool
+        Kc = K[c_idx]
+        return cls(np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, :3], 0, -1)),
+                   np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, 3], 0, -1)))
 
     def take(self, keep: np.ndarray) -> Flat:
-        return Flat(self.pre_R[..., keep], self.pre_t[..., keep], self.post_R[..., keep], self.post_t[..., keep],
-                    self.tool_R, self.tool_t)
+        return Flat(self.k_R[..., keep], self.k_t[..., keep])
 
 
 def _rot(R, P):
@@ -111,25 +135,20 @@ def forward_flat(f: Flat, q: np.ndarray):
     """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
     and position (3, B)."""
     n, B = q.shape
-    R = np.zeros((3, 3, B))
-    R[0, 0] = R[1, 1] = R[2, 2] = 1.0
-    t = np.zeros((3, B))
     p = np.empty((n, 3, B))
     z = np.empty((n, 3, B))
     c, s = np.cos(q), np.sin(q)
+    R, t = f.k_R[0].copy(), f.k_t[0]  # base_link is the identity: K_0 needs no product
     for i in range(n):
-        t = t + _apply(R, f.pre_t[i])
-        R = _rot(R, f.pre_R[i])
+        if i:
+            t = t + _apply(R, f.k_t[i])
+            R = _rot(R, f.k_R[i])
         x, y = R[:, 0].copy(), R[:, 1]
         R[:, 0] = c[i] * x + s[i] * y
         R[:, 1] = c[i] * y - s[i] * x
         p[i] = t
         z[i] = R[:, 2]
-        t = t + _apply(R, f.post_t[i])
-        R = _rot(R, f.post_R[i])
-    t_tool = t + np.tensordot(np.moveaxis(R, -1, 0), f.tool_t, axes=1).T
-    R_tool = np.moveaxis(np.moveaxis(R, -1, 0) @ f.tool_R, 0, -1)
-    return p, z, R_tool, t_tool
+    return p, z, _rot(R, f.k_R[n]), t + _apply(R, f.k_t[n])
 
 
 def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:

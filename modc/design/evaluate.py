@@ -51,13 +51,20 @@ class Spec:
 
 @dataclass
 class Screened:
-    """Per candidate (C): feasible, a score (0 when feasible; else how far from it), per target the
-    closest position error (C, T) and the joint vectors that pass the screen, best first."""
+    """Per candidate (C): feasible; a score (0 when feasible; else how far from it); per target
+    the closest position error (C, T), whether an IK run got within tolerance at all (C, T,
+    collisions aside), whether the target was tried; per feasible candidate its worst error as
+    a share of the tolerance (0: dead on, 1: at the edge) and the joint vectors that pass the
+    screen, best first."""
 
     feasible: np.ndarray
     score: np.ndarray
     closest: np.ndarray
     solutions: list[list[list[np.ndarray]]] = field(default_factory=list)
+    hit: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    tried: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    worst: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    reached: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (C, T): within tolerance, clear of the cell
 
 
 def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
@@ -65,16 +72,18 @@ def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
     return reach.Targets(tg.xyz[k], tg.R[k], tg.oriented[k], tg.tol_p[k], tg.tol_r[k], tg.names[k])
 
 
-def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray, seed: int) -> Screened:
+def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray, seed: int,
+                 g: Geometry | None = None) -> Screened:
     """Targets one at a time, farthest from the base first: a candidate leaves the batch at the
-    first target it cannot reach (most random twist settings miss the hardest one), so the rest
-    of the work is spent on candidates that may pass."""
+    first target it cannot reach (most twist settings miss the hardest one), so the rest of the
+    work is spent on candidates that may pass."""
     lib = spec.problem.cell.library
     assert lib is not None
-    types = [lib.units[k] for k in shape.kinds]
-    links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
-    tool = spec.problem.cell.tool
-    g = geometry(types, pivots, ports, links, tool.xyz, tool.rpy)
+    if g is None:
+        types = [lib.units[k] for k in shape.kinds]
+        links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
+        tool = spec.problem.cell.tool
+        g = geometry(types, pivots, ports, links, tool.xyz, tool.rpy)
     n, C = shape.n, len(pivots)
     tg = spec.targets
     T = len(tg.names)
@@ -82,36 +91,53 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     q0 = reach.seeds(n, SEEDS, lo, hi, seed)
     q = np.zeros((C, T, SEEDS, n))
     ep = np.full((C, T, SEEDS), np.inf)
+    ratio = np.full((C, T, SEEDS), np.inf)
     hit = np.zeros((C, T, SEEDS), bool)
+    ik_hit = np.zeros((C, T), bool)
+    tried = np.zeros((C, T), bool)
     live = np.arange(C)
     for t in np.argsort(-np.linalg.norm(tg.xyz, axis=1), kind="stable"):
         if live.size == 0:
             break
-        sub = Geometry(g.pre[live], g.post[live], g.t1, g.flange_tool)
-        qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0, lo, hi)
-        h = (ept <= tg.tol_p[t]) & (ert <= (tg.tol_r[t] if tg.oriented[t] else np.inf))
-        if h.any() and len(spec.obstacles.shape):
-            # only the runs that reached their target are worth a collision test
-            c, s_ = np.nonzero(h[:, 0])
-            one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
-            _, _, _, pts = forward(one, qt[c, 0, s_][:, None, None, :], points=True)
-            h[c, 0, s_] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
-        q[live, t], ep[live, t], hit[live, t] = qt[:, 0], ept[:, 0], h[:, 0]
-        live = live[h[:, 0].any(-1)]
+        tried[live, t] = True
+        # seeds one after the other: a candidate stops at its first run that reaches the target
+        # clear of the cell (whether any seed does is the same as running them all)
+        need = live
+        for s in range(SEEDS):
+            if need.size == 0:
+                break
+            sub = Geometry(g.pre[need], g.post[need], g.t1, g.flange_tool)
+            qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0[s:s + 1], lo, hi)
+            r = ept[:, 0, 0] / max(tg.tol_p[t], 1e-12)
+            if tg.oriented[t]:
+                r = np.maximum(r, ert[:, 0, 0] / max(tg.tol_r[t], 1e-12))
+            h = r <= 1.0
+            ik_hit[need, t] |= h
+            if h.any() and len(spec.obstacles.shape):
+                # only the runs that reached their target are worth a collision test
+                c = np.flatnonzero(h)
+                one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+                _, _, _, pts = forward(one, qt[c, 0, 0][:, None, None, :], points=True)
+                h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+            q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, 0], ept[:, 0, 0], h, r
+            need = need[~h]
+        live = live[hit[live, t].any(-1)]
     reached = hit.any(-1)  # (C, T)
     feasible = reached.all(-1)
     closest = ep.min(-1)
     # how far from feasible: metres missed on the targets tried, plus a metre per target not reached
     excess = np.where(np.isfinite(closest), np.maximum(closest - tg.tol_p[None], 0.0), 0.0)
     score = np.where(feasible, 0.0, excess.sum(-1) + (~reached).sum(-1) * 1.0)
-    sols = []
+    sols, worst = [], []
     for cand in np.flatnonzero(feasible):
         per_target = []
         for t in range(T):
-            order = np.argsort(ep[cand, t] + 1e3 * ~hit[cand, t], kind="stable")
+            order = np.argsort(ratio[cand, t] + 1e3 * ~hit[cand, t], kind="stable")
             per_target.append([q[cand, t, s] for s in order if hit[cand, t, s]])
         sols.append(per_target)
-    return Screened(np.asarray(feasible), np.asarray(score), closest, sols)
+        worst.append(max(float(ratio[cand, t][hit[cand, t]].min()) for t in range(T)))
+    return Screened(np.asarray(feasible), np.asarray(score), closest, sols, ik_hit, tried, np.asarray(worst, float),
+                    np.asarray(reached))
 
 
 @dataclass(frozen=True)

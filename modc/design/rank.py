@@ -2,7 +2,7 @@
 largest torque margin), then by the chain text, so that the order is total and reproducible."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from .evaluate import Candidate, Verified
 
@@ -11,6 +11,7 @@ from .evaluate import Candidate, Verified
 class Design:
     candidate: Candidate
     verified: Verified
+    alternatives: tuple[Design, ...] = ()  # the same arm with other H/L variants, best first
 
     @property
     def modules(self) -> int:
@@ -38,6 +39,20 @@ def key(objectives: tuple[str, ...], modules: int, mass: float, margin: float | 
 
 def order(designs: list[Design], objectives: tuple[str, ...]) -> list[Design]:
     return sorted(designs, key=lambda d: key(objectives, d.modules, d.mass, d.margin, d.chain()))
+
+
+def identity(d: Design) -> tuple:
+    """The arm's kinematics: its shape and twists (H and L units of one type share their geometry)."""
+    c = d.candidate
+    return (c.shape.kinds, c.shape.links, tuple(round(x, 9) for x in c.pivots), tuple(round(x, 9) for x in c.ports))
+
+
+def distinct(designs: list[Design], objectives: tuple[str, ...]) -> list[Design]:
+    """Ranked designs, one entry per kinematic arm: its variant swaps become its alternatives."""
+    groups: dict[tuple, list[Design]] = {}
+    for d in order(designs, objectives):
+        groups.setdefault(identity(d), []).append(d)
+    return [replace(g[0], alternatives=tuple(g[1:])) for g in groups.values()]
 
 
 def pareto(points: list[tuple[float, float]]) -> list[bool]:

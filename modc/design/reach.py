@@ -17,6 +17,7 @@ from .batch import Flat, Geometry, forward_flat, rotation_error
 ROTATION_WEIGHT = 0.2  # m/rad: 1° of orientation error costs as much as 3.5 mm
 ITERATIONS = 40
 LAMBDA0 = 1e-2
+STALL_EVERY, STALL_GAIN, STALL_FACTOR = 5, 0.5, 3.0
 
 
 @dataclass(frozen=True)
@@ -100,6 +101,10 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     runs = _Runs(tg, t_idx)
     # runs go on well inside the tolerances (LM converges quadratically there): reported errors are ~0
     tol_p, tol_r = np.full(B, 1e-7), np.full(B, 1e-6)
+    # a run still STALL_FACTOR tolerances off that has not cut its cost by STALL_GAIN in STALL_EVERY
+    # iterations leaves: the screen is a local search, and such runs end beyond the tolerance
+    give_up = np.asarray(tg.tol_p, float)[t_idx] * STALL_FACTOR
+    ref = np.full(B, np.inf)
     p, z, R_tool, t_tool = forward_flat(f, q)
     e_p, e_r = runs.residual(R_tool, t_tool)
     cost = (e_p ** 2).sum(0) + w * w * (e_r ** 2).sum(0)
@@ -107,11 +112,15 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     for it in range(iterations + 1):
         ep, er = np.sqrt((e_p ** 2).sum(0)), np.sqrt((e_r ** 2).sum(0))
         active = ((ep > tol_p) | (er > tol_r)) & (lam < 1e4) & (it < iterations)
+        if it % STALL_EVERY == 0:
+            if it >= 2 * STALL_EVERY:
+                active &= ~((cost > STALL_GAIN * ref) & (ep > give_up))
+            ref = cost.copy()
         if active.sum() < 0.8 * active.size or not active.any():  # compaction costs: do it in steps
             gone = ~active
             q_all[:, live[gone]], ep_all[live[gone]], er_all[live[gone]] = q[:, gone], ep[gone], er[gone]
             live, q, f, runs = live[active], q[:, active], f.take(active), runs.take(active)
-            tol_p, tol_r = tol_p[active], tol_r[active]
+            tol_p, tol_r, give_up, ref = tol_p[active], tol_r[active], give_up[active], ref[active]
             p, z, t_tool, e_p, e_r = p[..., active], z[..., active], t_tool[:, active], e_p[:, active], e_r[:, active]
             cost, lam = cost[active], lam[active]
             active = active[active]

@@ -48,12 +48,23 @@ def _svg(o: Outcome) -> str:
 
 def _table(o: Outcome) -> str:
     rows = ["<tr><th>rank</th><th>chain</th><th>modules</th><th>mass (kg)</th><th>torque margin</th>"
-            "<th>worst target error</th></tr>"]
+            "<th>worst target error</th><th>alternatives (other H/L variants)</th></tr>"]
     for rank, d in enumerate(o.designs, start=1):
         worst = max(t["position_error_m"] for t in d.verified.targets.values())
         rows.append(f"<tr><td>{rank}</td><td><code>{escape(d.chain())}</code></td><td>{d.modules}</td>"
-                    f"<td>{d.mass:.3f}</td><td>{d.margin * 100:.0f} %</td><td>{worst * 1000:.3g} mm</td></tr>")
+                    f"<td>{d.mass:.3f}</td><td>{d.margin * 100:.0f} %</td><td>{worst * 1000:.3g} mm</td>"
+                    f"<td>{'<br>'.join(f'<code>{escape(x.chain())}</code> ({x.mass:.3f} kg)' for x in d.alternatives)}"
+                    "</td></tr>")
     return "<table>" + "".join(rows) + "</table>"
+
+
+def _coverage(o: Outcome) -> str:
+    if o.stopped:
+        return (f"Not complete: the search stopped ({o.stopped}) with {len(o.unfinished)} shapes not finished; "
+                "a better design may exist.")
+    if o.coarse:
+        return f"Not complete: {len(o.coarse)} shapes too large to enumerate were searched on a coarse twist grid."
+    return "Complete within the bounds: every twist setting of every shape was screened or excluded by a sound bound."
 
 
 def report_html(outcomes: list[Outcome], renders: dict[str, bytes]) -> str:
@@ -62,7 +73,8 @@ def report_html(outcomes: list[Outcome], renders: dict[str, bytes]) -> str:
         name = escape(o.problem.name)
         body.append(f"<h2>design {name}</h2>")
         body.append(f"<p>{len(o.designs)} designs; {o.evaluated:,} twist settings screened over {o.shapes} shapes "
-                    f"in {o.seconds:.1f} s. Ranked by {escape(', '.join(o.problem.rank))}.</p>")
+                    f"in {o.seconds:.1f} s ({o.excluded:,} excluded by sound bounds). "
+                    f"Ranked by {escape(', '.join(o.problem.rank))}. {escape(_coverage(o))}</p>")
         body.append(_table(o))
         body.append("<h3>Pareto plot</h3><p>Red: no other design is both lighter and has more torque margin.</p>")
         body.append(_svg(o))

@@ -1,9 +1,10 @@
-"""The search, end to end: shapes by number of units, the twist search per shape (on any
-concurrent.futures executor), variant splits re-weighed, exact checks in ranking order.
+"""The search, end to end: shapes by number of units, the twist search of each shape in ranges
+of its settings (on any concurrent.futures executor), variant splits re-weighed, exact checks in
+ranking order, with a time budget, Ctrl-C and progress.
 
-Work goes to the executor in chunks of shapes (each a second or so of numpy); results come back
-in submission order and every chunk is a pure function of its inputs, so the ranking is the
-same for one process, a local pool or a Dask cluster.
+Work goes to the executor as ranges of one shape's settings (search.WORK); results are merged
+per shape in submission order and every range is a pure function of its inputs, so the ranking
+is the same for one process, a local pool or a Dask cluster.
 """
 from __future__ import annotations
 
@@ -17,15 +18,28 @@ import numpy as np
 
 from ..model import Problem
 from . import space
-from .evaluate import Candidate, Spec, verify
-from .rank import Design, key, order
-from .screen import reach_bound, static_torques
-from .search import ShapeResult, search_chunk
+from .bounds import blocked as bounds_blocked
+from .diagnose import diagnose, why_none
+from .evaluate import Spec
+from .rank import Design, distinct, key
+from .screen import reach_bound
+from .search import STOP, TICK, Part, ShapeResult, merge, parts_of, search_chunk, size
+from .verify_order import Verifier
 
-CHUNK = 1  # shapes per unit of work (a shape's search is 0.1-2 s of numpy)
-ROUND = 8  # shapes searched between two rounds of exact checks
-TRIES = 3  # twist settings verified per chain before giving up on it
-VERIFY_FACTOR = 4  # at most this many exact checks per design asked for, per number of units
+ROUND = 16  # shapes in a tier's first round of search between exact checks; rounds double up to ROUND_MAX
+ROUND_MAX = 512  # (sizes independent of the workers: where the search stops does not depend on them)
+
+
+@dataclass
+class Status:
+    """What the progress display shows."""
+
+    shapes_done: int
+    shapes_total: int
+    screened: int  # settings screened or excluded so far
+    feasible: int  # chains the screens passed
+    best: str
+    eta: float | None  # seconds, None while unknown
 
 
 @dataclass
@@ -38,24 +52,18 @@ class Outcome:
     closest: dict[str, float] = field(default_factory=dict)  # per target, m (0: reached by some design)
     screened: int = 0  # chains that passed the screen
     rejections: list[str] = field(default_factory=list)  # why exact checks failed, in order
+    excluded: int = 0  # settings ruled out by a sound bound
+    complete: bool = True  # every setting of every shape in the bounds screened or excluded
+    stopped: str | None = None  # "time budget" or "interrupted"
+    unfinished: list[str] = field(default_factory=list)  # shapes whose search did not run to the end
+    coarse: list[str] = field(default_factory=list)  # shapes searched on a coarse grid
+    targets: dict[str, dict] = field(default_factory=dict)  # per target: hit, clear, closest, excluded_by
 
     def why_none(self) -> str:
-        far = {t: d for t, d in self.closest.items() if d > 0}
-        if far:
-            name = max(far, key=lambda t: far[t])
-            if not math.isfinite(far[name]):  # closest starts at inf: never print it
-                return f"target '{name}': no design was measured against it"
-            return f"target '{name}': no design gets closer than {_length(far[name])}"
-        if self.rejections:
-            return (f"{len(self.rejections)} chains reach every target, but none passes the checks "
-                    f"(first: {self.rejections[0]})")
-        return "every target can be reached alone, but no chain reaches all of them without touching the cell"
+        return why_none(self)
 
 
-def _length(x: float) -> str:
-    from ..model.quantities import distance
-
-    return distance(x)
+_UNIT_MASS: dict[tuple, float] = {}  # (library, variant, kind, link) -> kg: thousands of shapes share a few units
 
 
 def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> float:
@@ -65,18 +73,12 @@ def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> fl
     assert lib is not None
     total = 0.0
     for v, k, x in zip(variants, shape.kinds, shape.links, strict=True):
-        total += unit_mass(lib, v, k, (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0)
+        link = (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0
+        key_ = (id(lib), v, k, link)
+        if key_ not in _UNIT_MASS:
+            _UNIT_MASS[key_] = unit_mass(lib, v, k, link)
+        total += _UNIT_MASS[key_]
     return total
-
-
-def _chunks(items: list, size: int) -> list[list]:
-    return [items[i:i + size] for i in range(0, len(items), size)]
-
-
-def _map(executor: Executor | None, spec: Spec, chunks: list, seed: int):
-    if executor is None:
-        return (search_chunk(spec, c, seed) for c in chunks)
-    return executor.map(search_chunk, [spec] * len(chunks), chunks, [seed] * len(chunks))
 
 
 def _min_mass(problem: Problem, shape: space.Shape, splits) -> float:
@@ -85,24 +87,68 @@ def _min_mass(problem: Problem, shape: space.Shape, splits) -> float:
     return min(masses, default=float("inf"))
 
 
-def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
-           executor: Executor | None = None, progress: Callable[[int, int, str], None] | None = None) -> Outcome:
-    """Ranked designs for a checked problem (its library resolved).
+def _rounds(items: list) -> list[list]:
+    """ROUND items, then twice as many, … up to ROUND_MAX: few shapes searched past the first
+    designs on small cells, and enough units of work in flight to keep many workers busy on a
+    large tier (4,096 six-unit shapes: rounds of 512)."""
+    out, i, k = [], 0, ROUND
+    while i < len(items):
+        out.append(items[i:i + k])
+        i, k = i + k, min(2 * k, ROUND_MAX)
+    return out
 
-    With the default objectives (fewest modules first), chains are searched by number of units,
-    and within one number lightest shape first, ROUND shapes at a time: the search stops as soon
-    as `top` designs are checked that no unsearched shape could beat. ROUND does not depend on
-    the number of workers, so neither does where the search stops."""
-    t0 = time.perf_counter()
-    spec = Spec.of(problem)
+
+def _stopping(deadline: float | None) -> str | None:
+    if STOP.is_set():
+        return "interrupted"
+    if deadline is not None and time.time() > deadline:
+        return "time budget"
+    return None
+
+
+def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, deadline: float | None,
+               each: Callable[[Part], None], tick: Callable[[], None]) -> None:
+    """Every range of work, its Part handed to each() in submission order; stops early (the
+    rest unsearched) on Ctrl-C or at the deadline."""
+    if executor is None:
+        TICK.append(tick)
+        try:
+            for w in work:
+                if _stopping(deadline):
+                    return
+                for p in search_chunk(spec, [w], seed, deadline):
+                    each(p)
+        finally:
+            TICK.remove(tick)
+        return
+    futures = [executor.submit(search_chunk, spec, [w], seed, deadline) for w in work]
+    try:
+        for f in futures:
+            while True:
+                if _stopping(deadline) == "interrupted":
+                    return
+                try:
+                    parts = f.result(timeout=0.2)
+                    break
+                except TimeoutError:
+                    tick()
+            for p in parts:
+                each(p)
+    finally:
+        for f in futures:
+            f.cancel()
+
+
+def _longest(problem: Problem, n: int) -> list[space.Shape]:
+    """The shapes of n units with the longest links allowed (the reach bound grows with them)."""
+    if not space.variant_splits(problem, n):
+        return []
+    return space.shapes(problem, n)
+
+
+def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float]) -> list:
     lib = problem.cell.library
     assert lib is not None
-    out = Outcome(problem, [])
-    hi = min(max_units or problem.max_units, lib.rules.max_dof)
-    names = [t.name for t in problem.cell.targets]
-    closest = {t: np.inf for t in names}
-    far = max((float(np.linalg.norm(t.xyz)) - t.position_tolerance for t in problem.cell.targets), default=0.0)
-    early = problem.rank[:2] == ("modules", "mass")
     tiers = []
     for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
         splits = space.variant_splits(problem, n)
@@ -112,116 +158,137 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
         for s in space.shapes(problem, n):
             lengths = [x or lib.units[k].x23 for k, x in zip(s.kinds, s.links, strict=True)]
             r = reach_bound([lib.units[k] for k in s.kinds], lengths, problem.cell.tool.xyz)
-            if r < far:  # a target beyond any pose of this shape: no IK needed
-                for t in problem.cell.targets:
-                    closest[t.name] = min(closest[t.name], max(float(np.linalg.norm(t.xyz)) - r, 0.0))
+            gaps = [float(np.linalg.norm(t.xyz)) - r - t.position_tolerance for t in problem.cell.targets]
+            for t, g in zip(problem.cell.targets, gaps, strict=True):
+                closest[t.name] = min(closest[t.name], max(g + t.position_tolerance, 0.0))
+            if max(gaps, default=-1.0) > 0:  # a target beyond any pose of this shape: no IK needed
                 continue
             shapes.append((_min_mass(problem, s, splits), s.label(), s))
         shapes.sort(key=lambda e: e[:2])
         tiers.append((n, splits, shapes))
-    tally = _Verifier(problem, top, out)
-    best = ""
+    return tiers
+
+
+def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
+           executor: Executor | None = None, progress: Callable[..., None] | None = None,
+           deadline: float | None = None) -> Outcome:
+    """Ranked designs for a checked problem (its library resolved).
+
+    With the default objectives (fewest modules first), chains are searched by number of units,
+    and within one number lightest shape first, ROUND shapes at a time: the search stops as soon
+    as `top` kinematically distinct designs are checked that no unsearched shape could beat.
+    ROUND does not depend on the number of workers, so neither does where the search stops.
+    deadline (time.time()) and search.STOP end it early with what was found."""
+    t0 = time.perf_counter()
+    spec = Spec.of(problem)
+    lib = problem.cell.library
+    assert lib is not None
+    out = Outcome(problem, [])
+    hi = min(max_units or problem.max_units, lib.rules.max_dof)
+    names = [t.name for t in problem.cell.targets]
+    closest = {t: np.inf for t in names}
+    hit = dict.fromkeys(names, False)
+    clear = dict.fromkeys(names, False)
+    tg = spec.targets
+    longest = max((reach_bound([lib.units[k] for k in s.kinds], [x or lib.units[k].x23 for k, x in
+                                zip(s.kinds, s.links, strict=True)], problem.cell.tool.xyz)
+                   for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
+                   for s in _longest(problem, n)), default=0.0)
+    starts = np.array([(u.x01, 0.0, u.z01) for u in lib.units.values()], float)
+    blocked, walls = bounds_blocked(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(problem.cell.tool.xyz)),
+                                    float(spec.radii.min()), longest, starts)
+    tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest)
+    total_shapes = sum(len(s) for _, _, s in tiers)
+    total_settings = sum(size(spec, s) for _, _, shapes in tiers for _, _, s in shapes)
+    early = problem.rank[:2] == ("modules", "mass")
+    tally = Verifier(problem, top, out, _mass)
+    state: dict = {"done": 0, "settings": 0, "best": ""}
+
+    def report(force: bool = False, final: bool = False) -> None:
+        if progress is None:
+            return
+        spent = time.perf_counter() - t0
+        # the share of every shape's settings done: an upper bound on what is left (the search
+        # may stop early once the top designs are found)
+        frac = state["settings"] / max(total_settings, 1)
+        eta = 0.0 if final else spent * (1 - frac) / frac if frac > 0.01 else None
+        status = Status(state["done"], total_shapes, out.evaluated, out.screened, state["best"], eta)
+        if force:
+            progress(status, True)
+        else:
+            progress(status)
+
+    searched: list[ShapeResult] = []
+    report(force=True)
     for n, splits, shapes in tiers:
-        rounds = _chunks(shapes, ROUND) if early else [shapes]
+        rounds = _rounds(shapes) if early else [shapes]
         for k, batch in enumerate(rounds):
-            out.shapes += len(batch)
-            for chunk in _map(executor, spec, _chunks([s for _, _, s in batch], CHUNK), seed):
-                for res in chunk:
-                    out.evaluated += res.evaluated
-                    for name, c in zip(names, res.closest, strict=True):
-                        closest[name] = min(closest[name], c)
-                    if res.found and not best:
-                        best = f"shape {res.shape.label()} (unchecked)"
+            work = [(s, lo, hi_) for _, _, s in batch for lo, hi_ in parts_of(spec, s)]
+            pending: dict[str, list[Part]] = {}
+            expected = {s.label(): len(parts_of(spec, s)) for _, _, s in batch}
+
+            def each(p: Part, n=n, splits=splits, pending=pending, expected=expected) -> None:
+                out.evaluated += p.screened + p.excluded
+                state["settings"] += p.upto - p.lo
+                pending.setdefault(p.shape.label(), []).append(p)
+                if len(pending[p.shape.label()]) == expected[p.shape.label()]:
+                    res = merge(spec, p.shape, pending.pop(p.shape.label()))
+                    _absorb(out, res, names, closest, hit, clear, searched)
+                    state["done"] += 1
                     tally.add(n, splits, res)
-                if progress is not None:
-                    progress(out.evaluated, out.shapes, best)
-            # designs no unsearched shape of this size can undercut are final
-            nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) else float("inf")
+                    if res.found and not state["best"]:
+                        state["best"] = f"shape {res.shape.label()} (unchecked)"
+                report()
+
+            out.shapes += len(batch)
+            _run_parts(executor, spec, work, seed, deadline, each, report)
+            for ps in pending.values():  # shapes cut short: what their finished ranges found
+                res = merge(spec, ps[0].shape, ps)
+                _absorb(out, res, names, closest, hit, clear, searched)
+                tally.add(n, splits, res)
+            stop = _stopping(deadline)
+            nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) and not stop else float("inf")
             tally.settle(n, nxt)
             if tally.accepted:
-                best = order(tally.accepted, problem.rank)[0].chain()
-                if progress is not None:
-                    progress(out.evaluated, out.shapes, best)
+                state["best"] = distinct(tally.accepted, problem.rank)[0].chain()
+                report()
+            if stop:
+                out.stopped = stop
+                break
             if early and tally.done(n, nxt):
                 break
+        if out.stopped:
+            break
         if not early:
             continue
         tally.settle(n, float("inf"))
-        if len(tally.accepted) >= top:
+        if tally.distinct_count() >= top:
             break
     tally.settle(hi, float("inf"))
-    out.closest = {t: (0.0 if c <= tp else float(c)) for (t, c), tp in
-                   zip(closest.items(), (t.position_tolerance for t in problem.cell.targets), strict=True)}
-    out.designs = order(tally.accepted, problem.rank)[:top]
+    done = {r.shape.label() for r in searched if r.finished}
+    if out.stopped:
+        out.unfinished = [s.label() for _, _, shapes in tiers for _, _, s in shapes if s.label() not in done]
+    else:
+        out.unfinished = [r.shape.label() for r in searched if not r.finished]
+    out.coarse = [r.shape.label() for r in searched if r.finished and not r.complete]
+    out.complete = not out.unfinished and not out.coarse
+    out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
+    out.designs = [tally.swaps(d) for d in distinct(tally.accepted, problem.rank)[:top]]
+    if not out.designs:
+        out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0
+    state["done"] = total_shapes - len(out.unfinished)
+    report(force=True, final=True)
     return out
 
 
-class _Verifier:
-    """Exact checks in ranking order of what the screen passed: a chain is checked once every
-    chain that could rank before it has been found (settle), until `top` pass."""
+def _absorb(out: Outcome, res: ShapeResult, names, closest, hit, clear, searched) -> None:
+    out.excluded += res.excluded
+    searched.append(res)
+    for i, name in enumerate(names):
+        closest[name] = min(closest[name], res.closest[i])
+        hit[name] = hit[name] or res.hit[i]
+        clear[name] = clear[name] or res.clear[i]
 
-    def __init__(self, problem: Problem, top: int, out: Outcome):
-        self.problem, self.top, self.out = problem, top, out
-        self.pending: list[tuple] = []
-        self.accepted: list[Design] = []
-        self.keys: list[tuple] = []
-        self.checks = 0
 
-    def add(self, n: int, splits, res: ShapeResult) -> None:
-        if not res.found:
-            return
-        p = self.problem
-        for variants in splits:
-            if not all(space.allowed(p, v, k) for v, k in zip(variants, res.shape.kinds, strict=True)):
-                continue
-            found = tuple(f for f in res.found if self._holds(res, variants, f))
-            if not found:
-                continue
-            mass = _mass(p, res.shape, variants)
-            chain = "-".join(f"{v}{k}" for v, k in zip(variants, res.shape.kinds, strict=True)) + res.shape.label()
-            kept = ShapeResult(res.shape, found, res.evaluated, res.closest, res.best_score)
-            self.pending.append((key(p.rank, n, mass, None, chain), n, mass, kept, variants))
-            self.out.screened += 1
-
-    def _holds(self, res: ShapeResult, variants, f) -> bool:
-        """The static torque screen: gravity torques at the poses found for the targets (inside the
-        limits, so no more than the worst case) within every actuator's peak."""
-        from .evaluate import robot_for
-
-        lib = self.problem.cell.library
-        assert lib is not None
-        cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
-        robot = robot_for(self.problem, cand, {}, self.problem.name)
-        tau = static_torques(robot, [sols[0] for sols in f.solutions])
-        peak = np.array([lib.variants[v].actuator.torque_peak for v in variants])
-        if np.all(tau <= peak):
-            return True
-        self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: over peak torque at a target pose")
-        return False
-
-    def done(self, n: int, next_mass: float) -> bool:
-        """top designs found that rank before anything of n units not yet searched."""
-        ahead = [k for k in self.keys if k[0] < n or (k[0] == n and k[1] < next_mass)]
-        return len(ahead) >= self.top
-
-    def settle(self, n: int, below: float) -> None:
-        """Check the pending chains of up to n units lighter than `below`, best first."""
-        ready = sorted((e for e in self.pending if e[1] < n or (e[1] == n and e[2] < below)), key=lambda e: e[0])
-        self.pending = [e for e in self.pending if not (e[1] < n or (e[1] == n and e[2] < below))]
-        for k, _n, _mass, res, variants in ready:
-            better = sorted(self.keys)[: self.top]
-            if len(better) >= self.top and k[:2] > better[-1][:2]:
-                break  # ranks behind top designs already checked (equal keys still compete on margin)
-            if self.checks >= VERIFY_FACTOR * self.top * 4:
-                break
-            for f in res.found[:TRIES]:
-                cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
-                self.checks += 1
-                v = verify(self.problem, cand)
-                if isinstance(v, str):
-                    self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: {v}")
-                    continue
-                self.accepted.append(Design(cand, v))
-                self.keys.append(k)
-                break
+__all__ = ["Outcome", "Status", "design", "key"]

@@ -1,31 +1,42 @@
-"""The twist search for one shape: which pivot and port settings let the arm do every task.
+"""The twist search of one shape: every pivot and port setting, in blocks.
 
-Small spaces are enumerated exhaustively. Larger ones are searched with CMA-ES (the `cma`
-package) over the twist indices: the screen's score (how far the closest IK runs end from their
-targets, plus a penalty per target reached only in collision) is smooth enough in the twist
-angles for a covariance-adapting search to descend it, CMA-ES needs no gradient and no tuning
-beyond a budget, and with its seed fixed it is deterministic. (pymoo/optuna would add a
-dependency for the same single-objective, small-dimensional problem: the ranking objectives
-are handled exactly by the enumeration of shapes, not by the optimiser.)
+Complete within its bounds: every setting of a shape with up to COMPLETE settings is either
+screened (batched IK per target within the joint limits, then the obstacle screen) or excluded
+by a sound bound (modc.design.bounds: no joint vector, limits or not, brings tool0 within
+tolerance of some target). Exact reductions (modc.design.space) remove settings that cannot
+change tool0. A shape with more settings than that (4 or more units with links) is searched on
+a deterministic coarse grid of its twists and reported as not complete.
 
-Everything here is a function of (spec, shape, seed): the same inputs give the same answer in any
-process, which makes the result independent of the number of workers.
+A shape's settings are numbered (first unit outermost); a unit of work is a range of those
+numbers (WORK settings), so a large shape spreads over many workers. Everything here is a
+function of (spec, shape, range, seed): the same inputs give the same answer in any process.
+Within a shape the settings are ordered by how deep inside the tolerances their worst target
+lies, then simplest twists first.
 """
 from __future__ import annotations
 
-import itertools
+import functools
+import math
+import threading
+import time
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import bounds
+from .batch import geometry
 from .evaluate import Spec, screen_batch
 from .space import Shape, port_free, twist_values
 
-EXHAUSTIVE = 1536  # twist settings enumerated outright up to this many
-BUDGET = 1024  # CMA-ES evaluations per shape beyond that
-BATCH = 512  # candidates screened together (numpy amortisation)
-KEEP = 6  # feasible twist settings kept per shape (simplest first)
+COMPLETE = 2_000_000  # settings of a shape searched in full up to this many
+COARSE = 2048  # settings on the coarse grid of a larger shape
+BLOCK = 4096  # settings screened together (numpy amortisation)
+WORK = 65536  # settings per unit of work
+KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
+
+STOP = threading.Event()  # set by Ctrl-C in this process: blocks end at the next boundary
+TICK: list = []  # callbacks after each block, in this process only (the progress display's heartbeat)
 
 
 @dataclass(frozen=True)
@@ -33,15 +44,40 @@ class Found:
     pivots: tuple[float, ...]
     ports: tuple[float, ...]
     solutions: tuple[tuple[tuple[float, ...], ...], ...]  # per target, joint vectors passing the screen
+    worst: float = 0.0  # the worst target's error as a share of its tolerance
 
 
 @dataclass(frozen=True)
+class Part:
+    """What one unit of work found: a range [lo, hi) of a shape's settings, done up to `upto`."""
+
+    shape: Shape
+    lo: int
+    hi: int
+    upto: int
+    found: tuple[Found, ...]
+    screened: int  # settings that went through the IK screen
+    excluded: int  # settings ruled out by a sound bound
+    closest: tuple[float, ...]  # per target, m (inf: never tried)
+    hit: tuple[bool, ...]  # per target: some IK run within tolerance (collisions aside)
+    clear: tuple[bool, ...]  # per target: reached without touching the cell
+
+
+@dataclass
 class ShapeResult:
     shape: Shape
     found: tuple[Found, ...]
-    evaluated: int
-    closest: tuple[float, ...]  # per target: the smallest position error any setting reached, m
+    evaluated: int  # screened + excluded
+    closest: tuple[float, ...]
     best_score: float
+    screened: int = 0
+    excluded: int = 0
+    total: int = 0  # settings of the shape (on the coarse grid when not complete)
+    complete: bool = True  # every setting screened or excluded
+    finished: bool = True  # the search of its settings ran to the end (no budget stop)
+    hit: tuple[bool, ...] = ()
+    clear: tuple[bool, ...] = ()
+    parts: list[Part] = field(default_factory=list)
 
 
 def shape_seed(seed: int, shape: Shape) -> int:
@@ -55,79 +91,134 @@ def _complexity(pivots, ports) -> tuple:
             tuple(round(float(v), 9) for v in vals))
 
 
-class _Tally:
-    def __init__(self, T: int):
-        self.found: dict[tuple, Found] = {}
-        self.evaluated = 0
-        self.closest = np.full(T, np.inf)
-        self.best = np.inf
-
-    def add(self, spec: Spec, shape: Shape, piv: np.ndarray, por: np.ndarray, seed: int) -> np.ndarray:
-        s = screen_batch(spec, shape, piv, por, seed)
-        self.evaluated += len(piv)
-        self.closest = np.minimum(self.closest, s.closest.min(0))  # inf where no candidate got that far
-        self.best = min(self.best, float(s.score.min()))
-        for k, c in enumerate(np.flatnonzero(s.feasible)):
-            key = (tuple(float(x) for x in piv[c]), tuple(float(x) for x in por[c]))
-            if key not in self.found:
-                sols = tuple(tuple(tuple(float(x) for x in q) for q in per) for per in s.solutions[k])
-                self.found[key] = Found(key[0], key[1], sols)
-        return s.score
-
-    def result(self, shape: Shape) -> ShapeResult:
-        found = sorted(self.found.values(), key=lambda f: _complexity(np.array(f.pivots), np.array(f.ports)))
-        return ShapeResult(shape, tuple(found[:KEEP]), self.evaluated, tuple(float(x) for x in self.closest), self.best)
+def order_key(f: Found) -> tuple:
+    """Deepest inside the tolerances first (to 1 % of a tolerance: IK runs end ~1e-7 m off a
+    reachable target, and such differences mean nothing), then simplest."""
+    return (round(f.worst, 2), *_complexity(np.array(f.pivots), np.array(f.ports)))
 
 
-def search_shape(spec: Spec, shape: Shape, seed: int) -> ShapeResult:
+def _coarse_index(count: int, i0: int, stride: int) -> list[int]:
+    """Every stride-th index counted from i0 (the value nearest 0 stays in)."""
+    return [i for i in range(count) if (i - i0) % stride == 0]
+
+
+def axes(spec: Spec, shape: Shape) -> tuple[list[np.ndarray], list[int], bool]:
+    """The twist values per variable (each pivot, then each port that matters), the positions of
+    those ports, and whether the grid is complete."""
     lib = spec.problem.cell.library
     assert lib is not None
     pivot_set, port_set = twist_values(lib.twists.pivot), twist_values(lib.twists.port)
     free = port_free(spec.problem, shape, lib)
-    # one variable per pivot and per port that matters
-    axes = [pivot_set] * shape.n + [port_set for f in free if f]
     where = [i for i, f in enumerate(free) if f]
-    n = shape.n
-    tally = _Tally(len(spec.targets.names))
+    out = [pivot_set] * shape.n + [port_set] * len(where)
+    if int(np.prod([len(a) for a in out], dtype=float)) <= COMPLETE:
+        return out, where, True
+    zero = [int(np.argmin(np.abs(a))) for a in out]
+    strides = _strides(tuple(len(a) for a in out), tuple(zero))
+    return [a[_coarse_index(len(a), z, s)] for a, z, s in zip(out, zero, strides, strict=True)], where, False
+
+
+@functools.lru_cache(maxsize=256)
+def _strides(lengths: tuple[int, ...], zero: tuple[int, ...]) -> tuple[int, ...]:
+    """Strides that thin the axes evenly (the longest first) until at most COARSE settings remain."""
+    strides = [1] * len(lengths)
+
+    def count(j: int) -> int:
+        return (lengths[j] - 1 - zero[j] % strides[j]) // strides[j] + 1
+
+    while math.prod(count(j) for j in range(len(lengths))) > COARSE:
+        k = max(range(len(lengths)), key=lambda j: (count(j), -j))
+        strides[k] += 1
+    return tuple(strides)
+
+
+def size(spec: Spec, shape: Shape) -> int:
+    return int(np.prod([len(a) for a in axes(spec, shape)[0]]))
+
+
+def _settings(ax: list[np.ndarray], where: list[int], n: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
+    idx = np.unravel_index(np.arange(lo, hi), [len(a) for a in ax])
+    values = np.stack([a[i] for a, i in zip(ax, idx, strict=True)], -1).reshape(hi - lo, len(ax))
+    pivots = values[:, :n]
+    ports = np.zeros((hi - lo, n))
+    ports[:, where] = values[:, n:]
+    return pivots, ports
+
+
+def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline: float | None = None) -> Part:
+    """Screen settings lo … hi-1 of a shape, BLOCK at a time, until done or the deadline (time.time())."""
+    lib = spec.problem.cell.library
+    assert lib is not None
+    ax, where, _ = axes(spec, shape)
+    types = [lib.units[k] for k in shape.kinds]
+    links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
+    tool = spec.problem.cell.tool
+    tg = spec.targets
+    T = len(tg.names)
     s0 = shape_seed(seed, shape)
-
-    def split(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        piv = values[:, :n]
-        por = np.zeros((len(values), n))
-        por[:, where] = values[:, n:]
-        return piv, por
-
-    size = int(np.prod([len(a) for a in axes]))
-    if size <= EXHAUSTIVE:
-        grid = np.array(list(itertools.product(*axes)), float).reshape(-1, len(axes))
-        for lo in range(0, len(grid), BATCH):
-            tally.add(spec, shape, *split(grid[lo:lo + BATCH]), s0)
-        return tally.result(shape)
-
-    import warnings
-
-    with warnings.catch_warnings():  # cma warns that matplotlib (for its plots) is missing
-        warnings.simplefilter("ignore")
-        import cma
-
-    dims = np.array([len(a) for a in axes], float)
-    # CMA-ES draws from its own generator: numpy's global one is shared by the threads of a Dask
-    # worker, and drawing from it would make results depend on how shapes interleave
-    rng = np.random.default_rng(s0)
-    x0 = np.array([float(np.argmin(np.abs(a))) + 0.5 for a in axes])  # every twist at 0
-    opts = {"bounds": [np.zeros_like(dims).tolist(), (dims - 1e-9).tolist()], "verbose": -9,
-            "popsize": 64, "maxfevals": BUDGET, "CMA_stds": (dims / 4).tolist(), "tolfun": 0, "tolx": 1e-3,
-            "randn": lambda *shape: rng.standard_normal(shape)}
-    es = cma.CMAEvolutionStrategy(x0.tolist(), 1.0, opts)
-    while not es.stop() and tally.evaluated < BUDGET and len(tally.found) < KEEP * 2:
-        xs = es.ask()
-        idx = np.clip(np.floor(np.array(xs)), 0, dims - 1).astype(int)
-        values = np.array([[axes[j][i] for j, i in enumerate(row)] for row in idx])
-        scores = tally.add(spec, shape, *split(values), s0)
-        es.tell(xs, (scores + 1e-6 * np.abs(values).sum(1)).tolist())
-    return tally.result(shape)
+    found: list[Found] = []
+    closest = np.full(T, np.inf)
+    hit, clear = np.zeros(T, bool), np.zeros(T, bool)
+    screened = excluded = 0
+    upto = lo
+    for start in range(lo, hi, BLOCK):
+        if STOP.is_set() or (deadline is not None and time.time() > deadline):
+            break
+        end = min(start + BLOCK, hi)
+        piv, por = _settings(ax, where, shape.n, start, end)
+        g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
+        ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
+        excluded += int((~ok).sum())
+        upto = end
+        for tick in TICK:
+            tick()
+        if not ok.any():
+            continue
+        k = np.flatnonzero(ok)
+        sub = type(g)(g.pre[k], g.post[k], g.t1, g.flange_tool)
+        s = screen_batch(spec, shape, piv[k], por[k], s0, g=sub)
+        screened += len(k)
+        closest = np.minimum(closest, s.closest.min(0))
+        hit |= s.hit.any(0)
+        clear |= s.reached.any(0)
+        for j, c in enumerate(np.flatnonzero(s.feasible)):
+            sols = tuple(tuple(tuple(float(x) for x in q) for q in per) for per in s.solutions[j])
+            found.append(Found(tuple(float(x) for x in piv[k[c]]), tuple(float(x) for x in por[k[c]]), sols,
+                               float(s.worst[j])))
+        found = sorted(found, key=order_key)[:KEEP]
+    return Part(shape, lo, hi, upto, tuple(found), screened, excluded, tuple(float(x) for x in closest),
+                tuple(bool(x) for x in hit), tuple(bool(x) for x in clear))
 
 
-def search_chunk(spec: Spec, shapes: list[Shape], seed: int) -> list[ShapeResult]:
-    """A worker's unit of work: several shapes, searched one after the other."""
-    return [search_shape(spec, s, seed) for s in shapes]
+def parts_of(spec: Spec, shape: Shape) -> list[tuple[int, int]]:
+    total = size(spec, shape)
+    return [(lo, min(lo + WORK, total)) for lo in range(0, total, WORK)]
+
+
+def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
+    """One shape's result from its parts (in any order: the merge sorts)."""
+    T = len(spec.targets.names)
+    found = sorted((f for p in parts for f in p.found), key=order_key)[:KEEP]
+    closest = np.full(T, np.inf)
+    hit, clear = np.zeros(T, bool), np.zeros(T, bool)
+    for p in parts:
+        closest = np.minimum(closest, p.closest)
+        hit |= np.array(p.hit, bool)
+        clear |= np.array(p.clear, bool)
+    screened = sum(p.screened for p in parts)
+    excluded = sum(p.excluded for p in parts)
+    finished = all(p.upto >= p.hi for p in parts) and len(parts) == len(parts_of(spec, shape))
+    complete = axes(spec, shape)[2] and finished
+    return ShapeResult(shape, tuple(found), screened + excluded, tuple(float(x) for x in closest),
+                       0.0 if found else 1.0, screened, excluded, size(spec, shape), complete, finished,
+                       tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), list(parts))
+
+
+def search_shape(spec: Spec, shape: Shape, seed: int, deadline: float | None = None) -> ShapeResult:
+    return merge(spec, shape, [search_part(spec, shape, lo, hi, seed, deadline) for lo, hi in parts_of(spec, shape)])
+
+
+def search_chunk(spec: Spec, work: list[tuple[Shape, int, int]], seed: int,
+                 deadline: float | None = None) -> list[Part]:
+    """A worker's unit of work: ranges of shapes' settings, one after the other."""
+    return [search_part(spec, s, lo, hi, seed, deadline) for s, lo, hi in work]

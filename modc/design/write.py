@@ -34,9 +34,21 @@ def ranking(outcomes: list[Outcome]) -> dict:
                 "rank": rank, "file": file_name(o.problem.name, rank), "design": o.problem.name, "chain": d.chain(),
                 "modules": d.modules, "mass_kg": round(d.mass, 6), "torque_margin": round(d.margin, 6),
                 "targets": d.verified.targets,
+                "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
+                                 for a in d.alternatives],
             })
+    prefix = len(outcomes) > 1
+
+    def shapes(o: Outcome, labels: list[str]) -> list[str]:
+        return [f"{o.problem.name}/{s}" if prefix else s for s in labels]
+
     return {"designs": designs, "evaluated": sum(o.evaluated for o in outcomes),
-            "seconds": round(sum(o.seconds for o in outcomes), 3)}
+            "excluded_by_bounds": sum(o.excluded for o in outcomes),
+            "seconds": round(sum(o.seconds for o in outcomes), 3),
+            "complete": all(o.complete for o in outcomes),
+            "stopped": next((o.stopped for o in outcomes if o.stopped), None),
+            "unfinished_shapes": [s for o in outcomes for s in shapes(o, o.unfinished)],
+            "coarse_shapes": [s for o in outcomes for s in shapes(o, o.coarse)]}
 
 
 def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> dict[str, str | bytes]:

@@ -1,0 +1,164 @@
+"""Sound bounds: which twist settings (and which targets) no joint vector can serve, decided
+without IK, for thousands of settings at once.
+
+Written as SPEC section 2's chain between joint frames: J_0 = base_link, and for joint i the
+frame after its rotation, J_i. From J_i to the next joint's frame before its rotation the
+transform K_i = POST_i . PRE_(i+1) is fixed by the twists (K_0 = PRE_1, K_n = POST_n . tool);
+p_i = the origin of J_i lies on joint i's axis. With v_j the tool relative to p_j in J_j,
+
+    v_n = t(K_n),    v_j = t(K_j) + R(K_j) . Rz(theta_(j+1)) . v_(j+1).
+
+Every joint turning freely is a superset of the joint limits, so each interval below contains
+every value the limited arm can take: a target outside them is out of reach for that setting,
+whatever the IK would say. Per joint j the test is that some p_j the prefix can reach and some
+tool position the suffix can reach are the target's distance apart:
+
+- |tool - p_j| lies in W_j: exact for the last two joints (|a + R Rz(t) b|^2 ranges over
+  |a|^2 + |b|^2 + 2 (a'_z b_z +- |a'_xy| |b_xy|) with a' = R^T a), the triangle inequality
+  before;
+- |x - p_j| lies in D_j: p_1 is fixed, p_2 runs on a circle about joint 1's axis (exact
+  distance range), p_j (j > 2) within the interval of |p_j - p_2| of the circle;
+- the tool's height along joint 1's axis, z_1 . (tool - p_1) = e_z . v_1, does not depend on
+  theta_1: exact range for two joints, a triangle bound after.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Frames:
+    """K_0 … K_n for C settings: rotations (C, n+1, 3, 3), translations (C, n+1, 3)."""
+
+    R: np.ndarray
+    t: np.ndarray
+
+
+def frames(g) -> Frames:
+    """K_0 … K_n of a batch.Geometry's C settings."""
+    pre_R, pre_t, post_R, post_t = g.pre[..., :3, :3], g.pre[..., :3, 3], g.post[..., :3, :3], g.post[..., :3, 3]
+    tool = g.flange_tool
+    C, n = pre_R.shape[:2]
+    R = np.empty((C, n + 1, 3, 3))
+    t = np.empty((C, n + 1, 3))
+    R[:, 0], t[:, 0] = pre_R[:, 0], pre_t[:, 0]
+    R[:, 1:n] = post_R[:, :-1] @ pre_R[:, 1:]
+    t[:, 1:n] = post_t[:, :-1] + np.einsum("cnij,cnj->cni", post_R[:, :-1], pre_t[:, 1:])
+    R[:, n] = post_R[:, -1] @ tool[:3, :3]
+    t[:, n] = post_t[:, -1] + post_R[:, -1] @ tool[:3, 3]
+    return Frames(R, t)
+
+
+def _pair(a: np.ndarray, R: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Exact range of |a + R Rz(t) b| over every t: a, b (C, 3), R (C, 3, 3)."""
+    ap = np.einsum("cji,cj->ci", R, a)  # R^T a
+    mid = (a * a).sum(-1) + (b * b).sum(-1) + 2 * ap[:, 2] * b[:, 2]
+    amp = 2 * np.hypot(ap[:, 0], ap[:, 1]) * np.hypot(b[:, 0], b[:, 1])
+    return np.sqrt(np.maximum(mid - amp, 0.0)), np.sqrt(np.maximum(mid + amp, 0.0))
+
+
+def _interval(f: Frames, first: int, last: int, end: np.ndarray | None = None):
+    """Range (lo, hi) of |t(K_first) + R(K_first) Rz . (… t(K_last))| (the point reached from
+    p_first through K_first … K_last, every joint in between free), end replacing t(K_last)."""
+    tail = f.t[:, last] if end is None else end
+    if first == last:
+        d = np.linalg.norm(tail, axis=-1)
+        return d, d
+    lo, hi = _pair(f.t[:, last - 1], f.R[:, last - 1], tail)
+    for j in range(last - 2, first - 1, -1):
+        a = np.linalg.norm(f.t[:, j], axis=-1)
+        lo, hi = np.maximum.reduce([np.zeros_like(a), a - hi, lo - a]), a + hi
+    return lo, hi
+
+
+def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray) -> np.ndarray:
+    """(C, T): False where no joint vector (limits or not) brings tool0 within tol of target xyz
+    (T, 3) for that setting."""
+    C, n1 = f.t.shape[:2]
+    n = n1 - 1
+    p1 = f.t[:, 0]  # (C, 3)
+    z1 = f.R[:, 0, :, 2]
+    x = xyz[None]  # (1, T, 3)
+    tl = tol[None] + 1e-9  # rounding: a target exactly at an interval's end stays possible
+    ok = np.ones((C, len(xyz)), bool)
+    # D_1: p_1 fixed
+    d1 = np.linalg.norm(x - p1[:, None], axis=-1)
+    lo, hi = _interval(f, 1, n)
+    ok &= (d1 <= hi[:, None] + tl) & (d1 >= lo[:, None] - tl)
+    # height along joint 1's axis
+    h_x = np.einsum("cti,ci->ct", x - p1[:, None], z1)
+    a1 = f.t[:, 1]
+    if n == 1:
+        h_lo = h_hi = a1[:, 2]
+    else:
+        c = f.R[:, 1, 2, :]  # R(K_1)^T e_z, as a row of R(K_1)
+        b = f.t[:, 2]
+        mid = a1[:, 2] + c[:, 2] * b[:, 2]
+        amp = np.hypot(c[:, 0], c[:, 1]) * np.hypot(b[:, 0], b[:, 1])
+        rest = _interval(f, 3, n)[1] if n >= 3 else 0.0
+        h_lo, h_hi = mid - amp - rest, mid + amp + rest
+    ok &= (h_x <= h_hi[:, None] + tl) & (h_x >= h_lo[:, None] - tl)
+    if n < 2:
+        return ok
+    # D_2: p_2 on a circle about joint 1's axis
+    a1w = np.einsum("cij,cj->ci", f.R[:, 0], a1)  # R(K_0) a_1, at theta_1 = 0
+    along = (a1w * z1).sum(-1)
+    r = np.linalg.norm(a1w - along[:, None] * z1, axis=-1)
+    centre = p1 + along[:, None] * z1
+    rel = x - centre[:, None]
+    h = np.einsum("cti,ci->ct", rel, z1)
+    s = np.sqrt(np.maximum((rel * rel).sum(-1) - h * h, 0.0))
+    dlo2, dhi2 = np.hypot(h, s - r[:, None]), np.hypot(h, s + r[:, None])
+    for j in range(2, n + 1):
+        if j == 2:
+            dlo, dhi = dlo2, dhi2
+        else:
+            ulo, uhi = _interval(f, 2, j - 1)
+            dlo = np.maximum.reduce([np.zeros_like(dlo2), dlo2 - uhi[:, None], ulo[:, None] - dhi2])
+            dhi = dhi2 + uhi[:, None]
+        wlo, whi = _interval(f, j, n)
+        ok &= (dlo <= whi[:, None] + tl) & (dhi >= wlo[:, None] - tl)
+    return ok
+
+
+def blocked(obstacles, xyz: np.ndarray, tol: np.ndarray, tool_reach: float, radius: float, reach: float,
+            starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Targets no arm in the bounds can serve because of an obstacle, and which obstacle ((T,)
+    bool, (T,) index or -1). Two sound reasons:
+
+    - inside: tool0 there puts the arm's last frame (within tool_reach + tol of the target) so
+      deep in an obstacle that its thinnest segment (radius) collides - a signed distance
+      changes no faster than the distance;
+    - walled off: a box lies between the arm's start and the target along one of its axes - the
+      start is base_link's origin and every unit type's twist1 origin `starts` (K, 3) (the screen
+      tests the chain from there), the target side is clear by tool_reach + tol - and the box
+      spans the whole ball of radius `reach` (the longest chain in the bounds) around the base
+      across that axis: every chain from the base to the target crosses the slab inside the box."""
+    T = len(xyz)
+    which = np.full(T, -1)
+    if len(obstacles.shape) == 0 or T == 0:
+        return np.zeros(T, bool), which
+    x = np.asarray(xyz, float)
+    sd = obstacles.distance(x)  # (T, K)
+    inside = sd + tool_reach + tol[:, None] - radius < -1e-3
+    for k in range(len(obstacles.shape)):
+        if obstacles.shape[k] != 0:
+            continue
+        s = obstacles.size[k]
+        b = -obstacles.centre[k] @ obstacles.R[k]  # base origin in the box frame
+        st = (np.vstack([np.zeros(3), starts]) - obstacles.centre[k]) @ obstacles.R[k]
+        xs = (x - obstacles.centre[k]) @ obstacles.R[k]
+        for a in range(3):
+            others = [j for j in range(3) if j != a]
+            if any(abs(b[j]) + reach > s[j] for j in others):
+                continue
+            side = float(np.sign(b[a]))
+            if side == 0.0 or not np.all(side * st[:, a] > s[a]):
+                continue
+            far = side * xs[:, a] < -(s[a] + tool_reach + tol)
+            inside[:, k] |= far
+    hit = inside.any(-1)
+    which[hit] = np.argmax(inside[hit], axis=-1)
+    return hit, which

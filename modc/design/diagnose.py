@@ -1,0 +1,139 @@
+"""Why no design: per target, whether any arm in the bounds reaches it alone, and if not, what
+rules it out - reach (a sound bound or no IK run gets there), the cell's obstacles (reached only
+in collision, or the target lies so deep in an obstacle that no arm fits), the joint limits
+(reached with the joints free, never within their limits) or, when every target is reachable
+alone, torque or the combination. Distances are always finite."""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from ..model import Problem
+from . import space
+from .evaluate import Spec, _sub_targets
+from .screen import reach_bound
+from .search import parts_of, search_part
+
+PROBE_SECONDS = 10.0  # per target not yet tried alone
+
+
+def _length(x: float) -> str:
+    return f"{x:.3g} m" if x >= 0.1 else f"{x * 1000:.3g} mm"
+
+
+def _shapes_for(problem: Problem, t: int, hi: int) -> list[space.Shape]:
+    """Shapes of the bounds that could reach target t alone (by the reach bound), smallest first."""
+    lib = problem.cell.library
+    assert lib is not None
+    target = problem.cell.targets[t]
+    out = []
+    for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
+        if not space.variant_splits(problem, n):
+            continue
+        for s in space.shapes(problem, n):
+            lengths = [x or lib.units[k].x23 for k, x in zip(s.kinds, s.links, strict=True)]
+            r = reach_bound([lib.units[k] for k in s.kinds], lengths, problem.cell.tool.xyz)
+            if float(np.linalg.norm(target.xyz)) - target.position_tolerance <= r:
+                out.append(s)
+    return out
+
+
+def _probe(problem: Problem, spec: Spec, t: int, seed: int, until: float, free: bool) -> dict:
+    """Search for target t alone (joints free of their limits with `free`) until it is reached clear
+    of the cell or time runs out."""
+    lib = problem.cell.library
+    assert lib is not None
+    one = dataclasses.replace(spec, targets=_sub_targets(spec.targets, t))
+    if free:
+        one = dataclasses.replace(one, lower=-math.pi, upper=math.pi)
+    res: dict[str, Any] = {"hit": False, "clear": False, "closest": math.inf, "screened": 0, "finished": True}
+    for s in _shapes_for(problem, t, min(problem.max_units, lib.rules.max_dof)):
+        for lo, hi in parts_of(one, s):
+            if time.time() > until:
+                res["finished"] = False
+                return res
+            p = search_part(one, s, lo, hi, seed, until)
+            res["hit"] |= p.hit[0]
+            res["clear"] |= p.clear[0]
+            res["closest"] = min(res["closest"], p.closest[0])
+            res["screened"] += p.screened
+            if res["clear"]:
+                return res
+    return res
+
+
+def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, seed: int,
+             deadline: float | None, stopped: bool) -> dict[str, dict]:
+    out: dict[str, dict] = {}
+    for i, name in enumerate(names):
+        entry: dict[str, Any] = {"reached_alone": bool(clear[name]), "ruled_out_by": None, "closest_m": None,
+                                 "detail": ""}
+        out[name] = entry
+        if blocked[i] >= 0:
+            wall = problem.cell.obstacles[int(blocked[i])].name
+            entry.update(ruled_out_by="obstacles", closest_m=None,
+                         detail=f"obstacle '{wall}' rules it out for every arm: tool0 there is inside it, or "
+                                "it stands between the base and the target across the arm's whole reach")
+            continue
+        if clear[name]:
+            continue
+        h, c = hit[name], closest[name]
+        if stopped and not h:
+            entry.update(detail="not reached by the settings screened before the search stopped")
+            continue
+        if not h:
+            until = time.time() + PROBE_SECONDS if deadline is None else min(deadline, time.time() + PROBE_SECONDS)
+            p = _probe(problem, spec, i, seed, until, free=False)
+            if p["clear"]:
+                entry["reached_alone"] = True
+                continue
+            h, c = p["hit"], min(c, p["closest"])
+            if not h and p["screened"]:
+                loose = _probe(problem, spec, i, seed, until + PROBE_SECONDS / 2, free=True)
+                if loose["hit"]:
+                    entry.update(ruled_out_by="joint limits", closest_m=_finite(c),
+                                 detail="reached only with the joints beyond their limits"
+                                 + (f" (within the limits no design gets closer than {_length(c)})"
+                                    if math.isfinite(c) else ""))
+                    continue
+        if h:
+            entry.update(ruled_out_by="obstacles", detail="reached only in collision with the cell")
+            continue
+        if math.isfinite(c) and c > 0:
+            detail = f"no design gets closer than {_length(c)}"
+        elif screened_any(p if not hit[name] else None):
+            detail = "no IK run within the joint limits gets within its tolerance"
+        else:
+            detail = "out of reach of every twist setting (a sound reach bound)"
+        entry.update(ruled_out_by="reach", closest_m=_finite(c) if math.isfinite(c) and c > 0 else None,
+                     detail=detail)
+    return out
+
+
+def screened_any(probe: dict | None) -> bool:
+    return probe is None or bool(probe["screened"])
+
+
+def _finite(x: float) -> float | None:
+    return round(float(x), 9) if math.isfinite(x) else None
+
+
+def why_none(o) -> str:
+    head = f"the search stopped ({o.stopped}) before finding one; " if o.stopped else ""
+    bad = [(n, t) for n, t in o.targets.items() if not t["reached_alone"]]
+    if bad:
+        return head + "; ".join(f"target '{n}': {t['detail']}" + (f" ({t['ruled_out_by']})"
+                                if t["ruled_out_by"] and t["ruled_out_by"] not in t["detail"] else "")
+                                for n, t in bad)
+    torque = [r for r in o.rejections if "torque" in r]
+    if torque:
+        return head + (f"every target can be reached alone, but torque rules out {len(torque)} chains "
+                       f"(first: {torque[0]})")
+    if o.rejections:
+        return head + (f"every target can be reached alone; {len(o.rejections)} chains reach every target, "
+                       f"but none passes the checks (first: {o.rejections[0]})")
+    return head + "every target can be reached alone, but no chain reaches all of them without touching the cell"

@@ -1,0 +1,114 @@
+"""Exact checks in ranking order of what the screens passed: a chain is checked once every chain
+that could rank before it has been found (settle), until `top` kinematically distinct designs
+pass (H/L variant swaps of one arm count once: they are alternatives of one entry)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Problem
+from . import space
+from .evaluate import Candidate, verify
+from .rank import Design, identity
+from .screen import static_torques
+from .search import ShapeResult
+
+TRIES = 3  # twist settings verified per chain before giving up on it
+VERIFY_FACTOR = 4  # at most this many exact checks per design asked for, per number of units
+
+
+class Verifier:
+    def __init__(self, problem: Problem, top: int, out, mass):
+        self.problem, self.top, self.out, self.mass = problem, top, out, mass
+        self.pending: list[tuple] = []
+        self.accepted: list[Design] = []
+        self.keys: list[tuple] = []
+        self.checks = 0
+
+    def add(self, n: int, splits, res: ShapeResult) -> None:
+        from .rank import key
+
+        if not res.found:
+            return
+        p = self.problem
+        for variants in splits:
+            if not all(space.allowed(p, v, k) for v, k in zip(variants, res.shape.kinds, strict=True)):
+                continue
+            found = tuple(f for f in res.found if self._holds(res, variants, f))
+            if not found:
+                continue
+            mass = self.mass(p, res.shape, variants)
+            chain = "-".join(f"{v}{k}" for v, k in zip(variants, res.shape.kinds, strict=True)) + res.shape.label()
+            self.pending.append((key(p.rank, n, mass, None, chain), n, mass, res.shape, found, variants))
+            self.out.screened += 1
+
+    def _holds(self, res: ShapeResult, variants, f) -> bool:
+        """The static torque screen: gravity torques at the poses found for the targets (inside the
+        limits, so no more than the worst case) within every actuator's peak."""
+        from .evaluate import robot_for
+
+        lib = self.problem.cell.library
+        assert lib is not None
+        cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
+        robot = robot_for(self.problem, cand, {}, self.problem.name)
+        tau = static_torques(robot, [sols[0] for sols in f.solutions])
+        peak = np.array([lib.variants[v].actuator.torque_peak for v in variants])
+        if np.all(tau <= peak):
+            return True
+        self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: over peak torque at a target pose")
+        return False
+
+    def _primary_keys(self) -> list[tuple]:
+        best: dict[tuple, tuple] = {}
+        for d, k in zip(self.accepted, self.keys, strict=True):
+            i = identity(d)
+            best[i] = min(best.get(i, k), k)
+        return sorted(best.values())
+
+    def distinct_count(self) -> int:
+        return len(self._primary_keys())
+
+    def done(self, n: int, next_mass: float) -> bool:
+        """top distinct designs found that rank before anything of n units not yet searched."""
+        ahead = [k for k in self._primary_keys() if k[0] < n or (k[0] == n and k[1] < next_mass)]
+        return len(ahead) >= self.top
+
+    def settle(self, n: int, below: float) -> None:
+        """Check the pending chains of up to n units lighter than `below`, best first."""
+        ready = sorted((e for e in self.pending if e[1] < n or (e[1] == n and e[2] < below)), key=lambda e: e[0])
+        self.pending = [e for e in self.pending if not (e[1] < n or (e[1] == n and e[2] < below))]
+        for k, _n, _mass, shape, found, variants in ready:
+            better = self._primary_keys()[: self.top]
+            if len(better) >= self.top and k[:2] > better[-1][:2]:
+                break  # ranks behind top designs already checked (equal keys still compete on margin)
+            if self.checks >= VERIFY_FACTOR * self.top * 4:
+                break
+            for f in found[:TRIES]:
+                cand = Candidate(shape, variants, f.pivots, f.ports, f.solutions)
+                self.checks += 1
+                v = verify(self.problem, cand)
+                if isinstance(v, str):
+                    self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: {v}")
+                    continue
+                self.accepted.append(Design(cand, v))
+                self.keys.append(k)
+                break
+
+    def swaps(self, d: Design) -> Design:
+        """d with every other H/L split of its arm that passes the exact check as an alternative."""
+        from dataclasses import replace
+
+        from .rank import order
+
+        p = self.problem
+        c = d.candidate
+        have = {a.candidate.variants for a in d.alternatives} | {c.variants}
+        found = list(d.alternatives)
+        for variants in space.variant_splits(p, c.shape.n):
+            allowed = all(space.allowed(p, v, k) for v, k in zip(variants, c.shape.kinds, strict=True))
+            if variants in have or not allowed:
+                continue
+            cand = Candidate(c.shape, variants, c.pivots, c.ports, c.solutions)
+            v = verify(p, cand)
+            if not isinstance(v, str):
+                found.append(Design(cand, v))
+        return replace(d, alternatives=tuple(order(found, p.rank)))

@@ -1,0 +1,109 @@
+"""`modc design` as a command: a time budget, Ctrl-C, progress on stderr, the output folder
+checked before the search, exit codes."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# two targets at tool0 of an H4-L3 arm: found within a second; the 3- and 4-unit shapes after it
+# take far longer than the budgets below
+CELL = """design two {
+    target t0 at (-0.333652449, -0.199597937, 0.127445974) m within 3 mm, 2 deg
+    target t1 at (-0.186580953, 0.390032369, -0.056370661) m within 3 mm, 2 deg
+    units 2 to 4
+    modules H4, L3
+}
+"""
+
+BIG = """design big {
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    target c at (0.10, 0.30, 0.45) m
+    units 5 to 6
+}
+"""
+
+
+def _env(tmp_path) -> dict:
+    return dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
+
+
+def _run(tmp_path, text: str, *args: str, timeout: float = 600) -> subprocess.CompletedProcess:
+    src = tmp_path / "cell.mod"
+    src.write_text(text, encoding="utf-8")
+    return subprocess.run([sys.executable, "-m", "modc", "design", str(src), *args], capture_output=True, text=True,
+                          env=_env(tmp_path), cwd=tmp_path, timeout=timeout)
+
+
+@pytest.mark.slow
+def test_time_budget_keeps_the_best_found(tmp_path):
+    out = tmp_path / "out"
+    p = _run(tmp_path, CELL, "-o", str(out), "--no-render", "--top", "20", "--time-budget", "20s")
+    assert p.returncode == 0, p.stderr
+    assert "the time budget ran out" in p.stderr and "shapes not finished" in p.stderr
+    ranking = json.loads((out / "ranking.json").read_text(encoding="utf-8"))
+    assert ranking["complete"] is False and ranking["stopped"] == "time budget"
+    assert ranking["unfinished_shapes"] and ranking["designs"][0]["modules"] == 2
+    # progress lines on a non-terminal stderr, the first at once
+    lines = [ln for ln in p.stderr.splitlines() if "feasible, best" in ln]
+    assert lines and "shapes" in lines[0] and "ETA" in lines[0]
+
+
+@pytest.mark.slow
+def test_time_budget_with_nothing_found_exits_1(tmp_path):
+    out = tmp_path / "out"
+    p = _run(tmp_path, BIG, "-o", str(out), "--no-render", "--time-budget", "1s", "-q")
+    assert p.returncode == 1, p.stderr
+    assert "the time budget ran out" in p.stderr and "no design found" in p.stderr
+    assert "feasible, best" not in p.stderr  # -q: no progress
+    assert "inf" not in p.stderr.replace("info", "") and not out.exists()
+
+
+def test_output_folder_is_checked_before_the_search(tmp_path):
+    (tmp_path / "taken").write_text("not a directory", encoding="utf-8")
+    t = time.perf_counter()
+    p = _run(tmp_path, BIG, "-o", str(tmp_path / "taken"), "--no-render")
+    assert p.returncode == 2, p.stderr
+    assert "output-not-modc" in p.stderr and "feasible, best" not in p.stderr
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine", encoding="utf-8")
+    p = _run(tmp_path, BIG, "-o", str(other), "--no-render")
+    assert p.returncode == 2 and "notes.txt" in p.stderr and "feasible, best" not in p.stderr
+    assert (other / "notes.txt").read_text(encoding="utf-8") == "mine"
+    assert time.perf_counter() - t < 300  # no search ran (a generous bound for a loaded machine)
+
+
+def test_bad_duration_is_a_usage_error(tmp_path):
+    p = _run(tmp_path, BIG, "-o", str(tmp_path / "o"), "--time-budget", "soon")
+    assert p.returncode == 2 and "not a duration" in p.stderr
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_with_exit_130(tmp_path):
+    src = tmp_path / "cell.mod"
+    src.write_text(BIG, encoding="utf-8")
+    proc = subprocess.Popen([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"),
+                             "--no-render"], stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
+                            env=_env(tmp_path), cwd=tmp_path)
+    try:
+        assert proc.stderr is not None
+        first = proc.stderr.readline()  # blocks until the first progress line: the search has started
+        assert "feasible, best" in first, first
+        proc.send_signal(signal.SIGINT)
+        rest = proc.stderr.read()
+        rc = proc.wait(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert rc == 130, rest
+    assert "interrupted" in rest and "Traceback" not in rest
