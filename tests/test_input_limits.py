@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
+from modc import trajectory
 from modc.files import MAX_JSON_BYTES, MAX_JSON_DEPTH, InputProblem, read_json
-from modc.sim import trajectory
 
 QUICKSTART = ROOT / "examples" / "quickstart.mod"
 GOOD = {"joint_names": ["joint_1", "joint_2", "joint_3"], "points": [{"t": 0.0, "q": [0.0, 0.0, 0.0]}]}

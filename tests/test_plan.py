@@ -253,7 +253,7 @@ def test_farm_json(plant_plan):
 
 def test_json_plays(farm, plant_plan):
     """What `plan --json` prints is a trajectory `play --traj` accepts."""
-    traj = pytest.importorskip("modc.sim.trajectory")
+    traj = pytest.importorskip("modc.trajectory")
     robot, _ = farm
     parsed, errors = traj.parse(json.loads(plant_plan.dumps()))
     assert not errors, errors

@@ -324,7 +324,7 @@ def test_cycle_time_retimed_independently(farm, serve, seam, urdf_model):
 @pytest.mark.slow
 def test_plan_task_cli_json(tmp_path, capsys):
     from modc.cli import main
-    from modc.sim.trajectory import parse
+    from modc.trajectory import parse
 
     with pytest.raises(SystemExit) as e:
         main(["plan", str(EXAMPLE), "--task", "serve", "--json"])

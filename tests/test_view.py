@@ -305,7 +305,7 @@ def test_bad_ranking_is_a_usage_error(tmp_path):
 
 
 def _traj(tmp_path: Path, q_last) -> Path:
-    from modc.sim.trajectory import Trajectory
+    from modc.trajectory import Trajectory
 
     t = Trajectory(("joint_1", "joint_2", "joint_3"), (0.0, 1.0), ((0.0, 0.0, 0.0), tuple(q_last)))
     p = tmp_path / "t.json"

@@ -386,7 +386,7 @@ def _click(browser, label: str) -> None:
 def test_buttons_page_the_ranking_go_to_poses_and_play(browser, tmp_path):
     import math
 
-    from modc.sim.trajectory import Trajectory
+    from modc.trajectory import Trajectory
     from modc.view.page import Ranking
 
     d = tmp_path / "designs"

@@ -109,7 +109,7 @@ def _along(traj_path: str, design, robots, mass) -> dict:
     from ..dynamics.along import peaks
     from ..dynamics.worst import Dynamics
     from ..model.select import choose_robot
-    from ..sim.trajectory import diagnostics, load, validate_for
+    from ..trajectory import diagnostics, load, validate_for
 
     def invalid(lines) -> NoReturn:
         _print_diagnostics(diagnostics(traj_path, lines), {})

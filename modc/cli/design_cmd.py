@@ -58,7 +58,6 @@ def _sigint_stops():
 
 def _cap_workers(_ctx: click.Context, _param: click.Parameter, value: int) -> int:
     """More processes than CPUs only add memory and switching: cap at the CPUs this process may use."""
-    import os
 
     cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     if value > cpus:
@@ -100,7 +99,6 @@ def _executor(workers: int, scheduler: str | None):
 def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
     """PNG pictures of the given design files, each at its first target's pose."""
     import tempfile
-    from pathlib import Path
 
     from ..sim.render import render
 

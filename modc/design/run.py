@@ -8,7 +8,6 @@ is the same for one process, a local pool or a Dask cluster.
 """
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor

@@ -31,7 +31,7 @@ from typing import Any
 
 from ..diagnostics import codes
 from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
-from ..sim.trajectory import Trajectory
+from ..trajectory import Trajectory
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
 
 IK_SEEDS_PER_JOINT = 16  # IK runs: 16 per joint (48 for a 3-joint arm), the start pose first

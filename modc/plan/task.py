@@ -29,7 +29,7 @@ import numpy as np
 
 from ..diagnostics import codes
 from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
-from ..sim.trajectory import Trajectory
+from ..trajectory import Trajectory
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
 
 STRAIGHT_STEP = 0.002  # m between IK waypoints along a straight path

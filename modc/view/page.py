@@ -12,11 +12,11 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from .. import trajectory
 from ..compiler import COMPILE_ANALYSES, InputError, check_file
 from ..diagnostics import Diagnostic, codes
 from ..diagnostics.render import render_text
 from ..model.select import RobotChoiceError, choose_robot
-from ..sim import trajectory
 from .arm import Arm
 
 

@@ -177,7 +177,7 @@ class Problem(str):
 def load(path: str | Path) -> tuple[Trajectory | None, list[str]]:
     """Read and check the structure, under the limits of every input file (files.read_json).
     Raises OSError when the file cannot be read (missing, a directory, a FIFO or a device)."""
-    from ..files import InputProblem, read_json
+    from .files import InputProblem, read_json
 
     try:
         doc = read_json(path)
@@ -188,7 +188,7 @@ def load(path: str | Path) -> tuple[Trajectory | None, list[str]]:
 
 def diagnostics(path: str, errors: list[str]) -> list:
     """traj-invalid diagnostics for load's or validate_for's errors, at their place in the file."""
-    from ..diagnostics import Span, codes
+    from .diagnostics import Span, codes
 
     return [codes.TRAJ_INVALID.at(Span.point(path, getattr(e, "line", 1), getattr(e, "col", 1)), detail=e)
             for e in errors]
