@@ -14,9 +14,9 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from .. import names
-from ..diagnostics import Span
 from ..diagnostics.plain_words import plain_words
 from . import quantities as Q
+from .library_file import LIBRARY_KEYS, MAX_LIBRARY_BYTES, LibraryError, read_library, where  # noqa: F401 (re-exported)
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
@@ -243,111 +243,6 @@ class Library(_Frozen):
         return None
 
 
-class LibraryError(Exception):
-    """A library that cannot be used; span points into the library file when the problem has a
-    place there (text is that file, for the caret excerpt), else it is None. code is the
-    diagnostic code's name; fields fill its message when it is not library-invalid's."""
-
-    def __init__(self, message: str, span: Span | None = None, text: str | None = None,
-                 code: str = "library-invalid", fields: dict[str, str] | None = None):
-        super().__init__(message)
-        self.span, self.text, self.code, self.fields = span, text, code, fields or {}
-
-    def diagnostic(self, span: Span, ref: str):
-        """The diagnostic at span (the reference in the .mod file, or self.span in the library)."""
-        from ..diagnostics import REGISTRY
-
-        fields = self.fields or {"name": names.shown(ref, 200), "detail": str(self),
-                                 "builtins": ", ".join(BUILTIN)}
-        return REGISTRY[self.code].at(span, **fields)
-
-
-def _node_span(file: str, node) -> Span:
-    s, e = node.start_mark, node.end_mark
-    if e.line != s.line:  # a block: point at its first line only
-        return Span(file, s.line + 1, s.column + 1, s.line + 1, s.column + 2, s.index, s.index + 1)
-    end_col, end = max(e.column + 1, s.column + 2), max(e.index, s.index + 1)
-    return Span(file, s.line + 1, s.column + 1, e.line + 1, end_col, s.index, end)
-
-
-def _where(text: str, file: str, loc: tuple) -> Span:
-    """Where a validation error's location (pydantic's loc) is in the library's YAML: the value
-    when it is a scalar, else its key; the deepest part of loc the file has."""
-    import yaml
-
-    try:
-        node = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except yaml.YAMLError:
-        node = None
-    if node is None:
-        return Span.point(file)
-    key = None
-    for part in loc:
-        if part == "[key]" and key is not None:
-            return _node_span(file, key)
-        if isinstance(node, yaml.MappingNode):
-            hit = next(((k, v) for k, v in node.value if k.value == str(part)), None)
-        elif isinstance(node, yaml.SequenceNode) and isinstance(part, int) and 0 <= part < len(node.value):
-            hit = (key, node.value[part])
-        else:
-            hit = None
-        if hit is None:
-            break
-        key, node = hit
-    return _node_span(file, node if isinstance(node, yaml.ScalarNode) or key is None else key)
-
-
-MAX_LIBRARY_BYTES = 1_000_000  # the shipped libraries are 4 kB; a 6 MB one took 30 s and 550 MB
-# What makes a YAML mapping a module library. Until a file has them it may be anything the
-# reference names (/etc/passwd, a .env file): then no line, key or character of it is shown.
-LIBRARY_KEYS = ("variants", "units")
-
-
-def _not_a_library(data) -> str | None:
-    """Why parsed YAML is not a module library (in words that quote none of it), else None."""
-    if not isinstance(data, dict):
-        kind = ("empty" if data is None else "a YAML list" if isinstance(data, list)
-                else "plain text or a single value")
-        return f"it is {kind}, not a YAML mapping"
-    missing = [k for k in LIBRARY_KEYS if k not in data]
-    return f"it has no `{missing[0]}` key" if missing else None
-
-
-def _not(why: str) -> LibraryError:
-    return LibraryError(f"not a module library: {why}")
-
-
-def _parse(path: str):
-    """(text, data) of a file that parses as a module library; LibraryError without any of its
-    content otherwise."""
-    import yaml
-
-    from ..files import read_bounded
-
-    try:
-        raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
-    except OSError as e:
-        raise LibraryError(f"it cannot be read: {e.strerror or type(e).__name__}") from None
-    if size > MAX_LIBRARY_BYTES:
-        raise LibraryError(f"the file is too large ({size:,} bytes; the limit is {MAX_LIBRARY_BYTES:,})")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as e:
-        raise _not(f"it is not UTF-8 text (at byte {e.start + 1})") from None
-    try:
-        data = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except RecursionError:
-        raise _not("its YAML is nested too deeply") from None
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
-        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
-        raise _not(f"it is not YAML{where}") from None
-    why = _not_a_library(data)
-    if why:
-        raise _not(why)
-    return text, data
-
-
 def _range_error(err, text: str, path: str) -> LibraryError | None:
     """A number beyond its field's upper bound: out-of-range, as for .mod quantities."""
     ctx = err.get("ctx") or {}
@@ -361,7 +256,7 @@ def _range_error(err, text: str, path: str) -> LibraryError | None:
     what = ".".join(str(p) for p in err["loc"])
     fields = {"what": what, "value": f"{value:g}{unit}", "limit": f"{ctx['le']:g}{unit}"}
     message = f"{what} = {fields['value']} is out of range (at most {fields['limit']})"
-    return LibraryError(message, _where(text, path, err["loc"]), text, "out-of-range", fields)
+    return LibraryError(message, where(text, path, err["loc"]), text, "out-of-range", fields)
 
 
 def _unit(loc: tuple) -> str:
@@ -385,7 +280,7 @@ def _unit(loc: tuple) -> str:
 def _load_path(path: str, mtime: float) -> Library:
     from pydantic import ValidationError
 
-    text, data = _parse(path)
+    text, data = read_library(path)
     try:
         return Library.model_validate(data)
     except ValidationError as e:
@@ -395,7 +290,7 @@ def _load_path(path: str, mtime: float) -> Library:
             raise ranged from None
         loc = ".".join(str(p) for p in first["loc"] if p != "[key]")
         message = plain_words(first)
-        raise LibraryError(f"{loc}: {message}" if loc else message, _where(text, path, first["loc"]), text) from None
+        raise LibraryError(f"{loc}: {message}" if loc else message, where(text, path, first["loc"]), text) from None
 
 
 def resolve(ref: str, relative_to: Path | None = None) -> Path | None:
