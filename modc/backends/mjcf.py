@@ -48,6 +48,7 @@ from .._version import __version__
 from ..kinematics import matrix_rpy, transform
 from ..model import Robot
 from ..physical.assembly import Description
+from ..physical.constants import TIME_STEP
 from ..physical.parts import Primitive
 from ..physical.statics import G
 from . import Build, register
@@ -56,7 +57,6 @@ from .srdf import collision_matrix
 from .templates import comment, render
 from .urdf import MATERIALS
 
-TIME_STEP = 1e-3  # s, as `modc sim`
 ERROR_AT_PEAK = 0.005  # rad of position error at which a servo reaches the actuator's peak torque
 ARMATURE = 1e-3  # kg·m², reflected rotor inertia per joint (numerical regularisation, see above)
 TOOL_SITE_RADIUS = 0.005  # m

@@ -12,8 +12,9 @@ import numpy as np
 from ..kinematics import Chain
 from ..model import Robot
 from .assembly import describe
+from .constants import GRAVITY_VECTOR
 
-G = np.array([0.0, 0.0, -9.81])
+G = np.array(GRAVITY_VECTOR)
 
 
 class Statics:

@@ -31,12 +31,12 @@ from typing import TYPE_CHECKING, Any
 
 from ..model import Robot
 from ..physical.cell import MODULE_RADIUS, OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA, extent_points  # noqa: F401  (one home: physical/)
+from ..physical.constants import GRAVITY
 from .contacts import CollisionQueries
 
 if TYPE_CHECKING:
     import numpy as np
 
-GRAVITY = 9.81  # m/s², the value modc.dynamics uses
 
 
 class UsageError(Exception):

@@ -48,6 +48,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from ..physical.constants import GRAVITY, TIME_STEP
 from . import scene
 from .contacts import srdf_disabled_pairs
 from .verdict import (  # noqa: F401  (the tolerances are part of this module's story)
@@ -64,7 +65,6 @@ from .verdict import (  # noqa: F401  (the tolerances are part of this module's 
     judge_pose,
 )
 
-TIME_STEP = 1e-3  # s
 HOLD_TIME = 2.0  # s of simulated time per pose
 SETTLE_WINDOW = 0.5  # s: tracking is judged over the end of the hold
 WARNING_LINE = re.compile(r"warning|error|failed|cannot|unable", re.IGNORECASE)
@@ -103,7 +103,7 @@ def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOL
 
     res = RobotResult(robot.name, robot.sequence)
     client.resetSimulation()
-    client.setGravity(0, 0, -scene.GRAVITY)
+    client.setGravity(0, 0, -GRAVITY)
     client.setTimeStep(time_step)
     try:
         s = scene.load_robot(client, robot, urdf)

@@ -1,0 +1,12 @@
+"""Physical constants every model of the arm shares (SI).
+
+One value each, so that the numpy statics, pinocchio, PyBullet (`modc sim`) and the MJCF scene
+agree on the torques they compute and the time they step. No imports: any layer may read it.
+"""
+from __future__ import annotations
+
+GRAVITY = 9.81  # m/s², standard gravity as pinocchio's default model uses it
+GRAVITY_VECTOR = (0.0, 0.0, -GRAVITY)  # m/s², world (and upright base_link) z up
+TIME_STEP = 1e-3  # s: `modc sim` steps at 1 kHz and the MJCF scene declares the same step
+
+__all__ = ["GRAVITY", "GRAVITY_VECTOR", "TIME_STEP"]
