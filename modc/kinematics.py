@@ -122,12 +122,6 @@ class Chain:
         u = self.units[i]
         return A_t2(u.port, u.x23) if u.has_link else np.eye(4)
 
-    def T_parent_joint(self, i: int) -> np.ndarray:
-        """Joint i's origin (q_i = 0) in the frame of the link before it (base_link for i = 0)."""
-        T = np.eye(4) if i == 0 else self.T_joint_end(i - 1)
-        u = self.units[i]
-        return T @ self.T_unit_twist1(i) @ A_J(0.0, u.z12)
-
     def T_last_tool(self) -> np.ndarray:
         """Last joint frame -> tool0."""
         return self.T_joint_end(self.dof - 1) @ self.T_flange_tool

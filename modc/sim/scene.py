@@ -334,12 +334,6 @@ class Scene(CollisionQueries):
 
         return np.linalg.inv(self.T_world_base) @ self.T_world_link(name)
 
-    def link_origins_world(self):
-        """Every link frame's origin in the world (for framing a camera)."""
-        import numpy as np
-
-        return np.array([self.T_world_link(n)[:3, 3] for n in self.links])
-
     def remove(self) -> None:
         for b in [self.body, *self.obstacles.values(), *self.targets.values()]:
             self.client.removeBody(b)
