@@ -48,9 +48,8 @@ from .._version import __version__
 from ..kinematics import matrix_rpy, transform
 from ..model import Robot
 from ..physical.assembly import Description
-from ..physical.constants import TIME_STEP
+from ..physical.constants import GRAVITY_VECTOR, TIME_STEP
 from ..physical.parts import Primitive
-from ..physical.statics import G
 from . import Build, register
 from . import format as fmt
 from .srdf import collision_matrix
@@ -192,7 +191,7 @@ def context(build: Build, robot: Robot) -> dict:
     return {
         "name": robot.file_stem, "robot": comment(robot.name), "sequence": comment(robot.sequence),
         "source": comment(build.source_name), "library": comment(robot.library.name if robot.library else ""),
-        "version": __version__, "timestep": num(TIME_STEP), "gravity": vec(G),
+        "version": __version__, "timestep": num(TIME_STEP), "gravity": vec(GRAVITY_VECTOR),
         "armature": num(ARMATURE), "visual_group": VISUAL_GROUP, "collision_group": COLLISION_GROUP,
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()],
         "meshes": _assets(desc), "bodies": _bodies(desc, robot),
