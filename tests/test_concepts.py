@@ -79,3 +79,32 @@ def test_the_sampled_worst_case_is_a_lower_bound_of_the_refined_search():
         refined = np.array([j.tau for j in worst_case(Dynamics(robot))])
         assert np.all(sampled <= refined + 2e-5)
         assert np.all(sampled >= 0.5 * refined)  # a ranking the DH conversion may rely on
+
+
+def _exp(v: np.ndarray) -> np.ndarray:
+    """Rodrigues: the rotation matrix of a rotation vector."""
+    a = float(np.linalg.norm(v))
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]]) / (a if a > 0 else 1.0)
+    return np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * K @ K
+
+
+def test_rotation_error_has_one_home_that_the_copies_equal():
+    from modc.design.batch import rotation_error as batched_copy
+    from modc.kinematics import rotation_error, rotation_vector
+    from modc.plan.ik import rotation_vector as ik_copy
+
+    rng = np.random.default_rng(11)
+    vs = [*rng.normal(size=(50, 3)), np.zeros(3), np.array([np.pi, 0, 0]), np.array([0, 1, 1]) / np.sqrt(2) * np.pi,
+          np.array([1e-10, 0, 0]), np.array([0, 0, np.pi - 1e-7])]
+    vs = [v if np.linalg.norm(v) <= np.pi else v / np.linalg.norm(v) * 3.0 for v in vs]
+    Rs = np.array([_exp(v) for v in vs])
+    got = rotation_vector(Rs)
+    for v, R, g in zip(vs, Rs, got, strict=True):
+        assert np.allclose(g, rotation_vector(R), atol=1e-12)  # one matrix or a batch: the same answer
+        assert np.allclose(g, ik_copy(R), atol=1e-9)
+        if np.linalg.norm(v) < np.pi - 1e-3:  # at 180°, v and -v are the same turn
+            assert np.allclose(g, v, atol=1e-7)
+        else:
+            assert np.allclose(_exp(g), R, atol=1e-6)
+    Rt = Rs[::-1]
+    assert np.allclose(rotation_error(Rt, Rs), batched_copy(Rt, Rs), atol=1e-12)
