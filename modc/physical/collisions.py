@@ -313,6 +313,48 @@ class _Checker:
         return bool(self.pin.computeCollisions(sub, sub_data, True))
 
 
+def _sample(checker: _Checker, n: int, active: list[int], Q: np.ndarray, samples: int,
+            stats: dict[str, int]) -> tuple[list[int], list[int], bool]:
+    """Run the sampled configurations, a chunk at a time, over the candidate pairs still active
+    until each one's reason is certain. Per candidate: how many samples collided, and after how
+    many samples its reason was certain (0: it never was); and whether any pair stayed undecided."""
+    coll = [0] * n
+    decided_at = [0] * n  # how many samples a pair saw before its reason was certain (0: all)
+    free_limit = samples * (100 - ALWAYS_PERCENT)  # free * 100 > this -> not Always
+    always_at = samples * ALWAYS_PERCENT  # coll * 100 >= this -> Always
+    pending: list[int] = []  # active pairs seen colliding: they wait for > 5 % free samples
+    for start in range(0, samples, CHUNK):
+        if not active:
+            break
+        mask = checker.broad_phase(Q[start:start + CHUNK])
+        for r in np.flatnonzero(mask.any(axis=1)).tolist():  # samples where some spheres touch
+            i = start + r
+            if not active:
+                break
+            row = mask[r]
+            flagged = [k for k in active if row[k]]
+            if flagged:
+                checker.set_configuration(Q[i])
+            changed = False
+            for k in flagged:
+                stats["broad_phase_hits"] += 1
+                if checker.collides(k):
+                    if not coll[k]:
+                        pending.append(k)
+                    coll[k] += 1
+                    if coll[k] * 100 >= always_at:
+                        decided_at[k] = i + 1
+                        changed = True
+            for k in pending:  # samples 0..i seen: i + 1 - coll[k] of them free
+                if not decided_at[k] and (i + 1 - coll[k]) * 100 > free_limit:
+                    decided_at[k] = i + 1
+                    changed = True
+            if changed:
+                active = [k for k in active if not decided_at[k]]
+                pending = [k for k in pending if not decided_at[k]]
+    return coll, decided_at, bool(active)
+
+
 def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_SEED) -> CollisionMatrix:
     """Classify every pair of links with collision geometry (see the module docstring)."""
     if samples < 0 or seed < 0:
@@ -339,49 +381,15 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
         active = [k for k, p in enumerate(candidates) if p not in reasons]
         stats["sampled_pairs"] = len(active)
         Q = sample_configurations(lower, upper, samples, seed)
-        n = len(candidates)
-        coll = [0] * n
-        decided_at = [0] * n  # how many samples a pair saw before its reason was certain (0: all)
-        free_limit = samples * (100 - ALWAYS_PERCENT)  # free * 100 > this -> not Always
-        always_at = samples * ALWAYS_PERCENT  # coll * 100 >= this -> Always
-        pending: list[int] = []  # active pairs seen colliding: they wait for > 5 % free samples
-        for start in range(0, samples, CHUNK):
-            if not active:
-                break
-            mask = checker.broad_phase(Q[start:start + CHUNK])
-            for r in np.flatnonzero(mask.any(axis=1)).tolist():  # samples where some spheres touch
-                i = start + r
-                if not active:
-                    break
-                row = mask[r]
-                flagged = [k for k in active if row[k]]
-                if flagged:
-                    checker.set_configuration(Q[i])
-                changed = False
-                for k in flagged:
-                    stats["broad_phase_hits"] += 1
-                    if checker.collides(k):
-                        if not coll[k]:
-                            pending.append(k)
-                        coll[k] += 1
-                        if coll[k] * 100 >= always_at:
-                            decided_at[k] = i + 1
-                            changed = True
-                for k in pending:  # samples 0..i seen: i + 1 - coll[k] of them free
-                    if not decided_at[k] and (i + 1 - coll[k]) * 100 > free_limit:
-                        decided_at[k] = i + 1
-                        changed = True
-                if changed:
-                    active = [k for k in active if not decided_at[k]]
-                    pending = [k for k in pending if not decided_at[k]]
-        stats["samples_run"] = samples if active else max(decided_at, default=0)
+        coll, decided_at, undecided = _sample(checker, len(candidates), active, Q, samples, stats)
+        stats["samples_run"] = samples if undecided else max(decided_at, default=0)
         for k, p in enumerate(candidates):
             if p in reasons or samples == 0:  # Default; or no sampling asked for
                 continue
             counts[p] = (coll[k], decided_at[k] or samples)
             if coll[k] == 0:
                 reasons[p] = "Never"
-            elif coll[k] * 100 >= always_at:
+            elif coll[k] * 100 >= samples * ALWAYS_PERCENT:
                 reasons[p] = "Always"
             # else: collides sometimes -> stays enabled
         stats["exact_tests"] = checker.exact_tests
