@@ -108,3 +108,28 @@ def test_rotation_error_has_one_home_that_the_copies_equal():
             assert np.allclose(_exp(g), R, atol=1e-6)
     Rt = Rs[::-1]
     assert np.allclose(rotation_error(Rt, Rs), batched_copy(Rt, Rs), atol=1e-12)
+
+
+def test_sim_skips_the_pairs_plan_and_the_srdf_skip_from_the_matrix_in_memory(tmp_path):
+    """`modc sim` without --srdf-from used to check every non-adjacent pair; it now takes the
+    collision matrix in memory, the one rule (CollisionMatrix.unchecked) plan and the SRDF use."""
+    pytest.importorskip("pinocchio")
+    from conftest import ROOT
+
+    from modc.compiler import build, check_file
+    from modc.files import write_files
+    from modc.physical.assembly import describe
+    from modc.physical.collisions import UNCHECKED_REASONS, cached_matrix
+    from modc.sim.contacts import srdf_disabled_pairs
+    from modc.sim.smoke import allowed_pairs
+
+    checked = check_file(ROOT / "examples" / "example_a.mod")
+    (robot,) = checked.design.robots
+    write_files(build(checked, ["srdf"]), tmp_path)
+    matrix = cached_matrix(describe(robot))
+    skipped = matrix.unchecked()
+    assert skipped and skipped == {frozenset((p.link1, p.link2)) for p in matrix.disabled if p.reason != "Never"}
+    assert set(UNCHECKED_REASONS) == {"Adjacent", "Default", "Always"}
+    assert allowed_pairs(None, robot) == skipped
+    assert allowed_pairs(tmp_path, robot) == srdf_disabled_pairs(tmp_path / "config" / f"{robot.file_stem}.srdf")
+    assert allowed_pairs(tmp_path, robot) == skipped

@@ -58,6 +58,10 @@ CHUNK = 4096  # samples per broad-phase batch (bounds memory for large sample co
 SPHERE_MARGIN = 1e-3  # m: bounding spheres closer than this count as touching (the filter errs towards testing meshes)
 
 REASONS = ("Adjacent", "Default", "Always", "Never")
+# Which pairs a collision check skips: the one rule of `modc plan`, `modc sim` (both engines) and
+# the viewer. "Never" pairs stay checked: never colliding in the samples is MoveIt's shortcut for
+# speed, not a promise, so a pose that brings them into contact is a real collision.
+UNCHECKED_REASONS = ("Adjacent", "Default", "Always")
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,11 @@ class CollisionMatrix:
     @property
     def links_without_geometry(self) -> tuple[str, ...]:
         return tuple(name for name in self.links if name not in self.geometry_links)
+
+    def unchecked(self) -> set[frozenset[str]]:
+        """The pairs a collision check skips (UNCHECKED_REASONS); every other pair of links with
+        geometry is checked."""
+        return {frozenset((p.link1, p.link2)) for p in self.disabled if p.reason in UNCHECKED_REASONS}
 
     def reason(self, a: str, b: str) -> str | None:
         for p in self.disabled:
@@ -475,6 +484,6 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
                            {"pairs": len(all_pairs), "mesh_pairs": len(owner)})
 
 
-__all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "CollisionMatrix", "Geometry", "Pair",
-           "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive", "default_configuration",
-           "geometry", "joint_limits", "load", "sample_configurations"]
+__all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "UNCHECKED_REASONS", "CollisionMatrix",
+           "Geometry", "Pair", "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive",
+           "default_configuration", "geometry", "joint_limits", "load", "sample_configurations"]

@@ -217,11 +217,11 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
              hold_time: float = HOLD_TIME) -> list[RobotResult]:
     """Every (or the named) robot of a checked design without errors (as smoke.simulate)."""
     from .scene import compiled, select_robots
-    from .smoke import allowed_from_srdf
+    from .smoke import allowed_pairs
 
     robots = select_robots(checked, robot)
     with compiled(checked, "mjcf") as xmls:
-        return [simulate_robot(r, xmls[r.name], allowed_from_srdf(out_dir, r), hold_time) for r in robots]
+        return [simulate_robot(r, xmls[r.name], allowed_pairs(out_dir, r), hold_time) for r in robots]
 
 
 __all__ = ["ENGINE", "FK_TOL", "MujocoScene", "import_mujoco", "load", "simulate", "simulate_robot"]

@@ -167,11 +167,18 @@ def _hold(client, s, qv, steps: int, window: int, time_step: float) -> Hold:
     return rec.hold(s.q(), s.applied_torques(), [s.limits[j][2] for j in s.joint_names])
 
 
-def allowed_from_srdf(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
-    if out_dir is None:
-        return set()
-    srdf = Path(out_dir) / "config" / f"{robot.file_stem}.srdf"
-    return srdf_disabled_pairs(srdf) if srdf.is_file() else set()
+def allowed_pairs(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
+    """The link pairs not checked for self-collision: the collision matrix in memory (the one the
+    SRDF backend writes and `modc plan` uses, with the same defaults), or, given a compile
+    output (--srdf-from OUT), the pairs its SRDF disables (compiled with other samples, say)."""
+    if out_dir is not None:
+        srdf = Path(out_dir) / "config" / f"{robot.file_stem}.srdf"
+        if srdf.is_file():
+            return srdf_disabled_pairs(srdf)
+    from ..physical.assembly import describe
+    from ..physical.collisions import cached_matrix
+
+    return cached_matrix(describe(robot)).unchecked()
 
 
 def simulate(checked, robot: str | None = None, out_dir: str | Path | None = None,
@@ -181,7 +188,7 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
     results = []
     with scene.compiled(checked) as urdfs, scene.connect() as client:
         for r in robots:
-            results.append(simulate_robot(client, r, urdfs[r.name], allowed_from_srdf(out_dir, r), hold_time))
+            results.append(simulate_robot(client, r, urdfs[r.name], allowed_pairs(out_dir, r), hold_time))
     return results
 
 
