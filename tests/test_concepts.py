@@ -43,6 +43,14 @@ def test_gravity_and_time_step_have_one_value():
     assert smoke.TIME_STEP is play.TIME_STEP is mjcf.TIME_STEP is constants.TIME_STEP
 
 
+def test_the_acceleration_ramp_has_one_value():
+    from modc.backends import ros
+    from modc.plan import timing
+
+    assert ros.ACCEL_RAMP_TIME is constants.ACCEL_RAMP_TIME
+    assert timing.ACCEL_RAMP_TIME == constants.ACCEL_RAMP_TIME  # plan/timing.py's copy: to import it
+
+
 TILTED = ("robot r {\n    chain H1 - H3 - L1\n    payload 0.2 kg at (0, 0, 0.03) m\n"
           "    base at (0, 0, 0) m rpy (90, 30, 0) deg\n}\n")
 
