@@ -364,6 +364,20 @@ def _sample(checker: _Checker, n: int, active: list[int], Q: np.ndarray, samples
     return coll, decided_at, bool(active)
 
 
+def _classify(candidates: list[tuple[str, str]], coll: list[int], decided_at: list[int], samples: int,
+              reasons: dict[tuple[str, str], str], counts: dict[tuple[str, str], tuple[int, int]]) -> None:
+    """Never or Always from the sampled counts, for the candidates without a reason yet (not
+    Default); a pair that collides sometimes stays enabled. Fills reasons and counts."""
+    for k, p in enumerate(candidates):
+        if p in reasons:
+            continue
+        counts[p] = (coll[k], decided_at[k] or samples)
+        if coll[k] == 0:
+            reasons[p] = "Never"
+        elif coll[k] * 100 >= samples * ALWAYS_PERCENT:
+            reasons[p] = "Always"
+
+
 def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_SEED) -> CollisionMatrix:
     """Classify every pair of links with collision geometry (see the module docstring)."""
     if samples < 0 or seed < 0:
@@ -392,15 +406,8 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
         Q = sample_configurations(lower, upper, samples, seed)
         coll, decided_at, undecided = _sample(checker, len(candidates), active, Q, samples, stats)
         stats["samples_run"] = samples if undecided else max(decided_at, default=0)
-        for k, p in enumerate(candidates):
-            if p in reasons or samples == 0:  # Default; or no sampling asked for
-                continue
-            counts[p] = (coll[k], decided_at[k] or samples)
-            if coll[k] == 0:
-                reasons[p] = "Never"
-            elif coll[k] * 100 >= samples * ALWAYS_PERCENT:
-                reasons[p] = "Always"
-            # else: collides sometimes -> stays enabled
+        if samples:  # else no sampling was asked for
+            _classify(candidates, coll, decided_at, samples, reasons, counts)
         stats["exact_tests"] = checker.exact_tests
 
     disabled = tuple(Pair(a, b, reasons[(a, b)]) for a, b in all_pairs if (a, b) in reasons)
