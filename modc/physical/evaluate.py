@@ -4,7 +4,6 @@
     arm.tool(q)                       # T_base_tool, 4x4 (FK of tool0)
     arm.gravity(q)                    # g(q): the joint torques holding the arm still, N·m
     arm.collides(q)                   # any self- or environment collision at q
-    arm.collision(q)                  # the first colliding pair's names, or None
     evaluate(robot, q)                # tool pose, g(q) and collision at once: an Evaluation
                                       # (~1 ms for 6 DoF; benchmarks/bench_compile.py)
 
@@ -71,10 +70,6 @@ class Candidate:
         after a bounding-sphere filter (a sphere contains its mesh, so spheres apart means
         meshes apart: the filter changes no answer)."""
         return self._collisions().first(self, np.asarray(q, float)) is not None
-
-    def collision(self, q) -> tuple[str, str] | None:
-        """The first counted pair in collision at q (link, link or obstacle), or None."""
-        return self._collisions().first(self, np.asarray(q, float))
 
     def _collisions(self) -> _Collisions:
         if self._geometry is None:
