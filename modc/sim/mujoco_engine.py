@@ -11,7 +11,7 @@ The checks and messages are verdict.py's, as for PyBullet; what differs is the m
                 double precision, so 1e-9 as the URDF's consumers (the consumers' tolerance), not PyBullet's 1e-6.
     self        signed distances between the collision geoms of link pairs (mj_geomDistance on
                 the parts' primitives; the visual meshes never collide), pairs adjacent
-                (contacts.py's rule) or allowed by an SRDF skipped, deeper than CONTACT_TOL. The
+                or skipped by the collision matrix (smoke.allowed_pairs) left out, deeper than CONTACT_TOL. The
                 MJCF excludes every SRDF pair from MuJoCo's own contacts, "Never" pairs too; the
                 check asks the geometry directly, so a pose that brings a "Never" pair into
                 contact is still reported.

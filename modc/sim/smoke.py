@@ -11,10 +11,11 @@ static bodies), then:
     FK          PyBullet's tool0 frame equals modc.kinematics (docs/conventions.md) to FK_POS_TOL /
                 FK_ROT_TOL: the pip wheel of PyBullet computes in single precision, so 1e-6 m and
                 1e-5 (rotation-matrix entries), not the 1e-9 the double-precision consumers meet.
-    self        no two links collide, except adjacent ones (parent-child, and neighbours of a
-                link without geometry such as tool0) and, when an SRDF is given, the pairs it
-                disables as Adjacent / Default / Always ("Never" pairs are checked: they are
-                disabled for MoveIt's speed, a pose that brings them into contact is a collision).
+    self        no two links collide, except the pairs the collision matrix skips (in memory, as
+                `modc plan`; or the SRDF of --srdf-from OUT): Adjacent (parent-child, and
+                neighbours of a link without geometry such as tool0) / Default / Always ("Never"
+                pairs are checked: they are disabled for MoveIt's speed, a pose that brings them
+                into contact is a collision).
     environment no link is inside an obstacle.
     hold        the joints are put at the pose at rest, every actuator holds its target with
                 POSITION_CONTROL (force = the URDF effort = the actuator's peak torque,
