@@ -81,6 +81,33 @@ def matrix_rpy(R: np.ndarray) -> tuple[float, float, float]:
     return roll, pitch, yaw
 
 
+def rotation_vector(R: np.ndarray) -> np.ndarray:
+    """Axis times angle (log map) of rotation matrices (..., 3, 3) -> (..., 3), accurate up to 180°.
+
+    The home of "how far is one orientation from another"; plan/ik.py (rotation_vector) and
+    design/batch.py (rotation_error) still carry copies, which tests/test_concepts.py checks equal."""
+    R = np.asarray(R, float)
+    v = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
+    cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos)
+    sin = np.linalg.norm(v, axis=-1)
+    out = v * np.where(sin > 1e-9, angle / np.maximum(sin, 1e-12), 1.0)[..., None]  # near identity: v itself
+    # near 180° the skew part vanishes: the axis comes from the symmetric part
+    near_pi = (cos < -0.999) & (sin < 1e-3)
+    if np.any(near_pi):
+        B = (R[near_pi] + np.eye(3)) / 2.0
+        k = np.argmax(np.diagonal(B, axis1=-2, axis2=-1), axis=-1)
+        axis = B[np.arange(len(k)), :, k]
+        out[near_pi] = axis / np.linalg.norm(axis, axis=-1, keepdims=True) * angle[near_pi][:, None]
+    return out
+
+
+def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """The turn (rotation vector, in base_link axes) that brings R onto R_target; its norm is the
+    angle between the two orientations, rad."""
+    return rotation_vector(np.asarray(R_target, float) @ np.swapaxes(np.asarray(R, float), -1, -2))
+
+
 @dataclass(frozen=True)
 class UnitGeometry:
     """The numbers eqs. (4)-(6) need for one unit, resolved from the library."""
@@ -121,12 +148,6 @@ class Chain:
         """Joint frame of unit i -> its last frame (twist2 for units 3/4, itself for 1/2)."""
         u = self.units[i]
         return A_t2(u.port, u.x23) if u.has_link else np.eye(4)
-
-    def T_parent_joint(self, i: int) -> np.ndarray:
-        """Joint i's origin (q_i = 0) in the frame of the link before it (base_link for i = 0)."""
-        T = np.eye(4) if i == 0 else self.T_joint_end(i - 1)
-        u = self.units[i]
-        return T @ self.T_unit_twist1(i) @ A_J(0.0, u.z12)
 
     def T_last_tool(self) -> np.ndarray:
         """Last joint frame -> tool0."""

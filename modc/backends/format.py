@@ -1,13 +1,7 @@
-"""Number formatting shared by text backends: deterministic, no '-0', enough digits for 1e-9 FK."""
+"""Number formatting shared by text backends; its home is modc/formatting.py (passes and
+analyses below the backends format the same way), re-exported here for the backends."""
 from __future__ import annotations
 
-from collections.abc import Iterable
+from ..formatting import num, vec
 
-
-def num(x: float) -> str:
-    s = f"{float(x):.12g}"
-    return "0" if s in ("-0", "0") else s
-
-
-def vec(xs: Iterable[float]) -> str:
-    return " ".join(num(x) for x in xs)
+__all__ = ["num", "vec"]

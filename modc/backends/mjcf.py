@@ -48,15 +48,14 @@ from .._version import __version__
 from ..kinematics import matrix_rpy, transform
 from ..model import Robot
 from ..physical.assembly import Description
+from ..physical.constants import GRAVITY_VECTOR, TIME_STEP
 from ..physical.parts import Primitive
-from ..physical.statics import G
 from . import Build, register
 from . import format as fmt
 from .srdf import collision_matrix
 from .templates import comment, render
 from .urdf import MATERIALS
 
-TIME_STEP = 1e-3  # s, as `modc sim`
 ERROR_AT_PEAK = 0.005  # rad of position error at which a servo reaches the actuator's peak torque
 ARMATURE = 1e-3  # kg·m², reflected rotor inertia per joint (numerical regularisation, see above)
 TOOL_SITE_RADIUS = 0.005  # m
@@ -192,7 +191,7 @@ def context(build: Build, robot: Robot) -> dict:
     return {
         "name": robot.file_stem, "robot": comment(robot.name), "sequence": comment(robot.sequence),
         "source": comment(build.source_name), "library": comment(robot.library.name if robot.library else ""),
-        "version": __version__, "timestep": num(TIME_STEP), "gravity": vec(G),
+        "version": __version__, "timestep": num(TIME_STEP), "gravity": vec(GRAVITY_VECTOR),
         "armature": num(ARMATURE), "visual_group": VISUAL_GROUP, "collision_group": COLLISION_GROUP,
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()],
         "meshes": _assets(desc), "bodies": _bodies(desc, robot),

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from .._version import __version__
 from ..kinematics import rpy_matrix
 from ..physical.assembly import kdl_root
+from ..physical.constants import ACCEL_RAMP_TIME  # the acceleration limits
 from .build import Build
 from .common import BASE_LINK, GROUP, urdf_context
 from .format import num
@@ -63,9 +64,6 @@ GOAL_TIME = 0.6  # s
 GOAL_TOLERANCE = 0.05  # rad (about 3 degrees)
 PATH_TOLERANCE = 0.0  # rad, 0 = not checked
 STOPPED_VELOCITY_TOLERANCE = 0.05  # rad/s
-# Acceleration limits: neither the paper nor Kinova's table gives one. We allow each actuator to
-# reach its rated speed in ACCEL_RAMP_TIME, i.e. max_acceleration = max_velocity / 0.5 s.
-ACCEL_RAMP_TIME = 0.5  # s
 # MoveIt's own defaults (Setup Assistant): plans run at 10 % of the limits until the user scales up.
 VELOCITY_SCALING = 0.1
 ACCELERATION_SCALING = 0.1

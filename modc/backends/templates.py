@@ -4,7 +4,7 @@ Escaping is done here, by construction, not by each backend:
 - XML templates (names ending in XML_TEMPLATES) autoescape every value: a value that is already
   XML or a trusted xacro expression must be passed as markupsafe.Markup, built from checked parts;
 - every comment of every output (XML, xacro, YAML, launch, CMake) takes text from outside through
-  comment(), and XML text content through text_line();
+  comment(); XML text content (package.xml's description, maintainer) by autoescape alone;
 - names are identifiers (modc.names), so nothing else reaches a name position; scene_token() keeps
   MoveIt's line-based .scene format one token per line anyway.
 """
@@ -58,13 +58,6 @@ def render(name: str, context: dict) -> str:
 
 
 _EXPANDS = re.compile(r"\$(?=[{(])")  # ${...} (xacro, roslaunch) and $(...) (xacro, roslaunch substitution args)
-
-
-def text_line(text: str) -> str:
-    """Text from outside as XML text content (package.xml's description): one line, control and
-    line-breaking characters escaped (\\n, \\x01), which XML cannot hold, and no "${" or "$("
-    (no output carries an expression from user text); autoescape does <, &."""
-    return _EXPANDS.sub("$ ", "".join(c if c.isprintable() or c == " " else ascii(c)[1:-1] for c in text))
 
 
 def comment(text: str) -> str:

@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass, field
 
 from ..diagnostics import Diagnostic, codes
+from ..formatting import angle
 from ..model import Robot, Transform, UnitSpec
 from ..model.library import Library
 
@@ -37,10 +38,6 @@ class Conversion:
     units: tuple[UnitSpec, ...]
     tool: Transform
     diagnostics: list[Diagnostic] = field(default_factory=list)
-
-
-def _deg(x: float) -> str:
-    return f"{math.degrees(x):.6g}deg"
 
 
 def structure(robot: Robot, lib: Library) -> Conversion:
@@ -59,8 +56,8 @@ def structure(robot: Robot, lib: Library) -> Conversion:
         real = math.radians(ts.nearest(math.degrees(alpha)))
         wrapped = math.remainder(alpha - real, 2 * math.pi)
         if abs(wrapped) > 1e-9:
-            diags.append(codes.TWIST_ROUNDED.at(rows[i].span, row=i + 1, requested=f"{alpha:.6g} rad ({_deg(alpha)})",
-                                                realised=_deg(real), where=where, step=f"{ts.step_deg:g}deg"))
+            diags.append(codes.TWIST_ROUNDED.at(rows[i].span, row=i + 1, requested=f"{alpha:.6g} rad ({angle(alpha)})",
+                                                realised=angle(real), where=where, step=f"{ts.step_deg:g}deg"))
         return real
 
     for i, r in enumerate(rows):

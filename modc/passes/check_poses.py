@@ -4,12 +4,9 @@ from __future__ import annotations
 import math
 
 from ..diagnostics import codes
+from ..formatting import angle
 from ..model import Design
 from .context import Context
-
-
-def _deg(x: float) -> str:
-    return f"{math.degrees(x):.6g}deg"
 
 
 def run(design: Design, ctx: Context) -> Design:
@@ -24,13 +21,13 @@ def run(design: Design, ctx: Context) -> Design:
                 continue
             if not lim.lower < lim.upper:
                 ctx.report(
-                    codes.LIMIT_ORDER.at(lim.span, joint=lim.joint, low=_deg(lim.lower), high=_deg(lim.upper)), r
+                    codes.LIMIT_ORDER.at(lim.span, joint=lim.joint, low=angle(lim.lower), high=angle(lim.upper)), r
                 )
                 continue
             v = lib.variants[r.units[joints[lim.joint] - 1].variant]
             hlo, hhi = math.radians(v.lower_deg), math.radians(v.upper_deg)
-            bounds = {"joint": lim.joint, "low": _deg(lim.lower), "high": _deg(lim.upper), "hlow": _deg(hlo),
-                      "hhigh": _deg(hhi)}
+            bounds = {"joint": lim.joint, "low": angle(lim.lower), "high": angle(lim.upper), "hlow": angle(hlo),
+                      "hhigh": angle(hhi)}
             if lim.upper <= hlo or lim.lower >= hhi:
                 ctx.report(codes.LIMIT_DISJOINT.at(lim.span, **bounds), r)
             elif lim.lower < hlo - 1e-12 or lim.upper > hhi + 1e-12:
@@ -43,5 +40,5 @@ def run(design: Design, ctx: Context) -> Design:
                 lo, hi = r.joint_range(i)
                 if lo < hi and not (lo - 1e-12 <= q <= hi + 1e-12):
                     ctx.report(codes.POSE_OUT_OF_LIMITS.at(
-                        pose.span, name=pose.name, joint=i, value=_deg(q), low=_deg(lo), high=_deg(hi)), r)
+                        pose.span, name=pose.name, joint=i, value=angle(q), low=angle(lo), high=angle(hi)), r)
     return design

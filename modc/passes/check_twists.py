@@ -4,19 +4,16 @@ from __future__ import annotations
 import math
 
 from ..diagnostics import codes
+from ..formatting import degrees
 from ..model import Design
 from ..model.library import TwistSet
 from .context import Context
 
 
-def _deg(x: float) -> str:
-    return f"{x:.6g}deg"
-
-
 def _reason(ts: TwistSet, deg: float) -> str:
     if not ts.wraps and not (ts.min_deg - 1e-9 <= deg <= ts.max_deg + 1e-9):
-        return f"the range is {_deg(ts.min_deg)}..{_deg(ts.max_deg)}"
-    return f"it is set in steps of {_deg(ts.step_deg)}"
+        return f"the range is {degrees(ts.min_deg)}..{degrees(ts.max_deg)}"
+    return f"it is set in steps of {degrees(ts.step_deg)}"
 
 
 def run(design: Design, ctx: Context) -> Design:
@@ -31,6 +28,6 @@ def run(design: Design, ctx: Context) -> Design:
                 deg = math.degrees(getattr(u, param))
                 if not ts.realisable(deg):
                     ctx.report(codes.TWIST_NOT_REALISABLE.at(
-                        u.param_spans[param], what=f"{u.name} {param}", value=_deg(deg),
-                        reason=_reason(ts, deg), nearest=_deg(ts.nearest(deg))), r)
+                        u.param_spans[param], what=f"{u.name} {param}", value=degrees(deg),
+                        reason=_reason(ts, deg), nearest=degrees(ts.nearest(deg))), r)
     return design

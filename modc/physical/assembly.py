@@ -13,7 +13,7 @@ import numpy as np
 from ..kinematics import A_J, A_t1, A_t2, transform
 from ..model import Robot, Transform
 from .inertia import Inertial, combine_groups, local_inertial, sphere
-from .parts import Part, unit_parts
+from .parts import Part, unit_mass, unit_parts
 
 PAYLOAD_RADIUS = 0.02  # m: a payload is modelled as a solid sphere this size around its centre of mass
 # tool0 is a frame, not a body, but PyBullet gives a link without <inertial> 1 kg and unit
@@ -91,7 +91,8 @@ class Description:
 
     @property
     def total_mass(self) -> float:
-        """Mass of the arm and payload (the tool0 frame's placeholder inertial excluded)."""
+        """Mass of the arm and payload (the tool0 frame's placeholder inertial excluded), summed from
+        the links' inertials: deliberately not library_mass(), which it is tested against."""
         return sum(link.inertial.mass for link in self.links if link.inertial is not None and link.name != "tool0")
 
 
@@ -229,7 +230,7 @@ def library_mass(robot: Robot) -> float:
     """What the library says the arm weighs (with payload): the check on describe()'s inertials."""
     lib = robot.library
     assert lib is not None
-    m = sum(p.mass for u in robot.units for p in unit_parts(lib, u.variant, u.kind, robot.link_length(u)))
+    m = sum(unit_mass(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units)
     return m + (robot.payload.mass if robot.payload else 0.0)
 
 

@@ -58,6 +58,10 @@ CHUNK = 4096  # samples per broad-phase batch (bounds memory for large sample co
 SPHERE_MARGIN = 1e-3  # m: bounding spheres closer than this count as touching (the filter errs towards testing meshes)
 
 REASONS = ("Adjacent", "Default", "Always", "Never")
+# Which pairs a collision check skips: the one rule of `modc plan`, `modc sim` (both engines) and
+# the viewer. "Never" pairs stay checked: never colliding in the samples is MoveIt's shortcut for
+# speed, not a promise, so a pose that brings them into contact is a real collision.
+UNCHECKED_REASONS = ("Adjacent", "Default", "Always")
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,11 @@ class CollisionMatrix:
     @property
     def links_without_geometry(self) -> tuple[str, ...]:
         return tuple(name for name in self.links if name not in self.geometry_links)
+
+    def unchecked(self) -> set[frozenset[str]]:
+        """The pairs a collision check skips (UNCHECKED_REASONS); every other pair of links with
+        geometry is checked."""
+        return {frozenset((p.link1, p.link2)) for p in self.disabled if p.reason in UNCHECKED_REASONS}
 
     def reason(self, a: str, b: str) -> str | None:
         for p in self.disabled:
@@ -313,6 +322,62 @@ class _Checker:
         return bool(self.pin.computeCollisions(sub, sub_data, True))
 
 
+def _sample(checker: _Checker, n: int, active: list[int], Q: np.ndarray, samples: int,
+            stats: dict[str, int]) -> tuple[list[int], list[int], bool]:
+    """Run the sampled configurations, a chunk at a time, over the candidate pairs still active
+    until each one's reason is certain. Per candidate: how many samples collided, and after how
+    many samples its reason was certain (0: it never was); and whether any pair stayed undecided."""
+    coll = [0] * n
+    decided_at = [0] * n  # how many samples a pair saw before its reason was certain (0: all)
+    free_limit = samples * (100 - ALWAYS_PERCENT)  # free * 100 > this -> not Always
+    always_at = samples * ALWAYS_PERCENT  # coll * 100 >= this -> Always
+    pending: list[int] = []  # active pairs seen colliding: they wait for > 5 % free samples
+    for start in range(0, samples, CHUNK):
+        if not active:
+            break
+        mask = checker.broad_phase(Q[start:start + CHUNK])
+        for r in np.flatnonzero(mask.any(axis=1)).tolist():  # samples where some spheres touch
+            i = start + r
+            if not active:
+                break
+            row = mask[r]
+            flagged = [k for k in active if row[k]]
+            if flagged:
+                checker.set_configuration(Q[i])
+            changed = False
+            for k in flagged:
+                stats["broad_phase_hits"] += 1
+                if checker.collides(k):
+                    if not coll[k]:
+                        pending.append(k)
+                    coll[k] += 1
+                    if coll[k] * 100 >= always_at:
+                        decided_at[k] = i + 1
+                        changed = True
+            for k in pending:  # samples 0..i seen: i + 1 - coll[k] of them free
+                if not decided_at[k] and (i + 1 - coll[k]) * 100 > free_limit:
+                    decided_at[k] = i + 1
+                    changed = True
+            if changed:
+                active = [k for k in active if not decided_at[k]]
+                pending = [k for k in pending if not decided_at[k]]
+    return coll, decided_at, bool(active)
+
+
+def _classify(candidates: list[tuple[str, str]], coll: list[int], decided_at: list[int], samples: int,
+              reasons: dict[tuple[str, str], str], counts: dict[tuple[str, str], tuple[int, int]]) -> None:
+    """Never or Always from the sampled counts, for the candidates without a reason yet (not
+    Default); a pair that collides sometimes stays enabled. Fills reasons and counts."""
+    for k, p in enumerate(candidates):
+        if p in reasons:
+            continue
+        counts[p] = (coll[k], decided_at[k] or samples)
+        if coll[k] == 0:
+            reasons[p] = "Never"
+        elif coll[k] * 100 >= samples * ALWAYS_PERCENT:
+            reasons[p] = "Always"
+
+
 def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_SEED) -> CollisionMatrix:
     """Classify every pair of links with collision geometry (see the module docstring)."""
     if samples < 0 or seed < 0:
@@ -339,51 +404,10 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
         active = [k for k, p in enumerate(candidates) if p not in reasons]
         stats["sampled_pairs"] = len(active)
         Q = sample_configurations(lower, upper, samples, seed)
-        n = len(candidates)
-        coll = [0] * n
-        decided_at = [0] * n  # how many samples a pair saw before its reason was certain (0: all)
-        free_limit = samples * (100 - ALWAYS_PERCENT)  # free * 100 > this -> not Always
-        always_at = samples * ALWAYS_PERCENT  # coll * 100 >= this -> Always
-        pending: list[int] = []  # active pairs seen colliding: they wait for > 5 % free samples
-        for start in range(0, samples, CHUNK):
-            if not active:
-                break
-            mask = checker.broad_phase(Q[start:start + CHUNK])
-            for r in np.flatnonzero(mask.any(axis=1)).tolist():  # samples where some spheres touch
-                i = start + r
-                if not active:
-                    break
-                row = mask[r]
-                flagged = [k for k in active if row[k]]
-                if flagged:
-                    checker.set_configuration(Q[i])
-                changed = False
-                for k in flagged:
-                    stats["broad_phase_hits"] += 1
-                    if checker.collides(k):
-                        if not coll[k]:
-                            pending.append(k)
-                        coll[k] += 1
-                        if coll[k] * 100 >= always_at:
-                            decided_at[k] = i + 1
-                            changed = True
-                for k in pending:  # samples 0..i seen: i + 1 - coll[k] of them free
-                    if not decided_at[k] and (i + 1 - coll[k]) * 100 > free_limit:
-                        decided_at[k] = i + 1
-                        changed = True
-                if changed:
-                    active = [k for k in active if not decided_at[k]]
-                    pending = [k for k in pending if not decided_at[k]]
-        stats["samples_run"] = samples if active else max(decided_at, default=0)
-        for k, p in enumerate(candidates):
-            if p in reasons or samples == 0:  # Default; or no sampling asked for
-                continue
-            counts[p] = (coll[k], decided_at[k] or samples)
-            if coll[k] == 0:
-                reasons[p] = "Never"
-            elif coll[k] * 100 >= always_at:
-                reasons[p] = "Always"
-            # else: collides sometimes -> stays enabled
+        coll, decided_at, undecided = _sample(checker, len(candidates), active, Q, samples, stats)
+        stats["samples_run"] = samples if undecided else max(decided_at, default=0)
+        if samples:  # else no sampling was asked for
+            _classify(candidates, coll, decided_at, samples, reasons, counts)
         stats["exact_tests"] = checker.exact_tests
 
     disabled = tuple(Pair(a, b, reasons[(a, b)]) for a, b in all_pairs if (a, b) in reasons)
@@ -467,6 +491,6 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
                            {"pairs": len(all_pairs), "mesh_pairs": len(owner)})
 
 
-__all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "CollisionMatrix", "Geometry", "Pair",
-           "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive", "default_configuration",
-           "geometry", "joint_limits", "load", "sample_configurations"]
+__all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "UNCHECKED_REASONS", "CollisionMatrix",
+           "Geometry", "Pair", "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive",
+           "default_configuration", "geometry", "joint_limits", "load", "sample_configurations"]

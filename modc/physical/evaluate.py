@@ -4,7 +4,6 @@
     arm.tool(q)                       # T_base_tool, 4x4 (FK of tool0)
     arm.gravity(q)                    # g(q): the joint torques holding the arm still, N·m
     arm.collides(q)                   # any self- or environment collision at q
-    arm.collision(q)                  # the first colliding pair's names, or None
     evaluate(robot, q)                # tool pose, g(q) and collision at once: an Evaluation
                                       # (~1 ms for 6 DoF; benchmarks/bench_compile.py)
 
@@ -13,12 +12,15 @@ and the same pinocchio model and collision meshes the analyses use (modc.physica
 so a design the search ranks first compiles to exactly the arm it evaluated. Nothing is
 written or parsed; coal's BVH models are built once per part and shared by every candidate.
 
-Collisions at one pose are judged as the SRDF judges them without sampling: pairs of links
+Collisions at one pose are judged by the rule of CollisionMatrix.unchecked (physical/collisions.py)
+without its sampling, which costs too much per candidate: pairs of links
 joined by a joint (after collapsing links without geometry) never count, nor do pairs that
 touch in the default configuration (MoveIt's default joint values: touching by construction);
 every other pair of links, and every link but base_link against every obstacle of the file,
 does. base_link against an obstacle is the same in every pose, so it is not counted here (the
-planner's CollisionChecker.static_contacts reports it). The collision model is built on the
+planner's CollisionChecker.static_contacts reports it). Only "Always" pairs, which need the
+samples, are counted here and skipped by the rule: tests/test_evaluate.py compares both on arms
+without them. The collision model is built on the
 first query (about 0.4 ms), so arms rejected on reach or torque never pay for it.
 """
 from __future__ import annotations
@@ -68,10 +70,6 @@ class Candidate:
         after a bounding-sphere filter (a sphere contains its mesh, so spheres apart means
         meshes apart: the filter changes no answer)."""
         return self._collisions().first(self, np.asarray(q, float)) is not None
-
-    def collision(self, q) -> tuple[str, str] | None:
-        """The first counted pair in collision at q (link, link or obstacle), or None."""
-        return self._collisions().first(self, np.asarray(q, float))
 
     def _collisions(self) -> _Collisions:
         if self._geometry is None:

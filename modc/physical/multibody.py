@@ -22,11 +22,12 @@ import numpy as np
 from ..kinematics import rpy_matrix
 from ..model import Robot
 from .assembly import Description
+from .constants import GRAVITY_VECTOR
 from .meshes import tessellate
 from .parts import Part
 
 ROOT = "base_link"
-G_WORLD = np.array([0.0, 0.0, -9.81])  # m/s², world z up
+G_WORLD = np.array(GRAVITY_VECTOR)  # m/s², world z up
 
 
 def gravity(robot: Robot) -> np.ndarray:

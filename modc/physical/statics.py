@@ -1,9 +1,14 @@
 """Static gravity torques of an assembled arm (numpy; no dynamics library needed).
 
 tau_i(q) = -z_i . sum_{bodies j after joint i} (c_j - p_i) x (m_j g): the torque holding the arm still,
-base_link upright (g = -9.81 z); the same convention as pinocchio's g(q).
-Used to choose H or L modules when converting DH tables, where only a ranking is needed; the
-`check` command refines worst cases further.
+g as seen in base_link (multibody.gravity: the base may be tilted); the same convention as pinocchio's g(q).
+
+The reference for gravity torques is pinocchio's g(q) on the multibody model (dynamics.Dynamics
+and physical.evaluate.Candidate, both multibody.model with multibody.gravity). This numpy copy is
+kept on purpose: DH conversion runs inside `modc lint`, which imports no pinocchio (0.2 s), and
+only needs a ranking. tests/test_concepts.py checks that it equals the reference, and that
+worst() (random samples, used to choose H or L modules) is a lower bound of the refined search
+of dynamics/worst.py that the `check` command and the torque pass report.
 """
 from __future__ import annotations
 
@@ -12,14 +17,14 @@ import numpy as np
 from ..kinematics import Chain
 from ..model import Robot
 from .assembly import describe
-
-G = np.array([0.0, 0.0, -9.81])
+from .multibody import gravity
 
 
 class Statics:
     def __init__(self, robot: Robot):
         self.robot = robot
         self.chain = Chain(robot)
+        self.g = gravity(robot)
         desc = describe(robot)
         by_name = {link.name: link for link in desc.links}
         # bodies rigid with link_i (i = 1..n), payload folded into link_n at its tool0 offset
@@ -48,7 +53,7 @@ class Statics:
         tau = np.empty(n)
         for i in range(n):
             F = (M[i:, None] * (C[i:] - P[i])).sum(axis=0)
-            tau[i] = -(Z[i] @ np.cross(F, G))  # the torque that holds the arm against gravity (pinocchio's g(q))
+            tau[i] = -(Z[i] @ np.cross(F, self.g))  # the torque that holds the arm against gravity (pinocchio's g(q))
         return tau
 
     def worst(self, samples: int = 256, seed: int = 0) -> np.ndarray:

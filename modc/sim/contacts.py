@@ -7,9 +7,10 @@ apart is apart; a pair found in contact may only touch the hull of a concave par
 casings and twist units are concave). Contacts are reported only beyond CONTACT_TOL of
 penetration: surfaces that merely touch (float32 geometry) are not collisions.
 
-Adjacent links (never checked against each other): parent and child of a joint; links without
-collision geometry (tool0, payload) are collapsed first, so their neighbours become adjacent
-(MoveIt's rule, as in the SRDF backend).
+Which pairs are checked is physical/collisions.py's rule, the one `modc plan` and the SRDF use:
+links with geometry, not adjacent (parent and child of a joint, after collapsing links without
+collision geometry such as tool0 and payload: MoveIt's rule), and not a pair the collision matrix
+skips (CollisionMatrix.unchecked: Adjacent, Default, Always; "Never" pairs stay checked).
 """
 from __future__ import annotations
 
@@ -46,17 +47,12 @@ class CollisionQueries:
 
     def adjacent_pairs(self) -> set[frozenset[str]]:
         """Parent-child pairs, after collapsing links without collision geometry (tool0,
-        payload): their neighbours become adjacent to each other."""
-        nbrs: dict[str, set[str]] = {n: set() for n in self.links}
-        for child, parent in self.parents.items():
-            nbrs[child].add(parent)
-            nbrs[parent].add(child)
-        for bare in [n for n in self.links if n not in self.geometry_links]:
-            around = nbrs.pop(bare)
-            for a in around:
-                nbrs[a].discard(bare)
-                nbrs[a] |= around - {a}
-        return {frozenset((a, b)) for a, bs in nbrs.items() for b in bs}
+        payload): their neighbours become adjacent to each other (the SRDF's rule, one home)."""
+        from ..physical.collisions import adjacent_pairs
+
+        has = set(self.geometry_links)
+        edges = [(parent, child) for child, parent in self.parents.items()]
+        return adjacent_pairs(tuple(self.links), edges, lambda name: name in has)
 
     def self_collision_pairs(self, allowed: Iterable[Iterable[str]] = ()) -> list[tuple[str, str]]:
         """Link pairs to check: links with geometry, not adjacent, not in `allowed`."""

@@ -11,7 +11,7 @@ The checks and messages are verdict.py's, as for PyBullet; what differs is the m
                 double precision, so 1e-9 as the URDF's consumers (the consumers' tolerance), not PyBullet's 1e-6.
     self        signed distances between the collision geoms of link pairs (mj_geomDistance on
                 the parts' primitives; the visual meshes never collide), pairs adjacent
-                (contacts.py's rule) or allowed by an SRDF skipped, deeper than CONTACT_TOL. The
+                or skipped by the collision matrix (smoke.allowed_pairs) left out, deeper than CONTACT_TOL. The
                 MJCF excludes every SRDF pair from MuJoCo's own contacts, "Never" pairs too; the
                 check asks the geometry directly, so a pose that brings a "Never" pair into
                 contact is still reported.
@@ -217,11 +217,11 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
              hold_time: float = HOLD_TIME) -> list[RobotResult]:
     """Every (or the named) robot of a checked design without errors (as smoke.simulate)."""
     from .scene import compiled, select_robots
-    from .smoke import allowed_from_srdf
+    from .smoke import allowed_pairs
 
     robots = select_robots(checked, robot)
     with compiled(checked, "mjcf") as xmls:
-        return [simulate_robot(r, xmls[r.name], allowed_from_srdf(out_dir, r), hold_time) for r in robots]
+        return [simulate_robot(r, xmls[r.name], allowed_pairs(out_dir, r), hold_time) for r in robots]
 
 
 __all__ = ["ENGINE", "FK_TOL", "MujocoScene", "import_mujoco", "load", "simulate", "simulate_robot"]

@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..physical.constants import TIME_STEP
 from . import scene, trajectory
 from .render import Stage
-from .smoke import TIME_STEP
 
 FPS = 12.5  # frames per second of simulated time (80 ms: a whole number of GIF centiseconds)
 GIF_SIZE = (640, 480)

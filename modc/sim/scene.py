@@ -31,12 +31,12 @@ from typing import TYPE_CHECKING, Any
 
 from ..model import Robot
 from ..physical.cell import MODULE_RADIUS, OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA, extent_points  # noqa: F401  (one home: physical/)
+from ..physical.constants import GRAVITY
 from .contacts import CollisionQueries
 
 if TYPE_CHECKING:
     import numpy as np
 
-GRAVITY = 9.81  # m/s², the value modc.dynamics uses
 
 
 class UsageError(Exception):
@@ -333,12 +333,6 @@ class Scene(CollisionQueries):
         import numpy as np
 
         return np.linalg.inv(self.T_world_base) @ self.T_world_link(name)
-
-    def link_origins_world(self):
-        """Every link frame's origin in the world (for framing a camera)."""
-        import numpy as np
-
-        return np.array([self.T_world_link(n)[:3, 3] for n in self.links])
 
     def remove(self) -> None:
         for b in [self.body, *self.obstacles.values(), *self.targets.values()]:

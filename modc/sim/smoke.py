@@ -11,10 +11,11 @@ static bodies), then:
     FK          PyBullet's tool0 frame equals modc.kinematics (docs/conventions.md) to FK_POS_TOL /
                 FK_ROT_TOL: the pip wheel of PyBullet computes in single precision, so 1e-6 m and
                 1e-5 (rotation-matrix entries), not the 1e-9 the double-precision consumers meet.
-    self        no two links collide, except adjacent ones (parent-child, and neighbours of a
-                link without geometry such as tool0) and, when an SRDF is given, the pairs it
-                disables as Adjacent / Default / Always ("Never" pairs are checked: they are
-                disabled for MoveIt's speed, a pose that brings them into contact is a collision).
+    self        no two links collide, except the pairs the collision matrix skips (in memory, as
+                `modc plan`; or the SRDF of --srdf-from OUT): Adjacent (parent-child, and
+                neighbours of a link without geometry such as tool0) / Default / Always ("Never"
+                pairs are checked: they are disabled for MoveIt's speed, a pose that brings them
+                into contact is a collision).
     environment no link is inside an obstacle.
     hold        the joints are put at the pose at rest, every actuator holds its target with
                 POSITION_CONTROL (force = the URDF effort = the actuator's peak torque,
@@ -48,6 +49,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from ..physical.constants import GRAVITY, TIME_STEP
 from . import scene
 from .contacts import srdf_disabled_pairs
 from .verdict import (  # noqa: F401  (the tolerances are part of this module's story)
@@ -64,7 +66,6 @@ from .verdict import (  # noqa: F401  (the tolerances are part of this module's 
     judge_pose,
 )
 
-TIME_STEP = 1e-3  # s
 HOLD_TIME = 2.0  # s of simulated time per pose
 SETTLE_WINDOW = 0.5  # s: tracking is judged over the end of the hold
 WARNING_LINE = re.compile(r"warning|error|failed|cannot|unable", re.IGNORECASE)
@@ -103,7 +104,7 @@ def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOL
 
     res = RobotResult(robot.name, robot.sequence)
     client.resetSimulation()
-    client.setGravity(0, 0, -scene.GRAVITY)
+    client.setGravity(0, 0, -GRAVITY)
     client.setTimeStep(time_step)
     try:
         s = scene.load_robot(client, robot, urdf)
@@ -167,11 +168,18 @@ def _hold(client, s, qv, steps: int, window: int, time_step: float) -> Hold:
     return rec.hold(s.q(), s.applied_torques(), [s.limits[j][2] for j in s.joint_names])
 
 
-def allowed_from_srdf(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
-    if out_dir is None:
-        return set()
-    srdf = Path(out_dir) / "config" / f"{robot.file_stem}.srdf"
-    return srdf_disabled_pairs(srdf) if srdf.is_file() else set()
+def allowed_pairs(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
+    """The link pairs not checked for self-collision: the collision matrix in memory (the one the
+    SRDF backend writes and `modc plan` uses, with the same defaults), or, given a compile
+    output (--srdf-from OUT), the pairs its SRDF disables (compiled with other samples, say)."""
+    if out_dir is not None:
+        srdf = Path(out_dir) / "config" / f"{robot.file_stem}.srdf"
+        if srdf.is_file():
+            return srdf_disabled_pairs(srdf)
+    from ..physical.assembly import describe
+    from ..physical.collisions import cached_matrix
+
+    return cached_matrix(describe(robot)).unchecked()
 
 
 def simulate(checked, robot: str | None = None, out_dir: str | Path | None = None,
@@ -181,7 +189,7 @@ def simulate(checked, robot: str | None = None, out_dir: str | Path | None = Non
     results = []
     with scene.compiled(checked) as urdfs, scene.connect() as client:
         for r in robots:
-            results.append(simulate_robot(client, r, urdfs[r.name], allowed_from_srdf(out_dir, r), hold_time))
+            results.append(simulate_robot(client, r, urdfs[r.name], allowed_pairs(out_dir, r), hold_time))
     return results
 
 

@@ -12,9 +12,10 @@ The checks and their tolerances are explained in smoke.py's docstring.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
+
+from ..formatting import angle_text
 
 TRACK_TOL = 1e-2  # rad
 FK_POS_TOL = 1e-6  # m (PyBullet computes in single precision)
@@ -134,10 +135,6 @@ class HoldRecorder:
                     efforts=tuple(float(e) for e in efforts))
 
 
-def _deg(x: float) -> str:
-    return f"{math.degrees(x):.1f}°"
-
-
 def judge_pose(robot, m: Measured, chain, dyn, engine: str = "PyBullet",
                fk_tol: tuple[float, float] = (FK_POS_TOL, FK_ROT_TOL)) -> PoseResult:
     """Every check of one pose: FK against modc.kinematics (chain), collisions, the hold, and
@@ -215,7 +212,8 @@ def _hold_failures(robot, pr: PoseResult, h: Hold, qv, dyn, at: str, engine: str
         out.append(
             Failure(
                 "sag",
-                f"{at}: {name} sags {h.peak[j]:.2f} rad ({_deg(h.peak[j])}) from its target {_deg(qv[j])}: {why}",
+                f"{at}: {name} sags {h.peak[j]:.2f} rad ({angle_text(h.peak[j])}) "
+                f"from its target {angle_text(qv[j])}: {why}",
                 joint=name,
             )
         )

@@ -1,0 +1,143 @@
+"""One home per concept (issue 25, item 2): each shared value and helper has one definition,
+and the modules that use it take it from there rather than typing it again."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from modc import formatting
+from modc.physical import constants
+
+
+def test_numbers_and_angles_are_written_one_way():
+    assert formatting.num(-0.0) == "0" and formatting.num(1 / 3) == "0.333333333333"
+    assert formatting.vec([0.5, -1e-13, 2]) == "0.5 -1e-13 2"
+    assert formatting.angle(math.pi / 4) == "45deg" and formatting.angle(0.1) == "5.72958deg"
+    assert formatting.degrees(22.5) == "22.5deg"
+    assert formatting.angle_text(-math.pi / 2) == "-90.0°"
+
+
+def test_every_user_takes_the_formatting_from_its_home():
+    from modc.backends import format as backend_format
+    from modc.dh import convert
+    from modc.passes import check_poses, check_twists
+    from modc.sim import verdict
+
+    assert backend_format.num is formatting.num and backend_format.vec is formatting.vec
+    assert convert.angle is formatting.angle and check_poses.angle is formatting.angle
+    assert check_twists.degrees is formatting.degrees and verdict.angle_text is formatting.angle_text
+    for module in (convert, check_poses, check_twists, verdict):
+        assert not hasattr(module, "_deg")
+
+
+def test_gravity_and_time_step_have_one_value():
+    from modc.backends import mjcf
+    from modc.physical import multibody
+    from modc.sim import play, scene, smoke
+
+    assert constants.GRAVITY_VECTOR == (0.0, 0.0, -constants.GRAVITY)
+    assert np.array_equal(multibody.G_WORLD, constants.GRAVITY_VECTOR)
+    assert scene.GRAVITY is smoke.GRAVITY is constants.GRAVITY
+    assert smoke.TIME_STEP is play.TIME_STEP is mjcf.TIME_STEP is constants.TIME_STEP
+
+
+def test_the_acceleration_ramp_has_one_value():
+    from modc.backends import ros
+    from modc.plan import timing
+
+    assert ros.ACCEL_RAMP_TIME is constants.ACCEL_RAMP_TIME
+    assert timing.ACCEL_RAMP_TIME == constants.ACCEL_RAMP_TIME  # plan/timing.py's copy: to import it
+
+
+TILTED = ("robot r {\n    chain H1 - H3 - L1\n    payload 0.2 kg at (0, 0, 0.03) m\n"
+          "    base at (0, 0, 0) m rpy (90, 30, 0) deg\n}\n")
+
+
+def _robots():
+    from conftest import ROOT
+
+    from modc.compiler import check_file, check_text
+
+    (tilted,) = check_text(TILTED, "t.mod").design.robots
+    return [*(check_file(ROOT / "examples" / f"{s}.mod").design.robots[0] for s in ("example_b", "farm")), tilted]
+
+
+def test_the_numpy_statics_equal_pinocchios_gravity_torques_also_on_a_tilted_base():
+    pytest.importorskip("pinocchio")
+    from modc.dynamics.model import Dynamics
+    from modc.physical.statics import Statics
+
+    for robot in _robots():
+        statics, dyn = Statics(robot), Dynamics(robot)
+        for q in np.random.default_rng(7).uniform(dyn.lower, dyn.upper, size=(20, robot.dof)):
+            # the statics leave out tool0's placeholder inertial (1 mg): up to 1e-5 N·m on these arms
+            assert np.allclose(statics.torques(q), dyn.gravity(q), rtol=0, atol=2e-5)
+
+
+def test_the_sampled_worst_case_is_a_lower_bound_of_the_refined_search():
+    pytest.importorskip("pinocchio")
+    from modc.dynamics.model import Dynamics
+    from modc.dynamics.worst import worst_case
+    from modc.physical.statics import Statics
+
+    for robot in _robots():
+        sampled = Statics(robot).worst(samples=64)
+        refined = np.array([j.tau for j in worst_case(Dynamics(robot))])
+        assert np.all(sampled <= refined + 2e-5)
+        assert np.all(sampled >= 0.5 * refined)  # a ranking the DH conversion may rely on
+
+
+def _exp(v: np.ndarray) -> np.ndarray:
+    """Rodrigues: the rotation matrix of a rotation vector."""
+    a = float(np.linalg.norm(v))
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]]) / (a if a > 0 else 1.0)
+    return np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * K @ K
+
+
+def test_rotation_error_has_one_home_that_the_copies_equal():
+    from modc.design.batch import rotation_error as batched_copy
+    from modc.kinematics import rotation_error, rotation_vector
+    from modc.plan.ik import rotation_vector as ik_copy
+
+    rng = np.random.default_rng(11)
+    vs = [*rng.normal(size=(50, 3)), np.zeros(3), np.array([np.pi, 0, 0]), np.array([0, 1, 1]) / np.sqrt(2) * np.pi,
+          np.array([1e-10, 0, 0]), np.array([0, 0, np.pi - 1e-7])]
+    vs = [v if np.linalg.norm(v) <= np.pi else v / np.linalg.norm(v) * 3.0 for v in vs]
+    Rs = np.array([_exp(v) for v in vs])
+    got = rotation_vector(Rs)
+    for v, R, g in zip(vs, Rs, got, strict=True):
+        assert np.allclose(g, rotation_vector(R), atol=1e-12)  # one matrix or a batch: the same answer
+        assert np.allclose(g, ik_copy(R), atol=1e-9)
+        if np.linalg.norm(v) < np.pi - 1e-3:  # at 180°, v and -v are the same turn
+            assert np.allclose(g, v, atol=1e-7)
+        else:
+            assert np.allclose(_exp(g), R, atol=1e-6)
+    Rt = Rs[::-1]
+    assert np.allclose(rotation_error(Rt, Rs), batched_copy(Rt, Rs), atol=1e-12)
+
+
+def test_sim_skips_the_pairs_plan_and_the_srdf_skip_from_the_matrix_in_memory(tmp_path):
+    """`modc sim` without --srdf-from used to check every non-adjacent pair; it now takes the
+    collision matrix in memory, the one rule (CollisionMatrix.unchecked) plan and the SRDF use."""
+    pytest.importorskip("pinocchio")
+    from conftest import ROOT
+
+    from modc.compiler import build, check_file
+    from modc.files import write_files
+    from modc.physical.assembly import describe
+    from modc.physical.collisions import UNCHECKED_REASONS, cached_matrix
+    from modc.sim.contacts import srdf_disabled_pairs
+    from modc.sim.smoke import allowed_pairs
+
+    checked = check_file(ROOT / "examples" / "example_a.mod")
+    (robot,) = checked.design.robots
+    write_files(build(checked, ["srdf"]), tmp_path)
+    matrix = cached_matrix(describe(robot))
+    skipped = matrix.unchecked()
+    assert skipped and skipped == {frozenset((p.link1, p.link2)) for p in matrix.disabled if p.reason != "Never"}
+    assert set(UNCHECKED_REASONS) == {"Adjacent", "Default", "Always"}
+    assert allowed_pairs(None, robot) == skipped
+    assert allowed_pairs(tmp_path, robot) == srdf_disabled_pairs(tmp_path / "config" / f"{robot.file_stem}.srdf")
+    assert allowed_pairs(tmp_path, robot) == skipped
