@@ -10,7 +10,7 @@ trajectory playback (`modc play`).
     caption.py     caption bands and target labels on renders and GIF frames
     play.py        play(path, traj_json, record=None, engine=...) -> (ok, report lines, checked)
     mujoco_engine.py, mujoco_play.py   `sim` and `play` with --engine mujoco, on the MJCF scene
-    trajectory.py  the trajectory file of `plan --json` / `play --traj` (docs/conventions.md): load, validate
+    (the trajectory file of `plan --json` / `play --traj` is modc/trajectory.py, below plan and view)
 
 Frames: the world is the cell frame of `base …` (docs/language.md): each robot's base_link is put at
 robot.base, gravity is -z of the world, and obstacles and targets, which the file gives in

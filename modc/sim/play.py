@@ -22,8 +22,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .. import trajectory
 from ..physical.constants import TIME_STEP
-from . import scene, trajectory
+from . import scene
 from .render import Stage
 
 FPS = 12.5  # frames per second of simulated time (80 ms: a whole number of GIF centiseconds)
