@@ -2,7 +2,7 @@
 
     python benchmarks/bench_design.py                 # everything, Timor if installed
     python benchmarks/bench_design.py --quick         # smaller samples, no whole-library run
-    python benchmarks/bench_design.py --timor ROOT    # Timor's venv from shared/tools/timor-offline.sh
+    python benchmarks/bench_design.py --timor ROOT    # ROOT: a venv with timor-python installed (ROOT/bin/python)
     python benchmarks/bench_design.py --json [OUT]
 
 CPU figures are time.process_time() of this process pinned to one core (BLAS/OpenMP pools at one
@@ -16,7 +16,7 @@ thread), so other load on the machine does not count; wall figures are time.perf
                screened setting (CPU / settings that reached the IK), and the worst case where
                every candidate solves all three targets (the farm arm's twists, repeated).
    reference   the same screen written plainly: one candidate at a time, numpy on small arrays
-               (SPEC section 2 FK, DLS from the same 4 seeds, 40 iterations, the first target
+               (docs/conventions.md FK, DLS from the same 4 seeds, 40 iterations, the first target
                missed ends it), no bounds, no batching: CPU ms per candidate.
 2. solve       run.design (top 1) on the three-target cell with at most 3 modules: CPU s.
 3. complete    run.design on a cell where nothing is feasible, units 1 to 3, every unit type:
@@ -361,7 +361,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--timor", default=os.environ.get("TIMOR_ROOT", "/tmp/timor-offline"),
-                    help="the ROOT given to shared/tools/timor-offline.sh")
+                    help="a venv with timor-python installed (ROOT/bin/python)")
     ap.add_argument("--json", nargs="?", const="-", default=None)
     args = ap.parse_args()
     warnings.simplefilter("ignore")
@@ -408,7 +408,7 @@ def main() -> None:
                      f"{a['ik_solved']}/{3 * a['designs']} IK solved, warm-up excluded)")
         lines.append(f"ratio      {result['ratio']:.0f}x (Timor per design / modc per twist setting)")
     else:
-        lines.append(f"anchor     Timor not measured: {a or 'not installed (run shared/tools/timor-offline.sh)'}")
+        lines.append(f"anchor     Timor not measured: {a or 'not installed (give --timor ROOT, a venv with timor-python)'}")
     print("\n".join(lines), file=sys.stderr)
     if args.json is not None:
         text = json.dumps(result, indent=2)

@@ -1,5 +1,5 @@
 """The search is complete within its bounds: compared with a brute-force enumeration written
-here, independently of modc.design (its own forward kinematics from SPEC section 2's formula,
+here, independently of modc.design (its own forward kinematics from docs/conventions.md's formula,
 its own damped-least-squares IK), on cells small enough to enumerate; and the sound bounds never
 exclude a point some joint vector reaches."""
 from __future__ import annotations
@@ -37,7 +37,7 @@ def _rz(a):
 
 
 def fk(units, pivots, ports, q, tool=(0.0, 0.0, 0.0)):
-    """SPEC section 2: T = prod_i A_t1(pivot_i) A_J(theta_i) A_t2(port_i), then the tool offset.
+    """docs/conventions.md: T = prod_i A_t1(pivot_i) A_J(theta_i) A_t2(port_i), then the tool offset.
     A_t1 = (Ry(pivot), (x01, 0, z01)), A_J = (Rz(theta), (0, 0, z12)), A_t2 = (Rx(port), (x23, 0, 0)).
     Broadcasts over leading axes; returns tool0's position (..., 3)."""
     shape = np.broadcast_shapes(pivots.shape[:-1], q.shape[:-1])

@@ -1,6 +1,6 @@
 """`modc plan`'s target-unreachable says why (modc/plan/advice.py): too far, too close, orientation,
 joint limits; obstacles are target-in-collision. The numbers are checked independently with
-modc.kinematics.Chain (SPEC section 2) and random poses, not with the planner's pinocchio.
+modc.kinematics.Chain (docs/conventions.md) and random poses, not with the planner's pinocchio.
 """
 from __future__ import annotations
 

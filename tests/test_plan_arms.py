@@ -2,7 +2,7 @@
 chains, and every design `modc design` proposes for the examples. Whatever the arm, the answer
 is a plan that reaches the target or a diagnostic (never a traceback, never inf or nan).
 
-Reached is checked with modc.kinematics.Chain (SPEC section 2), not with the planner's pinocchio.
+Reached is checked with modc.kinematics.Chain (docs/conventions.md), not with the planner's pinocchio.
 """
 from __future__ import annotations
 

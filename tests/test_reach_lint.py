@@ -1,6 +1,6 @@
 """Reach at lint time (modc/passes/check_reach.py, warning target-out-of-reach).
 
-The bound is checked against modc.kinematics.Chain (numpy, SPEC section 2), which the pass does
+The bound is checked against modc.kinematics.Chain (numpy, docs/conventions.md), which the pass does
 not use: the pass's joint origins agree with Chain's, and in random poses of random arms tool0
 stays inside the shell the pass computes, so the warning never fires on a reachable target.
 """

@@ -1,4 +1,4 @@
-"""Tasks (SPEC section 4): regions, visit tasks, straight paths, base placement; `modc plan --task`.
+"""Tasks (docs/language.md): regions, visit tasks, straight paths, base placement; `modc plan --task`.
 
 The language tests are fast. The planning tests (marked slow) plan examples/farm_task.mod once
 and check the result independently: collisions with the compiler's collision model, joint limits,

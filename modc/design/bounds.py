@@ -1,7 +1,7 @@
 """Sound bounds: which twist settings (and which targets) no joint vector can serve, decided
 without IK, for thousands of settings at once.
 
-Written as SPEC section 2's chain between joint frames: J_0 = base_link, and for joint i the
+Written as docs/conventions.md's chain between joint frames: J_0 = base_link, and for joint i the
 frame after its rotation, J_i. From J_i to the next joint's frame before its rotation the
 transform K_i = POST_i . PRE_(i+1) is fixed by the twists (K_0 = PRE_1, K_n = POST_n . tool);
 p_i = the origin of J_i lies on joint i's axis. With v_j the tool relative to p_j in J_j,

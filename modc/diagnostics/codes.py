@@ -270,7 +270,7 @@ NONPOSITIVE_SIZE = _register("nonpositive-size", E, "an obstacle size, radius or
 UNKNOWN_ALLOW = _register("unknown-allow", E, "`allow` naming a code that cannot be silenced",
     "'{name}' cannot be allowed", "allowable codes: {allowable}")
 
-# --- tasks (region, task, path, base within; SPEC section 4) -----------------------------------
+# --- tasks (region, task, path, base within; docs/language.md) -----------------------------------
 REGION_GRID = _register("region-grid", E, "a region's grid that gives no points, or absurdly many",
     "{what}", "{hint}")
 UNKNOWN_TASK_TARGET = _register("unknown-task-target", E, "a task or path naming no target or region point",

@@ -1,4 +1,4 @@
-"""Lowering of the task statements (SPEC section 4): `region`, `task`, `path`, `base within`.
+"""Lowering of the task statements (docs/language.md): `region`, `task`, `path`, `base within`.
 
 Regions and the base grid are checked alone (sizes, counts, steps); tasks and paths once the
 block's targets and regions are known (every name resolves to a target or a region point, and

@@ -1,5 +1,5 @@
 """Time-optimal timing of a task's segments under every joint's speed and peak-torque limits
-(SPEC section 4: `cycle_time`, `energy`), by toppra (reachability analysis, Pham & Pham 2018)
+(docs/language.md: `cycle_time`, `energy`), by toppra (reachability analysis, Pham & Pham 2018)
 with pinocchio's inverse dynamics (RNEA) for the torque constraint.
 
     limits = Limits.of(robot)                      # rated speed (library RPM), peak torque

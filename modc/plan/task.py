@@ -1,8 +1,8 @@
-"""`modc plan FILE --task NAME`: plan and time a robot's whole task (SPEC sections 4 and 6).
+"""`modc plan FILE --task NAME`: plan and time a robot's whole task (docs/language.md, docs/conventions.md).
 
     from modc.plan.task import plan_task
     result = plan_task("examples/farm_task.mod", "serve")     # -> TaskPlan, or raises PlanError
-    sys.stdout.write(result.dumps())                           # one trajectory, SPEC section 6
+    sys.stdout.write(result.dumps())                           # one trajectory, docs/conventions.md
     print(result.summary())
 
 A `task NAME { visit a, b, … }` is an approach from the home pose to a, then one segment per
@@ -88,7 +88,7 @@ class TaskPlan:
         return Trajectory(self.joint_names, self.t, self.q, self.robot if self.with_robot_name else None)
 
     def dumps(self) -> str:
-        """SPEC section 6 plan JSON for the whole task, with the task's figures as extra keys."""
+        """docs/conventions.md plan JSON for the whole task, with the task's figures as extra keys."""
         import json
 
         text = self.trajectory.dumps()

@@ -74,7 +74,7 @@ TargetValue = Vector | TargetDoc
 
 
 class RegionDoc(_Doc):
-    """A grid of targets over a box (SPEC section 4: `region`)."""
+    """A grid of targets over a box (docs/language.md: `region`)."""
 
     size: Vector
     at: Vector
