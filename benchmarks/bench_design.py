@@ -408,7 +408,7 @@ def main() -> None:
                      f"{a['ik_solved']}/{3 * a['designs']} IK solved, warm-up excluded)")
         lines.append(f"ratio      {result['ratio']:.0f}x (Timor per design / modc per twist setting)")
     else:
-        lines.append(f"anchor     Timor not measured: {a or 'not installed (give --timor ROOT, a venv with timor-python)'}")
+        lines.append(f"anchor     Timor not measured: {a or 'not installed (--timor ROOT: a venv with timor-python)'}")
     print("\n".join(lines), file=sys.stderr)
     if args.json is not None:
         text = json.dumps(result, indent=2)
