@@ -95,19 +95,19 @@ def page_text(browser) -> str:
 LIT = 1200  # coloured pixels in the 3D view once the scene is lit (~400 while its lighting still loads)
 
 
-def settled(browser, timeout: float = 180) -> np.ndarray:
+def settled(browser, timeout: float = 180, lit: bool = True) -> np.ndarray:
     """The page's picture once it is lit (the client decodes its environment light after the
     meshes arrive: until then the scene is washed out) and has stopped changing: two
-    screenshots in a row alike."""
+    screenshots in a row alike. lit=False: a page already lit, showing little colour (the arm hidden)."""
     last = [browser.screenshot()]
 
     def still():
         img = browser.screenshot()
         same = img.shape == last[0].shape and (np.abs(img - last[0]).sum(axis=2) > 30).sum() < 20
         part = scene_part(img)
-        lit = ((part.max(axis=2) - part.min(axis=2)) > 60).sum() > LIT
+        coloured = ((part.max(axis=2) - part.min(axis=2)) > 60).sum() > LIT or not lit
         last[0] = img
-        return same and lit
+        return same and coloured
 
     _wait(still, timeout, "the picture to light up and settle", every=0.3)
     return last[0]
@@ -184,7 +184,7 @@ def arm_pixels(browser, view, before: np.ndarray, left: int) -> np.ndarray:
     for link in view._links.values():
         link.visible = False
     try:
-        return changed(before, settled(browser), left)
+        return changed(before, settled(browser, lit=False), left)
     finally:
         for link in view._links.values():
             link.visible = True
@@ -247,7 +247,7 @@ def test_page_shows_the_arm_framed_and_a_slider_moves_it(browser, tmp_path):
         boxes = []
         for name, label in view.labels.items():
             label.visible = False
-            gone = changed(before, settled(browser), left)
+            gone = changed(before, settled(browser, lit=False), left)
             label.visible = True
             assert gone.sum() > 30, f"no label for target {name}"
             ys, xs = np.nonzero(gone)
