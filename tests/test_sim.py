@@ -17,10 +17,11 @@ import numpy as np
 import pytest
 from conftest import EXAMPLES, ROOT
 
+from modc import trajectory
 from modc.compiler import COMPILE_ANALYSES, build, check_file, check_text
 from modc.kinematics import Chain
 from modc.model.select import RobotChoiceError
-from modc.sim import scene, smoke, trajectory
+from modc.sim import scene, smoke
 from modc.sim.play import play
 from modc.sim.render import render
 
