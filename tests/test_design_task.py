@@ -105,6 +105,7 @@ def test_modc_design_writes_the_timed_task(tmp_path):
         for i, v in enumerate(row, start=1):
             lo, hi = robot.joint_range(i)
             assert lo - 1e-9 <= v <= hi + 1e-9
+    assert "<th>cycle time (s)</th>" in (out / "report.html").read_text()
     # the segments after the approach add up to the cycle time
     plan = json.loads((out / d["traj"]).read_text())
     assert plan["task"] == "serve"
