@@ -91,7 +91,7 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
 
 def summary_line(o: Outcome) -> str:
     best = o.designs[0]
-    timed = f", cycle time {best.cycle_time:.3f} s, {best.energy:.1f} J" if best.plans else ""
+    timed = f", cycle time {best.cycle_time:.3f} s, {best.energy:.2f} J" if best.plans else ""
     return (f"{o.problem.name}: {len(o.designs)} designs from {o.evaluated:,} evaluated in {o.seconds:.1f} s; "
             f"best {best.chain()} ({best.modules} modules, {best.mass:.3f} kg, "
             f"margin {math.floor(best.margin * 100)} %{timed})")
