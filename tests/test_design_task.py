@@ -93,6 +93,7 @@ def test_modc_design_writes_the_timed_task(tmp_path):
     d = ranking["designs"][0]
     assert d["traj"] == "small_1.traj.json" and d["traj_task"] == "serve" and d["coverage"] == 1.0
     assert d["cycle_time_s"] > 0 and d["energy_j"] >= 0
+    assert d["base"] == {"xyz": [0.0, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}
     assert d["cycle_time_s"] == pytest.approx(sum(t["cycle_time_s"] for t in d["tasks"]), abs=1e-5)
     traj, errors = trajectory.load(out / d["traj"])
     assert traj is not None and not errors

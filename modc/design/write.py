@@ -25,7 +25,9 @@ def task_figures(o: Outcome, rank: int, d: Design) -> dict:
     cell's tasks and paths, the figures per task, and which task the .traj.json holds."""
     if not d.plans:
         return {}
-    return {"cycle_time_s": round(d.cycle_time, 6), "energy_j": round(d.energy, 6),
+    base = d.verified.robot.base  # the base as written (`base within` is not searched yet)
+    return {"base": {"xyz": [round(v, 9) for v in base.xyz], "rpy": [round(v, 9) for v in base.rpy]},
+            "cycle_time_s": round(d.cycle_time, 6), "energy_j": round(d.energy, 6),
             "peak_torque_share": round(max(p.peak_share for p in d.plans), 6),
             "coverage": 1.0,  # every task planned: every point of every task reached
             "tasks": [{"task": p.task, "kind": p.kind, "cycle_time_s": round(p.cycle_time, 6),
