@@ -149,12 +149,13 @@ def design_cmd(
 ) -> None:
     """Find the best module chains for the cells and targets of FILE's design blocks."""
     import json
+    from dataclasses import replace
 
     from ..compiler import InputError, check_file, inputs_of
     from ..design import run as search
     from ..design.write import files as design_files
     from ..design.write import ranking, summary_line
-    from ..diagnostics import codes
+    from ..diagnostics import Severity, codes
     from ..outputs import check_output_dir, write_tree
     from .design_progress import progress as show_progress
 
@@ -163,8 +164,11 @@ def design_cmd(
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
         raise SystemExit(EXIT_USAGE) from None
-    _print_diagnostics(checked.diagnostics, checked.sources)
-    if not checked.ok:
+    # a statement the search would ignore is refused here, where ignoring it would mislead
+    refused = [replace(d, severity=Severity.ERROR) if d.code == codes.DESIGN_UNSUPPORTED.name else d
+               for d in checked.diagnostics]
+    _print_diagnostics(refused, checked.sources)
+    if not checked.ok or any(d.is_error for d in refused):
         raise SystemExit(EXIT_ERRORS)
     problems = checked.design.problems
     if not problems:

@@ -9,8 +9,9 @@
     search.py    per shape: every twist setting, screened or excluded by a bound, in ranges of settings
     run.py       shapes by size and mass on any concurrent.futures executor; budget, Ctrl-C, progress
     verify_order.py  exact checks in ranking order; H/L swaps of one arm as its alternatives
+    tasks.py     the cell's tasks and paths planned and timed (modc.plan.task) for the designs returned
     diagnose.py  why no design: per target, reach, obstacles, joint limits or torque
-    rank.py      the objectives' order, the Pareto front
+    rank.py      the objectives' registry and order, the Pareto front
     write.py     ranking.json, one robot .mod per design, report.json
     report.py    report.html (ranking, Pareto plot as inline SVG, pictures)
 """

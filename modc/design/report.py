@@ -47,12 +47,15 @@ def _svg(o: Outcome) -> str:
 
 
 def _table(o: Outcome) -> str:
+    timed = any(d.plans for d in o.designs)  # the cell's tasks planned and timed (modc.design.tasks)
     rows = ["<tr><th>rank</th><th>chain</th><th>modules</th><th>mass (kg)</th><th>torque margin</th>"
-            "<th>worst target error</th><th>alternatives (other H/L variants)</th></tr>"]
+            "<th>worst target error</th>" + ("<th>cycle time (s)</th><th>energy (J)</th>" if timed else "")
+            + "<th>alternatives (other H/L variants)</th></tr>"]
     for rank, d in enumerate(o.designs, start=1):
         worst = max(t["position_error_m"] for t in d.verified.targets.values())
+        task = f"<td>{d.cycle_time:.3f}</td><td>{d.energy:.2f}</td>" if timed else ""
         rows.append(f"<tr><td>{rank}</td><td><code>{escape(d.chain())}</code></td><td>{d.modules}</td>"
-                    f"<td>{d.mass:.3f}</td><td>{d.margin * 100:.0f} %</td><td>{worst * 1000:.3g} mm</td>"
+                    f"<td>{d.mass:.3f}</td><td>{d.margin * 100:.0f} %</td><td>{worst * 1000:.3g} mm</td>{task}"
                     f"<td>{'<br>'.join(f'<code>{escape(x.chain())}</code> ({x.mass:.3f} kg)' for x in d.alternatives)}"
                     "</td></tr>")
     return "<table>" + "".join(rows) + "</table>"

@@ -20,7 +20,7 @@ from . import space
 from .bounds import blocked as bounds_blocked
 from .diagnose import diagnose, why_none
 from .evaluate import Spec
-from .rank import Design, distinct, key
+from .rank import Design, distinct, key, static
 from .screen import reach_bound
 from .search import STOP, TICK, Part, ShapeResult, merge, parts_of, search_chunk, size
 from .verify_order import Verifier
@@ -172,6 +172,26 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
            executor: Executor | None = None, progress: Callable[..., None] | None = None,
            deadline: float | None = None) -> Outcome:
     """Ranked designs for a checked problem (its library resolved).
+
+    A cell with tasks or paths: the static search (ranked by the objectives it knows) returns
+    its best designs, more of them when a task objective ranks (tasks.candidates); each is then
+    planned and timed (tasks.plan_all) and the survivors ranked by every objective."""
+    from . import tasks
+
+    if not tasks.has_tasks(problem):
+        return _search(problem, max_units, top, seed, executor, progress, deadline)
+    t0 = time.perf_counter()
+    screen = problem.model_copy(update={"rank": static(problem.rank)})
+    out = _search(screen, max_units, tasks.candidates(problem, top), seed, executor, progress, deadline)
+    out.problem = problem
+    tasks.plan_all(out, top, seed, deadline, _stopping)
+    out.seconds = time.perf_counter() - t0
+    return out
+
+
+def _search(problem: Problem, max_units: int | None, top: int, seed: int, executor: Executor | None,
+            progress: Callable[..., None] | None, deadline: float | None) -> Outcome:
+    """The static search: designs ranked by the problem's (static) objectives.
 
     With the default objectives (fewest modules first), chains are searched by number of units,
     and within one number lightest shape first, ROUND shapes at a time: the search stops as soon

@@ -25,7 +25,7 @@ class Verifier:
         self.checks = 0
 
     def add(self, n: int, splits, res: ShapeResult) -> None:
-        from .rank import key
+        from .rank import Screened, key
 
         if not res.found:
             return
@@ -38,7 +38,7 @@ class Verifier:
                 continue
             mass = self.mass(p, res.shape, variants)
             chain = "-".join(f"{v}{k}" for v, k in zip(variants, res.shape.kinds, strict=True)) + res.shape.label()
-            self.pending.append((key(p.rank, n, mass, None, chain), n, mass, res.shape, found, variants))
+            self.pending.append((key(p.rank, Screened(n, mass, None, chain)), n, mass, res.shape, found, variants))
             self.out.screened += 1
 
     def _holds(self, res: ShapeResult, variants, f) -> bool:

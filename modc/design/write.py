@@ -1,6 +1,7 @@
 """What `modc design FILE -o DIR` writes: DIR/ranking.json (docs/conventions.md), one complete robot
 file per design (DIR/<name>_<rank>.mod: the chain, the cell, the targets and a pose per target,
-compilable as it is) and DIR/report.html."""
+compilable as it is), for a cell with tasks DIR/<name>_<rank>.traj.json (the first task, planned
+and timed) and DIR/report.html."""
 from __future__ import annotations
 
 import json
@@ -13,6 +14,26 @@ from .run import Outcome
 
 def file_name(problem: str, rank: int) -> str:
     return f"{problem}_{rank}.mod"
+
+
+def traj_name(problem: str, rank: int) -> str:
+    return f"{problem}_{rank}.traj.json"
+
+
+def task_figures(o: Outcome, rank: int, d: Design) -> dict:
+    """ranking.json's task keys of a planned design: cycle time and energy summed over the
+    cell's tasks and paths, the figures per task, and which task the .traj.json holds."""
+    if not d.plans:
+        return {}
+    base = d.verified.robot.base  # the base as written (`base within` is not searched yet)
+    return {"base": {"xyz": [round(v, 9) for v in base.xyz], "rpy": [round(v, 9) for v in base.rpy]},
+            "cycle_time_s": round(d.cycle_time, 6), "energy_j": round(d.energy, 6),
+            "peak_torque_share": round(max(p.peak_share for p in d.plans), 6),
+            "coverage": 1.0,  # every task planned: every point of every task reached
+            "tasks": [{"task": p.task, "kind": p.kind, "cycle_time_s": round(p.cycle_time, 6),
+                       "energy_j": round(p.energy, 6), "peak_torque_share": round(p.peak_share, 6),
+                       "segments": [s.to_json() for s in p.segments]} for p in d.plans],
+            "traj": traj_name(o.problem.name, rank), "traj_task": d.plans[0].task}
 
 
 def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
@@ -33,7 +54,7 @@ def ranking(outcomes: list[Outcome]) -> dict:
             designs.append({
                 "rank": rank, "file": file_name(o.problem.name, rank), "design": o.problem.name, "chain": d.chain(),
                 "modules": d.modules, "mass_kg": round(d.mass, 6), "torque_margin": round(d.margin, 6),
-                "targets": d.verified.targets,
+                "targets": d.verified.targets, **task_figures(o, rank, d),
                 "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
                                  for a in d.alternatives],
             })
@@ -60,6 +81,8 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
     for o in outcomes:
         for rank, d in enumerate(o.designs, start=1):
             out[file_name(o.problem.name, rank)] = robot_file(o, rank, d)
+            if d.plans:  # the whole of the first task (ranking.json's traj_task)
+                out[traj_name(o.problem.name, rank)] = d.plans[0].dumps()
     out["report.html"] = report_html(outcomes, renders or {})
     # what wrote this directory (write_tree's manifest is what lets a later run replace it)
     marker = {"generator": f"modc {__version__}", "command": "design",
@@ -70,6 +93,7 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
 
 def summary_line(o: Outcome) -> str:
     best = o.designs[0]
+    timed = f", cycle time {best.cycle_time:.3f} s, {best.energy:.2f} J" if best.plans else ""
     return (f"{o.problem.name}: {len(o.designs)} designs from {o.evaluated:,} evaluated in {o.seconds:.1f} s; "
             f"best {best.chain()} ({best.modules} modules, {best.mass:.3f} kg, "
-            f"margin {math.floor(best.margin * 100)} %)")
+            f"margin {math.floor(best.margin * 100)} %{timed})")

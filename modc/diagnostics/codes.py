@@ -288,6 +288,10 @@ DESIGN_BOUND = _register("design-bound", E, "a search bound of a design block th
     "{what}", "{hint}")
 UNKNOWN_OBJECTIVE = _register("unknown-objective", E, "`rank` naming an objective modc does not know",
     "unknown objective '{name}'", "objectives are {known}, written in order of importance")
+DESIGN_UNSUPPORTED = _register("design-unsupported", W,
+    "a design-block statement the language has but `modc design` does not search yet (it refuses the block)",
+    "{what} is parsed but not searched yet by modc design",
+    "remove it from design '{name}' to search the block; `modc design` refuses it until it is searched")
 DESIGN_NO_TARGETS = _register("design-no-targets", E, "a design block without any target",
     "design '{name}' has no targets: nothing to design the arm for", "add `target NAME at (x, y, z) m` to the block")
 NO_DESIGN = _register("no-design", E, "`modc design` found no chain that does every task of the cell",

@@ -1,0 +1,129 @@
+"""`modc design` with tasks: the cell's tasks planned and timed for the designs the static search
+returns, `rank … cycle_time` / `energy`, the trajectory and task keys written, and the design
+statements not searched yet (`base within`, `rank coverage`) refused with a diagnostic."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from modc.compiler import check_file, check_text
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# two targets on either side of a post: the motion between them is planned around it
+TASKED = """design small {
+    payload 100 g
+    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    units 3
+    modules H1, L3
+    task serve { visit a, b }
+    rank modules, cycle_time
+}
+"""
+
+
+def problem(text: str = TASKED):
+    checked = check_text(text, "cell.mod")
+    assert checked.ok, [d.message for d in checked.diagnostics]
+    return checked.design.problems[0]
+
+
+def _design(tmp_path, text: str, *args: str) -> subprocess.CompletedProcess:
+    src = tmp_path / "cell.mod"
+    src.write_text(text, encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
+    return subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
+                           "--no-render", *args], capture_output=True, text=True, env=env, timeout=900)
+
+
+@pytest.mark.slow
+def test_rank_cycle_time_plans_every_design_and_ranks_by_it():
+    """Was a KeyError in rank.key: the designs are now planned and ordered by modules, then cycle time."""
+    from modc.design import run
+
+    p = problem()
+    o = run.design(p, top=2, seed=0)
+    assert len(o.designs) == 2
+    for d in o.designs:
+        assert [pl.task for pl in d.plans] == ["serve"]
+        assert d.cycle_time == pytest.approx(sum(s.duration for s in d.plans[0].counted)) and d.cycle_time > 0
+        assert d.energy >= 0
+    keys = [(d.modules, d.cycle_time) for d in o.designs]
+    assert keys == sorted(keys)
+
+
+@pytest.mark.slow
+def test_a_design_whose_task_cannot_be_planned_is_rejected(monkeypatch):
+    from modc.design import run
+    from modc.plan import task
+    from modc.plan.errors import PlanError
+
+    real = task.plan_task_robot
+    refused: list[str] = []
+
+    def fails_for_the_first(robot, name, **kw):
+        chain = "-".join(u.name for u in robot.units)
+        if not refused or refused[0] == chain:  # the first design planned cannot do its task
+            refused.append(chain)
+            raise PlanError([], {})
+        return real(robot, name, **kw)
+
+    monkeypatch.setattr(task, "plan_task_robot", fails_for_the_first)
+    o = run.design(problem(), top=1, seed=0)
+    assert refused and all("-".join(u.name for u in d.verified.robot.units) != refused[0] for d in o.designs)
+    assert any(r.startswith(refused[0] + ": task 'serve' cannot be planned") for r in o.rejections)
+
+
+@pytest.mark.slow
+def test_modc_design_writes_the_timed_task(tmp_path):
+    from modc import trajectory
+
+    r = _design(tmp_path, TASKED, "--top", "1")
+    assert r.returncode == 0, r.stderr
+    assert "cycle time" in r.stderr
+    out = tmp_path / "out"
+    ranking = json.loads((out / "ranking.json").read_text())
+    d = ranking["designs"][0]
+    assert d["traj"] == "small_1.traj.json" and d["traj_task"] == "serve" and d["coverage"] == 1.0
+    assert d["cycle_time_s"] > 0 and d["energy_j"] >= 0
+    assert d["base"] == {"xyz": [0.0, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}
+    assert d["cycle_time_s"] == pytest.approx(sum(t["cycle_time_s"] for t in d["tasks"]), abs=1e-5)
+    traj, errors = trajectory.load(out / d["traj"])
+    assert traj is not None and not errors
+    robot_file = check_file(out / d["file"])
+    assert robot_file.ok
+    robot = robot_file.design.robots[0]
+    assert [t.name for t in robot.tasks] == ["serve"]  # the written robot keeps the cell's task
+    assert trajectory.validate_for(traj, robot) == []
+    for row in traj.q:  # within the joint limits, checked here directly too
+        for i, v in enumerate(row, start=1):
+            lo, hi = robot.joint_range(i)
+            assert lo - 1e-9 <= v <= hi + 1e-9
+    assert "<th>cycle time (s)</th>" in (out / "report.html").read_text()
+    # the segments after the approach add up to the cycle time
+    plan = json.loads((out / d["traj"]).read_text())
+    assert plan["task"] == "serve"
+    assert sum(s["duration_s"] for s in plan["segments"] if s["kind"] != "approach") == \
+        pytest.approx(d["cycle_time_s"], abs=1e-5)
+
+
+@pytest.mark.parametrize("statement, what", [
+    ("base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 50 mm", "`base within`"),
+    ("rank coverage", "`rank coverage`"),
+])
+def test_statements_not_searched_yet_are_refused(tmp_path, statement, what):
+    text = TASKED.replace("    rank modules, cycle_time\n", f"    {statement}\n")
+    r = _design(tmp_path, text)
+    assert r.returncode == 1
+    assert "Traceback" not in r.stderr
+    assert f"error[design-unsupported]: {what} is parsed but not searched yet by modc design" in r.stderr
+    line = text.splitlines().index(f"    {statement}") + 1
+    assert f"cell.mod:{line}:" in r.stderr
+    assert not (tmp_path / "out").exists()
