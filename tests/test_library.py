@@ -78,6 +78,9 @@ def test_user_library_file_is_used(tmp_path):
     (("max_dof: 6", 'max_dof: "six"'), "max_dof: expected a whole number"),
     (("first_variant: H", "first_variant: X"), "variant 'X'"),
     (("lower_deg: -170", "lower_deg: 200"), "lower_deg"),
+    # found by the fuzz campaign: 1e-400 reads as 0.0, a link bar without length or inertia
+    (("x23: 0.22}", "x23: 1e-400}"), "x23 of a unit with a link module must be at least 0.1 mm"),
+    (("x23: 0.22}", "x23: 0}"), "x23 of a unit with a link module must be at least 0.1 mm"),
 ])
 def test_invalid_library_is_a_diagnostic(tmp_path, mutation, fragment):
     text = (ROOT / "libraries" / "mark2.yaml").read_text().replace(*mutation, 1)

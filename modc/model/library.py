@@ -143,6 +143,13 @@ class UnitType(_Frozen):
     z12: Offset
     x23: Offset = Field(0.0, description="default link length for units with a link module")
 
+    @model_validator(mode="after")
+    def _link_length(self):
+        # a link module is a printed bar: a zero (or underflowed, 1e-400) length has no inertia
+        if self.link and not self.x23 >= SMALLEST_LENGTH:
+            raise ValueError(f"x23 of a unit with a link module must be at least {SMALLEST_LENGTH * 1000:g} mm")
+        return self
+
 
 class TwistSet(_Frozen):
     """Realisable twist values: min..max in steps of step (all degrees)."""
