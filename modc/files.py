@@ -18,6 +18,7 @@ from __future__ import annotations
 import errno
 import hashlib
 import json
+import math
 import os
 import re
 import shutil
@@ -348,13 +349,23 @@ def _check_depth(text: str, limit: int) -> None:
             depth -= 1
 
 
+def _json_int(text: str) -> int | float:
+    if len(text.lstrip("-")) <= 15:
+        return int(text)
+    value = float(text)
+    if math.isinf(value):  # wider than any float: read_json says so (ValueError)
+        raise ValueError("integer too large")
+    return value
+
+
 def read_json(path: str | os.PathLike, limit: int = MAX_JSON_BYTES, depth: int = MAX_JSON_DEPTH):
     """A JSON input file, read as .mod files are (read_text) and at most depth levels deep.
     OSError when it cannot be read; InputProblem when its content is not acceptable JSON."""
     text = read_text(path, limit)
     _check_depth(text, depth)
     try:
-        return json.loads(text)
+        # integers only as wide as a float: a 400-digit one overflowed every float check downstream
+        return json.loads(text, parse_int=_json_int)
     except json.JSONDecodeError as e:
         where = f"at line {e.lineno}, column {e.colno}"
         raise InputProblem(f"not JSON: {e.msg} {where}", e.lineno, e.colno, e.pos) from None

@@ -174,3 +174,28 @@ def test_render_options_are_checked_before_rendering(tmp_path, option):
     r = _modc("render", str(QUICKSTART), "-o", "p.png", *option, cwd=tmp_path)
     assert r.returncode == 2 and "Traceback" not in r.stderr and "bad_alloc" not in r.stderr, r.stderr
     assert option[0] in r.stderr and not (tmp_path / "p.png").exists()
+
+
+@pytest.mark.parametrize("digits", [17, 400])
+def test_wide_integers_never_reach_float_arithmetic(tmp_path, digits):
+    """Found by the fuzz campaign: a 400-digit integer in ranking.json or a trajectory overflowed
+    (OverflowError) where the page formatted a mass or the trajectory checked a number. Integers
+    wider than a float are refused by the reader; wide ones that fit read as floats."""
+    from modc.view.page import Ranking, ViewError
+
+    wide = "1" * digits
+    ranking = tmp_path / "ranking.json"
+    ranking.write_text('{"designs": [{"rank": 1, "file": "a.mod", "mass_kg": ' + wide + "}]}")
+    traj = tmp_path / "t.json"
+    traj.write_text('{"joint_names": ["joint_1"], "points": [{"t": 0, "q": [' + wide + "]}]}")
+    if digits > 308:
+        with pytest.raises(ViewError, match="too many digits"):
+            Ranking(ranking)
+        with pytest.raises(InputProblem):
+            read_json(traj)
+        _, errors = trajectory.load(traj)
+        assert errors and "too many digits" in " ".join(errors)  # a message, not a traceback
+    else:
+        assert Ranking(ranking).caption(0).startswith("design 1 of 1: rank 1")
+        assert isinstance(read_json(traj)["points"][0]["q"][0], float)
+        trajectory.load(traj)  # reads; the joint limits are checked against a robot later

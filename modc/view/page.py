@@ -9,6 +9,7 @@ re-check of the file whenever it changes on disk (an error keeps the last good a
 """
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -138,8 +139,9 @@ class Ranking:
         parts = [f"design {k + 1} of {len(self.designs)}: rank {d['rank']}"]
         if isinstance(d.get("chain"), str):
             parts.append(d["chain"])
-        if isinstance(d.get("mass_kg"), (int, float)):
-            parts.append(f"{d['mass_kg']:.3g} kg")
+        mass = d.get("mass_kg")
+        if isinstance(mass, (int, float)) and not isinstance(mass, bool) and math.isfinite(mass):
+            parts.append(f"{mass:.3g} kg")
         return ", ".join(parts) + f" ({d['file']})"
 
 
