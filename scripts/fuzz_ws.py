@@ -106,7 +106,10 @@ class ViewServer:
         kind, payload = frame
         if kind == "msg" and isinstance(payload.get("uuid"), int):
             payload = {**payload, "uuid": self.uuids[payload["uuid"] % len(self.uuids)] if self.uuids else "x"}
-        data = msgspec.msgpack.encode(payload) if kind == "msg" else payload
+        try:
+            data = msgspec.msgpack.encode(payload) if kind == "msg" else payload
+        except OverflowError:  # msgpack has no integer that wide: such a frame cannot be sent at all
+            return
         try:
             if self.ws is None:
                 self._connect()

@@ -199,3 +199,11 @@ def test_wide_integers_never_reach_float_arithmetic(tmp_path, digits):
         assert Ranking(ranking).caption(0).startswith("design 1 of 1: rank 1")
         assert isinstance(read_json(traj)["points"][0]["q"][0], float)
         trajectory.load(traj)  # reads; the joint limits are checked against a robot later
+
+
+def test_collision_samples_are_bounded(tmp_path):
+    """Found by the fuzz campaign: --collision-samples 6402373705728000 asked numpy for 136 PiB."""
+    r = _modc(str(QUICKSTART), "-o", str(tmp_path / "out"), "--collision-samples", "6402373705728000",
+              cwd=tmp_path)
+    assert r.returncode == 2 and "Traceback" not in r.stderr and "1000000" in r.stderr.replace(",", "")
+    assert not (tmp_path / "out").exists()

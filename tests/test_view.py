@@ -561,3 +561,28 @@ def test_a_malformed_message_is_one_line_per_connection(caplog):
         assert not [r for r in caplog.records if r.exc_info], "a traceback was logged"
     finally:
         server.stop()
+
+
+def test_a_message_viser_cannot_apply_is_one_line_per_kind():
+    """Found by the fuzz campaign (scripts/fuzz_ws.py, end to end): well-formed frames with values
+    viser cannot apply (a GUI update of a property that does not exist, a null slider value) printed
+    a full traceback per frame through asyncio's "Task exception was never retrieved". The filter
+    modc view installs on asyncio's logger keeps one line per kind of error, without traceback."""
+    from modc.view.guard import OneLineHandlerErrors, quiet_malformed_messages
+
+    quiet_malformed_messages()
+    assert any(isinstance(f, OneLineHandlerErrors) for f in logging.getLogger("asyncio").filters)
+
+    def record(exc: BaseException) -> logging.LogRecord:
+        text = ("Task exception was never retrieved\nfuture: <Task finished coro=<WebsockMessageHandler."
+                f"_handle_incoming_message() done> exception={exc!r}>")
+        return logging.LogRecord("asyncio", logging.ERROR, __file__, 1, text, None, (type(exc), exc, None))
+
+    f = OneLineHandlerErrors()
+    first, again, other = record(AssertionError()), record(AssertionError()), record(TypeError("float() None"))
+    assert f.filter(first) and first.exc_info is None and "\n" not in first.getMessage()
+    assert "cannot apply" in first.getMessage()
+    assert not f.filter(again)  # the same kind again: dropped
+    assert f.filter(other) and "TypeError: float() None" in other.getMessage()
+    unrelated = logging.LogRecord("asyncio", logging.ERROR, __file__, 1, "something else", None, None)
+    assert f.filter(unrelated) and unrelated.getMessage() == "something else"

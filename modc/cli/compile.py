@@ -24,8 +24,8 @@ from .app import (
 @click.option("--force/--no-force", default=False,
               help="replace OUT whatever it holds (deletes files modc did not write; never an input or a "
                    "folder holding one)")
-@click.option("--collision-samples", type=click.IntRange(min=0), default=10_000,
-              help="random poses for the SRDF collision matrix (MoveIt's default)")
+@click.option("--collision-samples", type=click.IntRange(min=0, max=1_000_000), default=10_000,
+              help="random poses for the SRDF collision matrix (MoveIt's default; at most 1,000,000)")
 @click.option("--seed", type=click.IntRange(min=0), default=0,
               help="seed of those poses: same file and seed, same SRDF on any machine")
 @click.option("--smoke", is_flag=True, help="also run `modc sim` (PyBullet) before writing OUT")

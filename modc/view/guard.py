@@ -118,7 +118,33 @@ class OneLineErrors(logging.Filter):
         return True
 
 
+class OneLineHandlerErrors(logging.Filter):
+    """A well-formed frame with values viser cannot apply (a GUI update of a missing property, a
+    null slider value) fails in viser's message task; asyncio then logs "Task exception was never
+    retrieved" with a full traceback per frame. Keep one line per kind of error."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.seen: set[str] = set()
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        text = record.getMessage()
+        if not (text.startswith("Task exception was never retrieved") and "_handle_incoming_message" in text):
+            return True
+        exc = record.exc_info[1] if record.exc_info else None
+        what = f"{type(exc).__name__}: {exc}"[:MESSAGE_CAP] if exc is not None else "unknown error"
+        if what in self.seen:
+            return False
+        self.seen.add(what)
+        record.msg, record.args = "modc view: ignored a message the page cannot apply (%s)", (what,)
+        record.exc_info, record.exc_text = None, None
+        return True
+
+
 def quiet_malformed_messages() -> None:
     logger = logging.getLogger("websockets.server")
     if not any(isinstance(f, OneLineErrors) for f in logger.filters):
         logger.addFilter(OneLineErrors())
+    tasks = logging.getLogger("asyncio")
+    if not any(isinstance(f, OneLineHandlerErrors) for f in tasks.filters):
+        tasks.addFilter(OneLineHandlerErrors())
