@@ -246,8 +246,9 @@ def test_page_shows_the_arm_framed_and_a_slider_moves_it(browser, tmp_path):
         # every target's label is drawn, each in its own place
         boxes = []
         for name, label in view.labels.items():
+            base = settled(browser)  # a fresh baseline: the picture with every label, as it is now
             label.visible = False
-            gone = changed(before, settled(browser, lit=False), left)
+            gone = changed(base, settled(browser, lit=False), left)
             label.visible = True
             assert gone.sum() > 30, f"no label for target {name}"
             ys, xs = np.nonzero(gone)
