@@ -117,11 +117,8 @@ def _contacts_text(contacts) -> str:
     return "; ".join(c.describe() for c in contacts)
 
 
-def plan(path, target: str, robot: str | None = None, seed: int = 0, start: str | None = None,
-         library: str | None = None, **options) -> Plan:
-    """Read a .mod (or YAML) file and plan robot's motion from `start` (default home) to
-    `target`. robot may be omitted when exactly one robot of the file declares the target.
-    options go to plan_robot (margin, timeout, max_checks). Raises PlanError."""
+def checked_or_raise(path, library: str | None = None):
+    """The checked file, or PlanError: exit 2 when it cannot be read, 1 when it has errors."""
     from ..compiler import InputError, check_file
 
     try:
@@ -130,6 +127,15 @@ def plan(path, target: str, robot: str | None = None, seed: int = 0, start: str 
         raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
     if not checked.ok:
         raise PlanError([d for d in checked.diagnostics if d.is_error], checked.sources, EXIT_FAILED)
+    return checked
+
+
+def plan(path, target: str, robot: str | None = None, seed: int = 0, start: str | None = None,
+         library: str | None = None, **options) -> Plan:
+    """Read a .mod (or YAML) file and plan robot's motion from `start` (default home) to
+    `target`. robot may be omitted when exactly one robot of the file declares the target.
+    options go to plan_robot (margin, timeout, max_checks). Raises PlanError."""
+    checked = checked_or_raise(path, library)
     robots = list(checked.design.robots)
     among = None
     if robot is None and len(robots) > 1:

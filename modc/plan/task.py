@@ -114,14 +114,9 @@ class TaskPlan:
 def plan_task(path, task: str, robot: str | None = None, seed: int = 0, library: str | None = None,
               timeout: float | None = None) -> TaskPlan:
     """Read a .mod (or YAML) file and plan and time the robot's task or path `task`. Raises PlanError."""
-    from ..compiler import InputError, check_file
+    from . import checked_or_raise
 
-    try:
-        checked = check_file(path, library)
-    except InputError as e:
-        raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
-    if not checked.ok:
-        raise PlanError([d for d in checked.diagnostics if d.is_error], checked.sources, EXIT_FAILED)
+    checked = checked_or_raise(path, library)
     robots = list(checked.design.robots)
     has = [r for r in robots if _find(r, task) is not None]
     if robot is None and len(robots) > 1 and not has:
