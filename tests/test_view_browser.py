@@ -225,6 +225,30 @@ def colour_pixels(img: np.ndarray, rgb, left: int, tol: int = 40) -> int:
     return int(((np.abs(norm - want).max(axis=2) < tol) & (bright[..., 0] > 40)).sum())
 
 
+def _dense(mask: np.ndarray, r: int = 2, least: int = 8) -> np.ndarray:
+    """The pixels of mask with at least `least` set pixels in their (2r+1)² neighbourhood."""
+    padded = np.pad(mask.astype(int), r)
+    h, w = mask.shape
+    count = sum(padded[dy:dy + h, dx:dx + w] for dy in range(2 * r + 1) for dx in range(2 * r + 1))
+    return mask & (count >= least)
+
+
+def label_box(browser, label, left: int, name: str, tries: int = 4) -> tuple:
+    """Where a label is drawn (and so that it is): what changes when it is hidden, against a fresh picture. A
+    software-GL browser sometimes hands over a transient frame (the whole canvas differs): such a
+    comparison says nothing about the label and is taken again."""
+    for _ in range(tries):
+        base = settled(browser)
+        label.visible = False
+        gone = changed(base, settled(browser, lit=False), left)
+        label.visible = True
+        dense = _dense(gone)  # a label is a solid box of changed pixels; flicker elsewhere is scattered
+        if 30 < dense.sum() < 0.2 * dense.size:
+            ys, xs = np.nonzero(dense)
+            return xs.min(), xs.max(), ys.min(), ys.max()
+    raise AssertionError(f"no label for target {name} ({gone.sum()} pixels changed when hiding it)")
+
+
 @pytest.mark.slow
 def test_page_shows_the_arm_framed_and_a_slider_moves_it(browser, tmp_path):
     page = Page([Source(FARM)])
@@ -244,18 +268,12 @@ def test_page_shows_the_arm_framed_and_a_slider_moves_it(browser, tmp_path):
         assert light > 100 and heavy > 30, (light, heavy)
 
         # every target's label is drawn, each in its own place
-        boxes = []
+        # (hiding one label lets the page re-stack the others, so pixels cannot tell where each one
+        # sits: that they never overlap is tested on the layout itself, test_view.py
+        # test_labels_do_not_overlap_on_screen)
         for name, label in view.labels.items():
-            base = settled(browser)  # a fresh baseline: the picture with every label, as it is now
-            label.visible = False
-            gone = changed(base, settled(browser, lit=False), left)
-            label.visible = True
-            assert gone.sum() > 30, f"no label for target {name}"
-            ys, xs = np.nonzero(gone)
-            boxes.append((xs.min(), xs.max(), ys.min(), ys.max()))
+            label_box(browser, label, left, name)
         assert set(view.labels) == {"plant", "tray"}
-        (a, b) = boxes
-        assert a[1] < b[0] or b[1] < a[0] or a[3] < b[2] or b[3] < a[2], f"labels overlap: {boxes}"
         settled(browser)
 
         # drag joint_1's slider from its thumb to near the right end of its track
