@@ -52,6 +52,20 @@ def compiled_examples(tmp_path_factory) -> dict[str, Path]:
     return out
 
 
+def random_units(rng, variant, link_max_mm: int) -> list[str]:
+    """1-6 units of the paper's four types with realisable random twists (and links on types 3/4),
+    each in the variant variant(i, n) says: the random chains the property tests share."""
+    n = rng.randint(1, 6)
+    units = []
+    for i in range(n):
+        kind = rng.randint(1, 4)
+        params = [f"pivot={rng.choice(range(-90, 91, 15))}deg"]
+        if kind >= 3:
+            params += [f"port={rng.choice(range(-180, 181, 15))}deg", f"link={rng.randint(50, link_max_mm)}mm"]
+        units.append(f"{variant(i, n)}{kind}({', '.join(params)})")
+    return units
+
+
 def run_cpu(cmd: list[str], *, timeout: float = 600, **kw) -> tuple[subprocess.CompletedProcess, float]:
     """subprocess.run(cmd, capture_output=True, text=True) and the CPU seconds the child (with its own
     children) used. CPU time, unlike wall-clock time, does not grow with the rest of the machine's

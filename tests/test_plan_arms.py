@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, random_units
 
 from modc.compiler import check_file
 from modc.kinematics import Chain, matrix_rpy
@@ -30,7 +30,8 @@ def _env() -> dict[str, str]:
 
 
 def _cli_plan(path: Path, target: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "modc", "plan", str(path), "--to", target, "--timeout", "5"],
+    # the planner's wall-clock timeout only as a hang guard: its max_checks bound decides, not the load
+    return subprocess.run([sys.executable, "-m", "modc", "plan", str(path), "--to", target, "--timeout", "300"],
                           capture_output=True, text=True, env=_env())
 
 
@@ -97,14 +98,7 @@ def test_a_one_joint_arm_reaches_a_full_pose(tmp_path):
 
 
 def _random_arm(rng: random.Random) -> str:
-    n = rng.randint(1, 6)
-    units = []
-    for _ in range(n):
-        kind = rng.randint(1, 4)
-        params = [f"pivot={rng.choice(range(-90, 91, 15))}deg"]
-        if kind >= 3:
-            params += [f"port={rng.choice(range(-180, 181, 15))}deg", f"link={rng.randint(50, 400)}mm"]
-        units.append(f"{rng.choice('HL')}{kind}({', '.join(params)})")
+    units = random_units(rng, lambda i, n: rng.choice("HL"), 400)
     allow = "".join(f"    allow {c}\n" for c in ("first-variant", "last-variant", "illegal-succession",
                                                   "epsilon-exceeded"))
     return f"robot r {{\n{allow}    chain {' - '.join(units)}\n"
@@ -132,7 +126,7 @@ def test_random_arms_plan_or_say_why(tmp_path, seed):
                           f"    target pose at ({x!r}, {y!r}, {z!r}) m rpy ({r!r}, {p!r}, {w!r}) deg\n"
                           "    target far at (3, 0, 0.2) m\n    target base at (0, 0, 0.01) m\n}\n", encoding="utf-8")
     robot = check_file(src).design.robots[0]
-    outcomes = {t.name: _outcome(src, t.name, timeout=5.0) for t in robot.targets}
+    outcomes = {t.name: _outcome(src, t.name, timeout=300.0) for t in robot.targets}
     for t in robot.targets:
         if isinstance(outcomes[t.name], Plan):
             _assert_reached(outcomes[t.name], robot, t)

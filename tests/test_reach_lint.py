@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, random_units
 
 from modc.compiler import check_file, check_text
 from modc.kinematics import Chain
@@ -25,14 +25,7 @@ CODE = "target-out-of-reach"
 
 
 def _random_chain(rng: random.Random) -> str:
-    n = rng.randint(1, 6)
-    units = []
-    for i in range(n):
-        kind = rng.randint(1, 4)
-        params = [f"pivot={rng.choice(range(-90, 91, 15))}deg"]
-        if kind >= 3:
-            params += [f"port={rng.choice(range(-180, 181, 15))}deg", f"link={rng.randint(50, 500)}mm"]
-        units.append(f"{'H' if i < n - 1 else 'L'}{kind}({', '.join(params)})")
+    units = random_units(rng, lambda i, n: "H" if i < n - 1 else "L", 500)
     tool = f"({rng.uniform(-0.1, 0.1):.3f}, {rng.uniform(-0.1, 0.1):.3f}, {rng.uniform(0, 0.15):.3f}) m"
     return (f"robot r {{\n    allow epsilon-exceeded\n    allow first-variant\n    chain {' - '.join(units)}\n"
             f"    tool at {tool} rpy (10, 20, 30) deg\n")
