@@ -9,39 +9,54 @@ import math
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
-from typing import Annotated, Literal
-
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
+from typing import Annotated, Any, Literal
 
 from .. import names
-from ..diagnostics.plain_words import plain_words
 from . import quantities as Q
 from .library_file import LIBRARY_KEYS, MAX_LIBRARY_BYTES, LibraryError, read_library, where  # noqa: F401 (re-exported)
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
+# The library's types are plain frozen dataclasses: a command whose library is in modc's cache
+# (modc.model.library_check) builds them from stored values without importing pydantic. Their
+# annotations are the schema: pydantic reads them, with the Rule and Bounds below, only when a
+# library file is validated.
 
-def _rule(problem: Callable[[str], str | None]) -> AfterValidator:
-    def check(text: str) -> str:
-        why = problem(text)
-        if why:
-            raise ValueError(why)
-        return text
-    return AfterValidator(check)
+
+@dataclasses.dataclass(frozen=True)
+class Rule:
+    """A string field's rule (one of modc.names'): the problem with a text, or None."""
+
+    problem: Callable[[str], str | None]
+
+    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+        def check(text: str) -> str:
+            why = self.problem(text)
+            if why:
+                raise ValueError(why)
+            return text
+        return {"type": "function-after", "function": {"type": "no-info", "function": check},
+                "schema": handler(source)}
 
 
 # A library file is input like a .mod file: every string in it reaches outputs (XML, xacro, YAML
 # comments, mesh file names), so each obeys one of modc.names' rules.
-VariantName = Annotated[str, _rule(names.variant_problem)]
-Label = Annotated[str, _rule(names.label_problem)]
-Text = Annotated[str, _rule(names.text_problem)]
+VariantName = Annotated[str, Rule(names.variant_problem)]
+Label = Annotated[str, Rule(names.label_problem)]
+Text = Annotated[str, Rule(names.text_problem)]
 
 
 @dataclasses.dataclass(frozen=True)
-class Unit:
-    """The unit of a library number (for out-of-range messages)."""
+class Bounds:
+    """The range of a library number, and its unit (for out-of-range messages)."""
 
-    symbol: str
+    lo: float
+    hi: float
+    symbol: str = ""
+    open_lo: bool = False  # lo itself is outside
+
+    def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
+        return {**handler(source), ("gt" if self.open_lo else "ge"): self.lo, "le": self.hi}
 
 
 # Every library number has a range, as .mod quantities do (quantities.LIMIT): nothing beyond it
@@ -58,33 +73,37 @@ MAX_COUNT = 32  # modules per arm (the paper's arms have 1-6)
 
 
 _LENGTH, _MASS = Q.LIMIT["a length"], Q.LIMIT["a mass"]
-Length = Annotated[float, Field(ge=SMALLEST_LENGTH, le=_LENGTH), Unit("m")]
-Offset = Annotated[float, Field(ge=-_LENGTH, le=_LENGTH), Unit("m")]
-Mass = Annotated[float, Field(ge=SMALLEST, le=_MASS), Unit("kg")]
-LinearDensity = Annotated[float, Field(ge=SMALLEST, le=_MASS), Unit("kg/m")]
-Torque = Annotated[float, Field(ge=SMALLEST, le=MAX_TORQUE), Unit("N·m")]
-Speed = Annotated[float, Field(ge=SMALLEST, le=MAX_RPM), Unit("rev/min")]
-JointDeg = Annotated[float, Field(ge=-MAX_JOINT_DEG, le=MAX_JOINT_DEG), Unit("deg")]
-TwistDeg = Annotated[float, Field(ge=-360.0, le=360.0), Unit("deg")]
-TwistStep = Annotated[float, Field(ge=1.0, le=360.0), Unit("deg")]  # `modc design` enumerates every value
-Gain = Annotated[float, Field(ge=0, le=MAX_GAIN), Unit("")]
-PositiveGain = Annotated[float, Field(gt=0, le=MAX_GAIN), Unit("")]
-Count = Annotated[int, Field(ge=1, le=MAX_COUNT), Unit("")]
+Length = Annotated[float, Bounds(SMALLEST_LENGTH, _LENGTH, "m")]
+Offset = Annotated[float, Bounds(-_LENGTH, _LENGTH, "m")]
+Mass = Annotated[float, Bounds(SMALLEST, _MASS, "kg")]
+LinearDensity = Annotated[float, Bounds(SMALLEST, _MASS, "kg/m")]
+Torque = Annotated[float, Bounds(SMALLEST, MAX_TORQUE, "N·m")]
+Speed = Annotated[float, Bounds(SMALLEST, MAX_RPM, "rev/min")]
+JointDeg = Annotated[float, Bounds(-MAX_JOINT_DEG, MAX_JOINT_DEG, "deg")]
+TwistDeg = Annotated[float, Bounds(-360.0, 360.0, "deg")]
+TwistStep = Annotated[float, Bounds(1.0, 360.0, "deg")]  # `modc design` enumerates every value
+Gain = Annotated[float, Bounds(0, MAX_GAIN)]
+PositiveGain = Annotated[float, Bounds(0, MAX_GAIN, open_lo=True)]
+Count = Annotated[int, Bounds(1, MAX_COUNT)]
+UnitNumber = Annotated[int, Bounds(1, 99)]  # unit type numbers: H1..H4
 
 
-class _Frozen(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+class _Frozen:
+    # read by pydantic when it validates a library file (a plain dict: no pydantic import here)
+    __pydantic_config__ = {"extra": "forbid", "allow_inf_nan": False}
 
 
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Actuator(_Frozen):
     model: Text
-    mass: Mass = Field(description="kg (paper Table 1)")
-    rpm: Speed = Field(description="rated speed, rev/min (paper Table 1)")
-    torque_nominal: Torque = Field(description="N·m (paper Table 1)")
-    torque_peak: Torque = Field(description="N·m (paper Table 1)")
-    epsilon: Count = Field(description="modules of this kind one module can carry (paper Table 1)")
-    diameter: Length = Field(description="m, housing diameter")
-    length: Length = Field(description="m, housing length along the joint axis")
+    mass: Mass  # kg (paper Table 1)
+    rpm: Speed  # rated speed, rev/min (paper Table 1)
+    torque_nominal: Torque  # N·m (paper Table 1)
+    torque_peak: Torque  # N·m (paper Table 1)
+    epsilon: Count  # modules of this kind one module can carry (paper Table 1)
+    diameter: Length  # m, housing diameter
+    length: Length  # m, housing length along the joint axis
 
     @property
     def velocity(self) -> float:
@@ -92,47 +111,51 @@ class Actuator(_Frozen):
         return self.rpm * 2.0 * math.pi / 60.0
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Part(_Frozen):
-    mass: Mass = Field(description="kg")
+    mass: Mass  # kg
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Casings(_Frozen):
     input_mass: Mass
     output_mass: Mass
-    wall: Length = Field(description="m, casing wall thickness")
-    output_thickness: Length = Field(description="m, output casing (flange) thickness")
-    boss_radius: Length = Field(description="m, radius of the pivotal extension")
+    wall: Length  # m, casing wall thickness
+    output_thickness: Length  # m, output casing (flange) thickness
+    boss_radius: Length  # m, radius of the pivotal extension
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class TwistUnit(_Frozen):
     mass: Mass
-    plate: Length = Field(description="m, base plate thickness")
+    plate: Length  # m, base plate thickness
     cheek_thickness: Length
     cheek_width: Length
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class LinkModule(_Frozen):
-    mass_per_length: LinearDensity = Field(description="kg/m of a printed link bar")
-    width: Length = Field(description="m, along y of the joint frame")
-    height: Length = Field(description="m, along z of the joint frame")
+    mass_per_length: LinearDensity  # kg/m of a printed link bar
+    width: Length  # m, along y of the joint frame
+    height: Length  # m, along z of the joint frame
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Variant(_Frozen):
     description: Text
     actuator: Actuator
     casings: Casings
     twist_unit: TwistUnit
     link_module: LinkModule
-    lower_deg: JointDeg = Field(description="joint position limit")
+    lower_deg: JointDeg  # joint position limit
     upper_deg: JointDeg
 
-    @model_validator(mode="after")
-    def _limits(self):
+    def __post_init__(self) -> None:
         if not self.lower_deg < self.upper_deg:
             raise ValueError("lower_deg must be below upper_deg")
-        return self
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class UnitType(_Frozen):
     """One of the paper's four modular units (section 3.1, eqs. 7-10)."""
 
@@ -141,23 +164,22 @@ class UnitType(_Frozen):
     x01: Offset
     z01: Offset
     z12: Offset
-    x23: Offset = Field(0.0, description="default link length for units with a link module")
+    x23: Offset = 0.0  # default link length for units with a link module
 
-    @model_validator(mode="after")
-    def _link_length(self):
+    def __post_init__(self) -> None:
         # a link module is a printed bar: a zero (or underflowed, 1e-400) length has no inertia
         if self.link and not self.x23 >= SMALLEST_LENGTH:
             raise ValueError(f"x23 of a unit with a link module must be at least {SMALLEST_LENGTH * 1000:g} mm")
-        return self
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class TwistSet(_Frozen):
     """Realisable twist values: min..max in steps of step (all degrees)."""
 
     min_deg: TwistDeg
     max_deg: TwistDeg
     step_deg: TwistStep
-    wraps: bool = Field(False, description="angles are taken modulo 360 (ports)")
+    wraps: bool = False  # angles are taken modulo 360 (ports)
 
     def nearest(self, deg: float) -> float:
         if not math.isfinite(deg):
@@ -189,11 +211,13 @@ def _clean(x: float) -> float:
     return 0.0 if abs(x) < 1e-12 else x
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Twists(_Frozen):
     pivot: TwistSet
     port: TwistSet
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Rules(_Frozen):
     """Assembly rules (paper section 3, rules 1-4)."""
 
@@ -204,26 +228,27 @@ class Rules(_Frozen):
     max_dof: Count
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Control(_Frozen):
-    p: PositiveGain = Field(description="proportional gain, actuator units (paper section 4.4)")
+    p: PositiveGain  # proportional gain, actuator units (paper section 4.4)
     i: Gain
     d: Gain
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Library(_Frozen):
     name: Label
     description: Text
     source: Text
     variants: dict[VariantName, Variant]
-    units: dict[Annotated[int, Field(ge=1, le=99)], UnitType]  # unit type numbers: H1..H4
+    units: dict[UnitNumber, UnitType]
     twists: Twists
     link_length_min: Length
     link_length_max: Length
     rules: Rules
     control: Control
 
-    @model_validator(mode="after")
-    def _consistent(self):
+    def __post_init__(self) -> None:
         for v in (self.rules.first_variant, self.rules.last_variant, *self.rules.may_follow):
             if v not in self.variants:
                 raise ValueError(f"rules name variant '{v}' that is not defined")
@@ -233,7 +258,6 @@ class Library(_Frozen):
                     raise ValueError(f"rules name variant '{v}' that is not defined")
         if not self.units:
             raise ValueError("no unit types defined")
-        return self
 
     def unit_names(self) -> list[str]:
         return [f"{v}{k}" for v in self.variants for k in sorted(self.units)]
@@ -250,54 +274,11 @@ class Library(_Frozen):
         return None
 
 
-def _range_error(err, text: str, path: str) -> LibraryError | None:
-    """A number beyond its field's upper bound: out-of-range, as for .mod quantities."""
-    ctx = err.get("ctx") or {}
-    if err.get("type") != "less_than_equal" or "le" not in ctx:
-        return None
-    try:  # YAML 1.1 reads 1e308 (no dot) as text, which pydantic takes for a number
-        value = float(err.get("input"))
-    except (TypeError, ValueError, OverflowError):
-        return None
-    unit = _unit(err["loc"])
-    what = ".".join(str(p) for p in err["loc"])
-    fields = {"what": what, "value": f"{value:g}{unit}", "limit": f"{ctx['le']:g}{unit}"}
-    message = f"{what} = {fields['value']} is out of range (at most {fields['limit']})"
-    return LibraryError(message, where(text, path, err["loc"]), text, "out-of-range", fields)
-
-
-def _unit(loc: tuple) -> str:
-    """' kg' for a location whose field is annotated with Unit('kg'), else ''."""
-    cls: object = Library
-    info = None
-    for part in loc:
-        fields = getattr(cls, "model_fields", None)
-        if fields is not None and isinstance(part, str) and part in fields:
-            info = fields[part]
-            cls = info.annotation
-        elif getattr(cls, "__origin__", None) is dict:
-            cls = cls.__args__[1]  # type: ignore[attr-defined]
-        else:
-            return ""
-    unit = next((m.symbol for m in getattr(info, "metadata", ()) if isinstance(m, Unit)), "")
-    return f" {unit}" if unit else ""
-
-
 @cache
 def _load_path(path: str, mtime: float) -> Library:
-    from pydantic import ValidationError
+    from .library_check import load_file
 
-    text, data = read_library(path)
-    try:
-        return Library.model_validate(data)
-    except ValidationError as e:
-        first = e.errors()[0]
-        ranged = _range_error(first, text, path)
-        if ranged is not None:
-            raise ranged from None
-        loc = ".".join(str(p) for p in first["loc"] if p != "[key]")
-        message = plain_words(first)
-        raise LibraryError(f"{loc}: {message}" if loc else message, where(text, path, first["loc"]), text) from None
+    return load_file(path)
 
 
 def resolve(ref: str, relative_to: Path | None = None) -> Path | None:

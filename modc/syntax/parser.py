@@ -30,14 +30,87 @@ def too_large(text: str, file: str) -> Diagnostic | None:
     return codes.INPUT_TOO_LARGE.at(Span.point(file), what="the file", size=shown, limit=f"{MAX_BYTES:,} bytes")
 
 
+_OPTIONS = {"parser": "lalr", "propagate_positions": True, "maybe_placeholders": True,
+            "start": ["start", "unit_text", "quantity_text", "vector_text"]}
+
+
 @cache
 def _lark():
-    from lark import Lark
+    import lark
 
     text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
-    # cache=True keeps the LALR tables in the temp dir: a cold `modc lint` skips building them.
-    return Lark(text, parser="lalr", propagate_positions=True, maybe_placeholders=True, cache=True,
-                start=["start", "unit_text", "quantity_text", "vector_text"])
+    name = _tables_name(text, lark.__version__)
+    parser = _load_tables(name)
+    if parser is None:
+        parser = lark.Lark(text, **_OPTIONS)
+        _save_tables(name, parser)
+    return parser
+
+
+def _tables_name(text: str, lark_version: str) -> str:
+    """The cache entry of the grammar's LALR tables: keyed by the grammar, the options, lark's
+    version and Python's (marshal's format is Python's)."""
+    import sys
+
+    from ..cache import key
+
+    return key(text, repr(sorted(_OPTIONS.items())), lark_version, repr(sys.version_info[:2])) + ".lalr"
+
+
+# Building the LALR tables is most of a cold `modc lint` (benchmarks/bench_startup.py). They are
+# kept in modc's cache as marshal data (lists, dicts, strings: never pickle, which runs code), each
+# entry led by a digest of its payload: a torn or altered entry is rebuilt, never used.
+_TABLES = "grammar"
+
+
+def _load_tables(name: str):
+    import hashlib
+    import marshal
+
+    from .. import cache
+
+    blob = cache.get(_TABLES, name)
+    if blob is None:
+        return None
+    digest, _, payload = blob.partition(b"\n")
+    if hashlib.sha256(payload).hexdigest().encode() != digest:
+        return None
+    from lark import Lark
+
+    try:
+        data, memo = marshal.loads(payload)
+        return Lark._load_from_dict(data, memo, propagate_positions=_OPTIONS["propagate_positions"])
+    except Exception:  # an entry of another lark, or not ours: build the tables instead
+        return None
+
+
+def _plain(v) -> bool:
+    if isinstance(v, list | tuple):
+        return all(_plain(x) for x in v)
+    if isinstance(v, dict):
+        return all(_plain(x) for x in v.values())
+    return v is None or isinstance(v, str | int | float)
+
+
+def _save_tables(name: str, parser) -> None:
+    import hashlib
+    import marshal
+
+    from lark.grammar import Rule
+    from lark.lexer import TerminalDef
+
+    from .. import cache
+
+    if cache.directory(_TABLES) is None:
+        return
+    data, memo = parser.memo_serialize([TerminalDef, Rule])
+    # options that are not data (callbacks, classes) take their defaults at load, as in lark's own cache
+    data["options"] = {k: v for k, v in data["options"].items() if _plain(v)}
+    try:
+        payload = marshal.dumps((data, memo))
+    except ValueError:  # a lark whose tables hold more than plain data: no cache
+        return
+    cache.put(_TABLES, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
 
 
 def grammar_keywords() -> set[str]:

@@ -1,0 +1,188 @@
+"""The boundary of the module library: a library file validated by pydantic against the types of
+modc.model.library, and a content-keyed cache of the validated values.
+
+A file whose validated values are in modc's cache (modc.cache, kind "library") is rebuilt from
+them as plain dataclasses: no YAML parser, no pydantic (a cold `modc lint` pays neither). An entry
+is keyed by the file's bytes, modc's version and the library's types; it carries a digest of its
+content, and one that is torn, altered or of another shape is ignored and rewritten.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import typing
+from functools import cache
+from typing import Any
+
+from .. import __version__
+from ..diagnostics.plain_words import plain_words
+from . import library as L
+from .library_file import MAX_LIBRARY_BYTES, LibraryError, read_library, where
+
+_KIND = "library"
+FORMAT = "1"  # the entry's layout
+
+# pydantic's names for the errors of a plain dataclass, as plain_words knows them from models
+_ERROR_TYPES = {"missing_argument": "missing", "unexpected_keyword_argument": "extra_forbidden",
+                "dataclass_type": "model_type", "dataclass_args_type": "model_type"}
+
+
+def load_file(path: str) -> L.Library:
+    """The validated library in the file at path (resolved); LibraryError if it is none."""
+    from ..files import read_bounded
+
+    try:
+        raw, size = read_bounded(path, MAX_LIBRARY_BYTES)
+    except OSError:
+        raw, size = b"", -1  # read_library says why
+    name = _entry_name(raw) if 0 <= size <= MAX_LIBRARY_BYTES else None
+    if name is not None:
+        hit = _from_cache(name)
+        if hit is not None:
+            return hit
+    library = validate(path)
+    if name is not None:
+        _store(name, library)
+    return library
+
+
+def validate(path: str) -> L.Library:
+    from pydantic import ValidationError
+
+    text, data = read_library(path)
+    try:
+        return _adapter().validate_python(data)
+    except ValidationError as e:
+        first: dict[str, Any] = dict(e.errors()[0])
+        first["type"] = _ERROR_TYPES.get(first["type"], first["type"])
+        ranged = _range_error(first, text, path)
+        if ranged is not None:
+            raise ranged from None
+        loc = ".".join(str(p) for p in first["loc"] if p != "[key]")
+        message = plain_words(first)
+        raise LibraryError(f"{loc}: {message}" if loc else message, where(text, path, first["loc"]), text) from None
+
+
+@cache
+def _adapter():
+    from pydantic import TypeAdapter
+
+    return TypeAdapter(L.Library)
+
+
+def _range_error(err, text: str, path: str) -> LibraryError | None:
+    """A number beyond its field's upper bound: out-of-range, as for .mod quantities."""
+    ctx = err.get("ctx") or {}
+    if err.get("type") != "less_than_equal" or "le" not in ctx:
+        return None
+    try:  # YAML 1.1 reads 1e308 (no dot) as text, which pydantic takes for a number
+        value = float(err.get("input"))
+    except (TypeError, ValueError, OverflowError):
+        return None
+    unit = _unit(err["loc"])
+    what = ".".join(str(p) for p in err["loc"])
+    fields = {"what": what, "value": f"{value:g}{unit}", "limit": f"{ctx['le']:g}{unit}"}
+    message = f"{what} = {fields['value']} is out of range (at most {fields['limit']})"
+    return LibraryError(message, where(text, path, err["loc"]), text, "out-of-range", fields)
+
+
+def _unit(loc: tuple) -> str:
+    """' kg' for a location whose field's Bounds name a unit, else ''."""
+    tp: Any = L.Library
+    for part in loc:
+        if isinstance(tp, type) and dataclasses.is_dataclass(tp) and isinstance(part, str):
+            hints = _hints(tp, extras=True)
+            if part not in hints:
+                return ""
+            tp = hints[part]
+        elif typing.get_origin(tp) is dict:
+            tp = typing.get_args(tp)[1]
+        else:
+            return ""
+    unit = next((m.symbol for m in getattr(tp, "__metadata__", ()) if isinstance(m, L.Bounds)), "")
+    return f" {unit}" if unit else ""
+
+
+@cache
+def _hints(cls: type, extras: bool = False) -> dict[str, Any]:
+    return typing.get_type_hints(cls, vars(L), include_extras=extras)
+
+
+# --- the cache -----------------------------------------------------------------------------------
+
+@cache
+def _shape() -> str:
+    """The library's types, field by field: an entry written for other types is another key."""
+    seen: list[str] = []
+
+    def walk(tp: Any) -> None:
+        if isinstance(tp, type) and dataclasses.is_dataclass(tp):
+            seen.append(tp.__name__)
+            for f in dataclasses.fields(tp):
+                seen.append(f"{f.name}:{f.type}")
+                walk(_hints(tp)[f.name])
+        for arg in typing.get_args(tp):
+            walk(arg)
+
+    walk(L.Library)
+    return ";".join(seen)
+
+
+def _entry_name(raw: bytes) -> str:
+    from ..cache import key
+
+    return key(_KIND, FORMAT, __version__, _shape(), raw) + ".json"
+
+
+def _from_cache(name: str) -> L.Library | None:
+    from .. import cache as disk
+
+    blob = disk.get(_KIND, name)
+    if blob is None:
+        return None
+    digest, _, payload = blob.partition(b"\n")
+    if hashlib.sha256(payload).hexdigest().encode() != digest:
+        return None
+    try:
+        library = _build(L.Library, json.loads(payload))
+    except (ValueError, TypeError, KeyError, AttributeError):  # not the shape of a Library
+        return None
+    return library if isinstance(library, L.Library) else None
+
+
+def _store(name: str, library: L.Library) -> None:
+    from .. import cache as disk
+
+    payload = json.dumps(dataclasses.asdict(library), allow_nan=False).encode()
+    disk.put(_KIND, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
+
+
+def _build(tp: Any, value: Any) -> Any:
+    """value (JSON) as the type tp: the inverse of dataclasses.asdict + json for the library's
+    types (JSON turns the int keys of `units` into strings)."""
+    origin = typing.get_origin(tp)
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise TypeError(tp.__name__)
+        hints = _hints(tp)
+        return tp(**{k: _build(hints[k], v) for k, v in value.items()})
+    if origin is dict:
+        kt, vt = typing.get_args(tp)
+        return {_build(kt, k): _build(vt, v) for k, v in value.items()}
+    if origin is list:
+        (et,) = typing.get_args(tp)
+        return [_build(et, v) for v in value]
+    if origin is typing.Literal:
+        if value not in typing.get_args(tp):
+            raise ValueError(value)
+        return value
+    if tp is float:
+        if isinstance(value, bool):
+            raise TypeError("bool")
+        return float(value)
+    if tp in (int, str, bool):
+        if type(value) is not tp and not (tp is int and isinstance(value, str) and value.isdigit()):
+            raise TypeError(tp.__name__)
+        return tp(value)
+    raise TypeError(repr(tp))
