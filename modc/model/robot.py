@@ -4,43 +4,128 @@ Backends read only this (and the library it points to), never the syntax.
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal
-
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, SkipValidation
+import dataclasses
+from collections.abc import Callable
+from typing import Any, ClassVar, Literal
 
 from .. import names
 from ..diagnostics import NOWHERE, Span
 from .library import Library
 
 
+class InvalidModel(ValueError):
+    """A model value that breaks the model's own rules (a bad name): lowering reports these as
+    diagnostics first, so this is the guarantee that no backend sees one, not the user's path."""
+
+
 def _identifier(text: str) -> str:
     problem = names.identifier_problem(text)
     if problem:
-        raise ValueError(problem)
+        raise InvalidModel(problem)
     return text
 
 
 # Every user-given name in the model (robot, unit, pose, target, obstacle, joint reference) is one
 # of these: lowering reports a bad one as invalid-name, so no backend can ever see another string.
-Name = Annotated[str, AfterValidator(_identifier)]
+Name = str
 Vec3 = tuple[float, float, float]
-# the default is assigned at each field (`span: SpanField = NOWHERE`) so that type checkers see it
-SpanField = Annotated[SkipValidation[Span], Field(exclude=True, repr=False)]
 
 
-class _M(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
+def _vec3(v: Any) -> Vec3:
+    x, y, z = v
+    return (float(x), float(y), float(z))
 
 
+def _floats(v: Any) -> tuple[float, ...]:
+    return tuple(float(x) for x in v)
+
+
+def _grid(v: Any) -> tuple[int, int, int]:
+    i, j, k = v
+    return (int(i), int(j), int(k))
+
+
+def _optional(convert: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    return lambda v: None if v is None else convert(v)
+
+
+def _hidden(default: Any = dataclasses.MISSING, **kw: Any) -> Any:
+    """A field left out of repr and model_dump (spans, analyses' results)."""
+    return dataclasses.field(default=default, repr=False, metadata={"hidden": True}, **kw)
+
+
+
+class _M:
+    """The checked model's values: frozen dataclasses, checked when built (names, numbers as
+    floats, sequences as tuples) and never after. The methods are those of pydantic's models,
+    which these types were, that callers use."""
+
+    _names: ClassVar[tuple[str, ...]] = ()  # fields that are identifiers
+    _convert: ClassVar[tuple[tuple[str, Callable[[Any], Any]], ...]] = ()  # (field, to its type)
+
+    def __post_init__(self) -> None:
+        for f in self._names:
+            _identifier(getattr(self, f))
+        for f, convert in self._convert:
+            object.__setattr__(self, f, convert(getattr(self, f)))
+
+    def model_copy(self, update: dict[str, Any] | None = None) -> Any:
+        """A copy with some fields replaced, unchecked (as pydantic's model_copy)."""
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        for k, v in (update or {}).items():
+            if k not in new.__dict__:
+                raise TypeError(f"{type(self).__name__} has no field {k!r}")
+            new.__dict__[k] = v
+        return new
+
+    @classmethod
+    def model_construct(cls, **values: Any) -> Any:
+        """An instance built unchecked, missing fields at their defaults (as pydantic's)."""
+        new = object.__new__(cls)
+        for f in dataclasses.fields(cls):  # type: ignore[arg-type]
+            if f.name in values:
+                new.__dict__[f.name] = values[f.name]
+            elif f.default is not dataclasses.MISSING:
+                new.__dict__[f.name] = f.default
+            elif f.default_factory is not dataclasses.MISSING:
+                new.__dict__[f.name] = f.default_factory()
+        return new
+
+    def model_dump(self) -> dict[str, Any]:
+        """The fields as plain values, spans and analyses' results left out."""
+        return {f.name: _dump(getattr(self, f.name)) for f in dataclasses.fields(self)  # type: ignore[arg-type]
+                if not f.metadata.get("hidden")}
+
+
+def _dump(v: Any) -> Any:
+    if isinstance(v, _M):
+        return v.model_dump()
+    if dataclasses.is_dataclass(v) and not isinstance(v, type):
+        return dataclasses.asdict(v)
+    if isinstance(v, tuple | list):
+        return type(v)(_dump(x) for x in v)
+    if isinstance(v, dict):
+        return {k: _dump(x) for k, x in v.items()}
+    return v
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Transform(_M):
     """A placement: position (m) then fixed-axis roll-pitch-yaw (rad), as in URDF."""
+
+    _convert = (("xyz", _vec3), ("rpy", _vec3))
 
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class UnitSpec(_M):
     """One modular unit of the chain, e.g. H4(pivot=-90deg, port=45deg)."""
+
+    _names = ("name",)
+    _convert = (("kind", int), ("pivot", float), ("port", float), ("link", _optional(float)))
 
     name: Name
     variant: str = ""  # filled once the library is known
@@ -48,66 +133,100 @@ class UnitSpec(_M):
     pivot: float = 0.0  # rad, twist in the adaptive twist unit (rotation about y, eq. 4)
     port: float = 0.0  # rad, twist at the connection port after the link (rotation about x, eq. 6)
     link: float | None = None  # m, link-module length; None = the library's default
-    span: SpanField = NOWHERE
-    param_spans: Annotated[SkipValidation[dict[str, Span]], Field(exclude=True, repr=False)] = {}  # pydantic copies it
+    span: Span = _hidden(NOWHERE)
+    param_spans: dict[str, Span] = _hidden(default_factory=dict)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class DHRow(_M):
     """One row of a standard DH table: Rz(theta) Tz(d) Tx(a) Rx(alpha), SI units."""
+
+    _convert = (("a", float), ("alpha", float), ("d", float), ("theta", float))
 
     a: float
     alpha: float
     d: float
     theta: float = 0.0
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Payload(_M):
+    _convert = (("mass", float), ("com", _vec3))
+
     mass: float  # kg
     com: Vec3 = (0.0, 0.0, 0.0)  # m, in the tool0 frame
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Pose(_M):
+    _names = ("name",)
+    _convert = (("q", _floats),)
+
     name: Name
     q: tuple[float, ...]  # rad, joint_1 first
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class JointLimit(_M):
+    _names = ("joint",)
+    _convert = (("lower", float), ("upper", float))
+
     joint: Name
     lower: float
     upper: float
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Obstacle(_M):
+    _names = ("name",)
+    _convert = (("size", _floats),)
+    SHAPES: ClassVar[tuple[str, ...]] = ("box", "sphere", "cylinder")
+
     name: Name
     shape: Literal["box", "sphere", "cylinder"]
     size: tuple[float, ...]  # box: (x, y, z); sphere: (r,); cylinder: (r, length along z)
     origin: Transform
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.shape not in self.SHAPES:
+            raise InvalidModel(f"an obstacle is one of {', '.join(self.SHAPES)}")
 
 
 POSITION_TOLERANCE = 0.005  # m: default distance of tool0 from a target that counts as on it
 ORIENTATION_TOLERANCE = 0.034906585039886591  # rad (2°): default for a target with an orientation
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Target(_M):
+    _names = ("name",)
+    _convert = (("xyz", _vec3), ("rpy", _optional(_vec3)), ("position_tolerance", float),
+                ("orientation_tolerance", float))
+
     name: Name
     xyz: Vec3  # m, in base_link
     rpy: Vec3 | None = None  # rad, tool0's orientation in base_link (URDF fixed axes); None: position only
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
 MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; beyond this, a typo
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Region(_M):
     """`region NAME box size … at … grid nx x ny x nz`: targets evenly spaced over an axis-aligned
     box, faces included; an axis with one point holds it at the box's centre."""
+
+    _names = ("name",)
+    _convert = (("size", _vec3), ("center", _vec3), ("grid", _grid), ("rpy", _optional(_vec3)),
+                ("position_tolerance", float), ("orientation_tolerance", float))
 
     name: Name
     size: Vec3  # m, full extents
@@ -116,7 +235,7 @@ class Region(_M):
     rpy: Vec3 | None = None  # every point's tool0 orientation
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
     def indices(self) -> list[tuple[int, int, int]]:
         """Every point's (i, j, k), in order: k fastest, then j, then i."""
@@ -139,33 +258,43 @@ class Region(_M):
         return [self.point(ix) for ix in self.indices()]
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Task(_M):
     """`task NAME { visit … }`: the targets tool0 visits in order (region names expanded to their
     points), joined by collision-free joint-space motions."""
 
+    _names = ("name",)
+    _convert = (("visits", tuple),)
+
     name: Name
     visits: tuple[str, ...]  # target names and region point names (`tray[0,1,0]`)
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class StraightPath(_M):
     """`path NAME from a to b straight`: tool0 along the segment a -> b, orientation interpolated."""
+
+    _names = ("name",)
 
     name: Name
     start: str
     end: str
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class BaseGrid(_M):
     """`base within box size … at … step … [yaw lo to hi step s]` (design blocks): the base
     positions (and yaws) to try, in the cell frame."""
+
+    _convert = (("size", _vec3), ("center", _vec3), ("step", float), ("yaws", _floats))
 
     size: Vec3
     center: Vec3
     step: float  # m
     yaws: tuple[float, ...] = (0.0,)  # rad
-    span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
 
     def positions(self) -> list[Vec3]:
         axes = []
@@ -184,7 +313,12 @@ def default_position(lower: float, upper: float) -> float:
     return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Robot(_M):
+    _names = ("name",)
+    _convert = (*((f, tuple) for f in ("units", "poses", "limits", "obstacles", "targets", "regions", "tasks", "paths")),
+                ("dh", _optional(tuple)), ("allow", frozenset))
+
     name: Name
     library_ref: str = "mark2"
     library_dir: str | None = None  # where a relative library path is resolved
@@ -203,10 +337,10 @@ class Robot(_M):
     regions: tuple[Region, ...] = ()
     tasks: tuple[Task, ...] = ()
     paths: tuple[StraightPath, ...] = ()
-    torque: tuple | None = Field(default=None, exclude=True, repr=False)  # set by check_torque
-    span: SpanField = NOWHERE
-    name_span: SpanField = NOWHERE
-    library_span: SpanField = NOWHERE  # the `library` statement, where library errors point
+    torque: tuple | None = _hidden(None)  # set by check_torque
+    span: Span = _hidden(NOWHERE)
+    name_span: Span = _hidden(NOWHERE)
+    library_span: Span = _hidden(NOWHERE)  # the `library` statement, where library errors point
 
     @property
     def dof(self) -> int:
@@ -278,9 +412,14 @@ RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest
 TASK_RANK_KEYS = ("cycle_time", "energy", "coverage")  # objectives of tasks: ranked only when named
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Problem(_M):
     """A `design` block: the cell (a robot without units: library, base, tool, payload,
     obstacles, targets) and the bounds and objectives of the search for its chains."""
+
+    _names = ("name",)
+    _convert = (("min_units", int), ("max_units", int), ("modules", _optional(tuple)), ("links", _optional(_floats)),
+                ("rank", tuple))
 
     name: Name
     cell: Robot
@@ -290,14 +429,17 @@ class Problem(_M):
     links: tuple[float, ...] | None = None  # m, link-module lengths to try; None: the library's default
     rank: tuple[str, ...] = RANK_KEYS
     base_grid: BaseGrid | None = None  # `base within …`: base poses to try (cell frame); None: the base as written
-    span: SpanField = NOWHERE
-    name_span: SpanField = NOWHERE
+    span: Span = _hidden(NOWHERE)
+    name_span: Span = _hidden(NOWHERE)
     # where each bound was written ("units", "links", "module:H9"), for the library checks
-    bound_spans: Annotated[SkipValidation[dict[str, Span]], Field(default_factory=dict, exclude=True, repr=False)]
+    bound_spans: dict[str, Span] = _hidden(default_factory=dict)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Design(_M):
     """Everything one input file defines."""
+
+    _convert = (("robots", tuple), ("problems", tuple))
 
     path: str
     robots: tuple[Robot, ...] = ()
