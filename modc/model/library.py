@@ -14,20 +14,21 @@ from typing import Annotated, Any, Literal
 from .. import names
 from . import quantities as Q
 from .library_file import LIBRARY_KEYS, MAX_LIBRARY_BYTES, LibraryError, read_library, where  # noqa: F401 (re-exported)
+from .record import Record
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
-# The library's types are plain frozen dataclasses: a command whose library is in modc's cache
+# The library's types are frozen records (modc.model.record): a command whose library is in modc's cache
 # (modc.model.library_check) builds them from stored values without importing pydantic. Their
 # annotations are the schema: pydantic reads them, with the Rule and Bounds below, only when a
 # library file is validated.
 
 
-@dataclasses.dataclass(frozen=True)
 class Rule:
     """A string field's rule (one of modc.names'): the problem with a text, or None."""
 
-    problem: Callable[[str], str | None]
+    def __init__(self, problem: Callable[[str], str | None]):
+        self.problem = problem
 
     def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
         def check(text: str) -> str:
@@ -46,14 +47,11 @@ Label = Annotated[str, Rule(names.label_problem)]
 Text = Annotated[str, Rule(names.text_problem)]
 
 
-@dataclasses.dataclass(frozen=True)
 class Bounds:
     """The range of a library number, and its unit (for out-of-range messages)."""
 
-    lo: float
-    hi: float
-    symbol: str = ""
-    open_lo: bool = False  # lo itself is outside
+    def __init__(self, lo: float, hi: float, symbol: str = "", open_lo: bool = False):
+        self.lo, self.hi, self.symbol, self.open_lo = lo, hi, symbol, open_lo  # open_lo: lo itself is outside
 
     def __get_pydantic_core_schema__(self, source: Any, handler: Any) -> Any:
         return {**handler(source), ("gt" if self.open_lo else "ge"): self.lo, "le": self.hi}
@@ -88,14 +86,8 @@ Count = Annotated[int, Bounds(1, MAX_COUNT)]
 UnitNumber = Annotated[int, Bounds(1, 99)]  # unit type numbers: H1..H4
 
 
-class _Frozen:
-    # read by pydantic when it validates a library file (a plain dict: no pydantic import here)
-    __pydantic_config__ = {"extra": "forbid", "allow_inf_nan": False}
 
-
-
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Actuator(_Frozen):
+class Actuator(Record):
     model: Text
     mass: Mass  # kg (paper Table 1)
     rpm: Speed  # rated speed, rev/min (paper Table 1)
@@ -111,13 +103,11 @@ class Actuator(_Frozen):
         return self.rpm * 2.0 * math.pi / 60.0
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Part(_Frozen):
+class Part(Record):
     mass: Mass  # kg
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Casings(_Frozen):
+class Casings(Record):
     input_mass: Mass
     output_mass: Mass
     wall: Length  # m, casing wall thickness
@@ -125,23 +115,20 @@ class Casings(_Frozen):
     boss_radius: Length  # m, radius of the pivotal extension
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class TwistUnit(_Frozen):
+class TwistUnit(Record):
     mass: Mass
     plate: Length  # m, base plate thickness
     cheek_thickness: Length
     cheek_width: Length
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class LinkModule(_Frozen):
+class LinkModule(Record):
     mass_per_length: LinearDensity  # kg/m of a printed link bar
     width: Length  # m, along y of the joint frame
     height: Length  # m, along z of the joint frame
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Variant(_Frozen):
+class Variant(Record):
     description: Text
     actuator: Actuator
     casings: Casings
@@ -155,8 +142,7 @@ class Variant(_Frozen):
             raise ValueError("lower_deg must be below upper_deg")
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class UnitType(_Frozen):
+class UnitType(Record):
     """One of the paper's four modular units (section 3.1, eqs. 7-10)."""
 
     port: Literal["Ip1", "Ip2"]
@@ -172,8 +158,7 @@ class UnitType(_Frozen):
             raise ValueError(f"x23 of a unit with a link module must be at least {SMALLEST_LENGTH * 1000:g} mm")
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class TwistSet(_Frozen):
+class TwistSet(Record):
     """Realisable twist values: min..max in steps of step (all degrees)."""
 
     min_deg: TwistDeg
@@ -211,14 +196,12 @@ def _clean(x: float) -> float:
     return 0.0 if abs(x) < 1e-12 else x
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Twists(_Frozen):
+class Twists(Record):
     pivot: TwistSet
     port: TwistSet
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Rules(_Frozen):
+class Rules(Record):
     """Assembly rules (paper section 3, rules 1-4)."""
 
     first_variant: VariantName
@@ -228,15 +211,13 @@ class Rules(_Frozen):
     max_dof: Count
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Control(_Frozen):
+class Control(Record):
     p: PositiveGain  # proportional gain, actuator units (paper section 4.4)
     i: Gain
     d: Gain
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class Library(_Frozen):
+class Library(Record):
     name: Label
     description: Text
     source: Text

@@ -1,32 +1,28 @@
 """The boundary of the module library: a library file validated by pydantic against the types of
-modc.model.library, and a content-keyed cache of the validated values.
+modc.model.library (pydantic models made from those records' annotations, here only), and a
+content-keyed cache of the validated values.
 
 A file whose validated values are in modc's cache (modc.cache, kind "library") is rebuilt from
-them as plain dataclasses: no YAML parser, no pydantic (a cold `modc lint` pays neither). An entry
+them as records: no YAML parser, no pydantic (a cold `modc lint` pays neither). An entry
 is keyed by the file's bytes, modc's version and the library's types; it carries a digest of its
 content, and one that is torn, altered or of another shape is ignored and rewritten.
 """
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import typing
 from functools import cache
-from typing import Any
+from typing import Annotated, Any
 
 from .. import __version__
 from ..diagnostics.plain_words import plain_words
 from . import library as L
 from .library_file import MAX_LIBRARY_BYTES, LibraryError, read_library, where
+from .record import as_plain, is_record
 
 _KIND = "library"
 FORMAT = "1"  # the entry's layout
-
-# pydantic's names for the errors of a plain dataclass, as plain_words knows them from models
-_ERROR_TYPES = {"missing_argument": "missing", "unexpected_keyword_argument": "extra_forbidden",
-                "dataclass_type": "model_type", "dataclass_args_type": "model_type"}
-
 
 def load_file(path: str) -> L.Library:
     """The validated library in the file at path (resolved); LibraryError if it is none."""
@@ -54,8 +50,7 @@ def validate(path: str) -> L.Library:
     try:
         return _adapter().validate_python(data)
     except ValidationError as e:
-        first: dict[str, Any] = dict(e.errors()[0])
-        first["type"] = _ERROR_TYPES.get(first["type"], first["type"])
+        first = e.errors()[0]
         ranged = _range_error(first, text, path)
         if ranged is not None:
             raise ranged from None
@@ -68,7 +63,30 @@ def validate(path: str) -> L.Library:
 def _adapter():
     from pydantic import TypeAdapter
 
-    return TypeAdapter(L.Library)
+    return TypeAdapter(_schema(L.Library))
+
+
+def _schema(tp: Any) -> Any:
+    """tp for pydantic: each record type as a pydantic model of its fields that, once valid, is
+    made into the record (whose own checks then run: their ValueError is pydantic's too)."""
+    if is_record(tp):
+        return _model(tp)
+    args = typing.get_args(tp)
+    if typing.get_origin(tp) is Annotated:
+        return Annotated[(_schema(args[0]),) + tuple(tp.__metadata__)]
+    if typing.get_origin(tp) in (dict, list):
+        return typing.get_origin(tp)[tuple(_schema(a) for a in args)]
+    return tp
+
+
+@cache
+def _model(cls: type) -> Any:
+    from pydantic import AfterValidator, ConfigDict, create_model
+
+    hints = _hints(cls, extras=True)
+    fields: dict[str, Any] = {n: (_schema(hints[n]), cls._defaults.get(n, ...)) for n in cls._fields}  # type: ignore[attr-defined]
+    model = create_model(cls.__name__, __config__=ConfigDict(extra="forbid", allow_inf_nan=False), **fields)
+    return Annotated[model, AfterValidator(lambda m: cls(**{n: getattr(m, n) for n in cls._fields}))]  # type: ignore[attr-defined]
 
 
 def _range_error(err, text: str, path: str) -> LibraryError | None:
@@ -91,7 +109,7 @@ def _unit(loc: tuple) -> str:
     """' kg' for a location whose field's Bounds name a unit, else ''."""
     tp: Any = L.Library
     for part in loc:
-        if isinstance(tp, type) and dataclasses.is_dataclass(tp) and isinstance(part, str):
+        if is_record(tp) and isinstance(part, str):
             hints = _hints(tp, extras=True)
             if part not in hints:
                 return ""
@@ -106,7 +124,8 @@ def _unit(loc: tuple) -> str:
 
 @cache
 def _hints(cls: type, extras: bool = False) -> dict[str, Any]:
-    return typing.get_type_hints(cls, vars(L), include_extras=extras)
+    hints = typing.get_type_hints(cls, include_extras=extras)
+    return {name: hints[name] for name in cls._fields}  # type: ignore[attr-defined]
 
 
 # --- the cache -----------------------------------------------------------------------------------
@@ -117,11 +136,11 @@ def _shape() -> str:
     seen: list[str] = []
 
     def walk(tp: Any) -> None:
-        if isinstance(tp, type) and dataclasses.is_dataclass(tp):
+        if is_record(tp):
             seen.append(tp.__name__)
-            for f in dataclasses.fields(tp):
-                seen.append(f"{f.name}:{f.type}")
-                walk(_hints(tp)[f.name])
+            for name in tp._fields:
+                seen.append(f"{name}:{tp.__annotations__.get(name, '')}")
+                walk(_hints(tp)[name])
         for arg in typing.get_args(tp):
             walk(arg)
 
@@ -154,15 +173,15 @@ def _from_cache(name: str) -> L.Library | None:
 def _store(name: str, library: L.Library) -> None:
     from .. import cache as disk
 
-    payload = json.dumps(dataclasses.asdict(library), allow_nan=False).encode()
+    payload = json.dumps(as_plain(library), allow_nan=False).encode()
     disk.put(_KIND, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
 
 
 def _build(tp: Any, value: Any) -> Any:
-    """value (JSON) as the type tp: the inverse of dataclasses.asdict + json for the library's
-    types (JSON turns the int keys of `units` into strings)."""
+    """value (JSON) as the type tp: the inverse of as_plain + json for the library's types (JSON
+    turns the int keys of `units` into strings)."""
     origin = typing.get_origin(tp)
-    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
+    if is_record(tp):
         if not isinstance(value, dict):
             raise TypeError(tp.__name__)
         hints = _hints(tp)

@@ -4,13 +4,13 @@ Backends read only this (and the library it points to), never the syntax.
 """
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from typing import Any, ClassVar, Literal
 
 from .. import names
 from ..diagnostics import NOWHERE, Span
 from .library import Library
+from .record import Record, as_plain, field
 
 
 class InvalidModel(ValueError):
@@ -49,16 +49,18 @@ def _optional(convert: Callable[[Any], Any]) -> Callable[[Any], Any]:
     return lambda v: None if v is None else convert(v)
 
 
-def _hidden(default: Any = dataclasses.MISSING, **kw: Any) -> Any:
+def _hidden(default: Any = None, *, default_factory: Callable[[], Any] | None = None) -> Any:
     """A field left out of repr and model_dump (spans, analyses' results)."""
-    return dataclasses.field(default=default, repr=False, metadata={"hidden": True}, **kw)
+    if default_factory is not None:
+        return field(default_factory=default_factory, hidden=True)
+    return field(default=default, hidden=True)
 
 
 
-class _M:
-    """The checked model's values: frozen dataclasses, checked when built (names, numbers as
-    floats, sequences as tuples) and never after. The methods are those of pydantic's models,
-    which these types were, that callers use."""
+class _M(Record):
+    """The checked model's values: frozen records, checked when built (names, numbers as
+    floats, sequences as tuples) and never after. The methods are those of pydantic's models
+    (which these types were) that callers use."""
 
     _names: ClassVar[tuple[str, ...]] = ()  # fields that are identifiers
     _convert: ClassVar[tuple[tuple[str, Callable[[Any], Any]], ...]] = ()  # (field, to its type)
@@ -83,34 +85,20 @@ class _M:
     def model_construct(cls, **values: Any) -> Any:
         """An instance built unchecked, missing fields at their defaults (as pydantic's)."""
         new = object.__new__(cls)
-        for f in dataclasses.fields(cls):  # type: ignore[arg-type]
-            if f.name in values:
-                new.__dict__[f.name] = values[f.name]
-            elif f.default is not dataclasses.MISSING:
-                new.__dict__[f.name] = f.default
-            elif f.default_factory is not dataclasses.MISSING:
-                new.__dict__[f.name] = f.default_factory()
+        for name in cls._fields:
+            if name in values:
+                new.__dict__[name] = values[name]
+            elif name in cls._defaults:
+                new.__dict__[name] = cls._defaults[name]
+            elif name in cls._factories:
+                new.__dict__[name] = cls._factories[name]()
         return new
 
     def model_dump(self) -> dict[str, Any]:
         """The fields as plain values, spans and analyses' results left out."""
-        return {f.name: _dump(getattr(self, f.name)) for f in dataclasses.fields(self)  # type: ignore[arg-type]
-                if not f.metadata.get("hidden")}
+        return as_plain(self, hidden=False)
 
 
-def _dump(v: Any) -> Any:
-    if isinstance(v, _M):
-        return v.model_dump()
-    if dataclasses.is_dataclass(v) and not isinstance(v, type):
-        return dataclasses.asdict(v)
-    if isinstance(v, tuple | list):
-        return type(v)(_dump(x) for x in v)
-    if isinstance(v, dict):
-        return {k: _dump(x) for k, x in v.items()}
-    return v
-
-
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Transform(_M):
     """A placement: position (m) then fixed-axis roll-pitch-yaw (rad), as in URDF."""
 
@@ -120,7 +108,6 @@ class Transform(_M):
     rpy: Vec3 = (0.0, 0.0, 0.0)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class UnitSpec(_M):
     """One modular unit of the chain, e.g. H4(pivot=-90deg, port=45deg)."""
 
@@ -137,7 +124,6 @@ class UnitSpec(_M):
     param_spans: dict[str, Span] = _hidden(default_factory=dict)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class DHRow(_M):
     """One row of a standard DH table: Rz(theta) Tz(d) Tx(a) Rx(alpha), SI units."""
 
@@ -150,7 +136,6 @@ class DHRow(_M):
     span: Span = _hidden(NOWHERE)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Payload(_M):
     _convert = (("mass", float), ("com", _vec3))
 
@@ -159,7 +144,6 @@ class Payload(_M):
     span: Span = _hidden(NOWHERE)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Pose(_M):
     _names = ("name",)
     _convert = (("q", _floats),)
@@ -169,7 +153,6 @@ class Pose(_M):
     span: Span = _hidden(NOWHERE)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class JointLimit(_M):
     _names = ("joint",)
     _convert = (("lower", float), ("upper", float))
@@ -180,7 +163,6 @@ class JointLimit(_M):
     span: Span = _hidden(NOWHERE)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Obstacle(_M):
     _names = ("name",)
     _convert = (("size", _floats),)
@@ -202,7 +184,6 @@ POSITION_TOLERANCE = 0.005  # m: default distance of tool0 from a target that co
 ORIENTATION_TOLERANCE = 0.034906585039886591  # rad (2°): default for a target with an orientation
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Target(_M):
     _names = ("name",)
     _convert = (("xyz", _vec3), ("rpy", _optional(_vec3)), ("position_tolerance", float),
@@ -219,7 +200,6 @@ class Target(_M):
 MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; beyond this, a typo
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Region(_M):
     """`region NAME box size … at … grid nx x ny x nz`: targets evenly spaced over an axis-aligned
     box, faces included; an axis with one point holds it at the box's centre."""
@@ -258,7 +238,6 @@ class Region(_M):
         return [self.point(ix) for ix in self.indices()]
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Task(_M):
     """`task NAME { visit … }`: the targets tool0 visits in order (region names expanded to their
     points), joined by collision-free joint-space motions."""
@@ -271,7 +250,6 @@ class Task(_M):
     span: Span = _hidden(NOWHERE)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class StraightPath(_M):
     """`path NAME from a to b straight`: tool0 along the segment a -> b, orientation interpolated."""
 
@@ -283,7 +261,6 @@ class StraightPath(_M):
     span: Span = _hidden(NOWHERE)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class BaseGrid(_M):
     """`base within box size … at … step … [yaw lo to hi step s]` (design blocks): the base
     positions (and yaws) to try, in the cell frame."""
@@ -313,11 +290,10 @@ def default_position(lower: float, upper: float) -> float:
     return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Robot(_M):
     _names = ("name",)
-    _convert = (*((f, tuple) for f in ("units", "poses", "limits", "obstacles", "targets", "regions", "tasks", "paths")),
-                ("dh", _optional(tuple)), ("allow", frozenset))
+    _convert = (*((f, tuple) for f in ("units", "poses", "limits", "obstacles", "targets", "regions", "tasks",
+                                       "paths")), ("dh", _optional(tuple)), ("allow", frozenset))
 
     name: Name
     library_ref: str = "mark2"
@@ -412,7 +388,6 @@ RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest
 TASK_RANK_KEYS = ("cycle_time", "energy", "coverage")  # objectives of tasks: ranked only when named
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Problem(_M):
     """A `design` block: the cell (a robot without units: library, base, tool, payload,
     obstacles, targets) and the bounds and objectives of the search for its chains."""
@@ -435,7 +410,6 @@ class Problem(_M):
     bound_spans: dict[str, Span] = _hidden(default_factory=dict)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
 class Design(_M):
     """Everything one input file defines."""
 
