@@ -7,15 +7,27 @@ libraries (numpy, jinja2, trimesh, pinocchio, pybullet…) are imported inside c
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
-# each module registers its commands; import order is the order `modc --help` lists them in
-from . import analysis, compile, design_cmd, info, lint, motion, view  # noqa: F401, I001
-from .app import app
+from . import app as _app_module
+
+if TYPE_CHECKING:
+    from .app import app
 
 __all__ = ["app", "main"]
+# `modc.cli.app` is the click group (with every command registered), as it always was, not the
+# module that the import above bound here: see __getattr__.
+del app  # noqa: F821
+
+
+def __getattr__(name: str):
+    if name == "app":
+        _app_module.load_commands()
+        globals()["app"] = _app_module.app
+        return _app_module.app
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def main(argv: list[str] | None = None) -> None:
-    from .app import run
-
-    run(list(sys.argv[1:] if argv is None else argv))
+    """The `modc` command: each command's module is imported only when it runs (app.COMMANDS)."""
+    _app_module.run(list(sys.argv[1:] if argv is None else argv))

@@ -15,11 +15,11 @@ import typing
 from functools import cache
 from typing import Annotated, Any
 
-from .. import __version__
+from .._version import __version__
 from ..diagnostics.plain_words import plain_words
 from . import library as L
 from .library_file import MAX_LIBRARY_BYTES, LibraryError, read_library, where
-from .record import as_plain, is_record
+from .record import Record, as_fields, is_record
 
 _KIND = "library"
 FORMAT = "1"  # the entry's layout
@@ -131,27 +131,22 @@ def _hints(cls: type, extras: bool = False) -> dict[str, Any]:
 # --- the cache -----------------------------------------------------------------------------------
 
 @cache
-def _shape() -> str:
-    """The library's types, field by field: an entry written for other types is another key."""
-    seen: list[str] = []
+def _types_source() -> bytes:
+    """The source of the library's types: an entry written by other types is another key."""
+    from pathlib import Path
 
-    def walk(tp: Any) -> None:
-        if is_record(tp):
-            seen.append(tp.__name__)
-            for name in tp._fields:
-                seen.append(f"{name}:{tp.__annotations__.get(name, '')}")
-                walk(_hints(tp)[name])
-        for arg in typing.get_args(tp):
-            walk(arg)
+    from . import record
 
-    walk(L.Library)
-    return ";".join(seen)
+    try:
+        return b"".join(Path(m.__file__ or "").read_bytes() for m in (L, record))
+    except OSError:  # no source beside the bytecode: modc's version alone tells
+        return b""
 
 
 def _entry_name(raw: bytes) -> str:
     from ..cache import key
 
-    return key(_KIND, FORMAT, __version__, _shape(), raw) + ".json"
+    return key(_KIND, FORMAT, __version__, _types_source(), raw) + ".json"
 
 
 def _from_cache(name: str) -> L.Library | None:
@@ -164,8 +159,8 @@ def _from_cache(name: str) -> L.Library | None:
     if hashlib.sha256(payload).hexdigest().encode() != digest:
         return None
     try:
-        library = _build(L.Library, json.loads(payload))
-    except (ValueError, TypeError, KeyError, AttributeError):  # not the shape of a Library
+        library = _decode(json.loads(payload))
+    except (ValueError, TypeError, KeyError, AttributeError):  # not a library this modc wrote
         return None
     return library if isinstance(library, L.Library) else None
 
@@ -173,35 +168,32 @@ def _from_cache(name: str) -> L.Library | None:
 def _store(name: str, library: L.Library) -> None:
     from .. import cache as disk
 
-    payload = json.dumps(as_plain(library), allow_nan=False).encode()
+    payload = json.dumps(_encode(library), allow_nan=False).encode()
     disk.put(_KIND, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
 
 
-def _build(tp: Any, value: Any) -> Any:
-    """value (JSON) as the type tp: the inverse of as_plain + json for the library's types (JSON
-    turns the int keys of `units` into strings)."""
-    origin = typing.get_origin(tp)
-    if is_record(tp):
-        if not isinstance(value, dict):
-            raise TypeError(tp.__name__)
-        hints = _hints(tp)
-        return tp(**{k: _build(hints[k], v) for k, v in value.items()})
-    if origin is dict:
-        kt, vt = typing.get_args(tp)
-        return {_build(kt, k): _build(vt, v) for k, v in value.items()}
-    if origin is list:
-        (et,) = typing.get_args(tp)
-        return [_build(et, v) for v in value]
-    if origin is typing.Literal:
-        if value not in typing.get_args(tp):
-            raise ValueError(value)
-        return value
-    if tp is float:
-        if isinstance(value, bool):
-            raise TypeError("bool")
-        return float(value)
-    if tp in (int, str, bool):
-        if type(value) is not tp and not (tp is int and isinstance(value, str) and value.isdigit()):
-            raise TypeError(tp.__name__)
-        return tp(value)
-    raise TypeError(repr(tp))
+# An entry is JSON in which a record is {"$record": its class's name, field: value...} and a dict
+# (whose keys may be numbers) {"$items": [[key, value]...]}: rebuilding it needs no type hints.
+_RECORDS = {name: cls for name, cls in vars(L).items() if is_record(cls) and cls.__module__ == L.__name__}
+
+
+def _encode(v: Any) -> Any:
+    if isinstance(v, Record):
+        return {"$record": type(v).__name__, **{n: _encode(x) for n, x in as_fields(v).items()}}
+    if isinstance(v, dict):
+        return {"$items": [[_encode(k), _encode(x)] for k, x in v.items()]}
+    if isinstance(v, list | tuple):
+        return [_encode(x) for x in v]
+    return v
+
+
+def _decode(v: Any) -> Any:
+    if isinstance(v, list):
+        return [_decode(x) for x in v]
+    if isinstance(v, dict):
+        if "$items" in v:
+            return {_decode(k): _decode(x) for k, x in v["$items"]}
+        fields = dict(v)
+        cls = _RECORDS[fields.pop("$record")]
+        return cls(**{k: _decode(x) for k, x in fields.items()})
+    return v

@@ -107,6 +107,11 @@ def is_record(tp: Any) -> bool:
     return isinstance(tp, type) and issubclass(tp, Record)
 
 
+def as_fields(r: Record) -> dict[str, Any]:
+    """A record's fields by name, in order."""
+    return {n: r.__dict__[n] for n in r._fields}
+
+
 def as_plain(v: Any, hidden: bool = True) -> Any:
     """Records as dicts of their fields (hidden ones too, unless hidden=False), recursively."""
     if isinstance(v, Record):
