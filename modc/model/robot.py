@@ -5,7 +5,7 @@ Backends read only this (and the library it points to), never the syntax.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, ClassVar, Literal
+from typing import Any, ClassVar, Literal, TypeVar
 
 from .. import names
 from ..diagnostics import NOWHERE, Span
@@ -56,6 +56,8 @@ def _hidden(default: Any = None, *, default_factory: Callable[[], Any] | None = 
     return field(default=default, hidden=True)
 
 
+_T = TypeVar("_T", bound="_M")
+
 
 class _M(Record):
     """The checked model's values: frozen records, checked when built (names, numbers as
@@ -71,7 +73,7 @@ class _M(Record):
         for f, convert in self._convert:
             object.__setattr__(self, f, convert(getattr(self, f)))
 
-    def model_copy(self, update: dict[str, Any] | None = None) -> Any:
+    def model_copy(self: _T, update: dict[str, Any] | None = None) -> _T:
         """A copy with some fields replaced, unchecked (as pydantic's model_copy)."""
         new = object.__new__(type(self))
         new.__dict__.update(self.__dict__)
@@ -82,7 +84,7 @@ class _M(Record):
         return new
 
     @classmethod
-    def model_construct(cls, **values: Any) -> Any:
+    def model_construct(cls: type[_T], **values: Any) -> _T:
         """An instance built unchecked, missing fields at their defaults (as pydantic's)."""
         new = object.__new__(cls)
         for name in cls._fields:
