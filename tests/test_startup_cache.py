@@ -82,7 +82,7 @@ def _tables(cache_dir):
 def test_tables_from_the_cache_parse_as_freshly_built_ones(cache_dir):
     built = parser._lark()  # a miss: built, then stored
     entry = _tables(cache_dir)
-    loaded = parser._load_tables(entry.name)
+    loaded = parser._load_tables(entry.name, parser._OPTIONS)
     assert loaded is not None and loaded is not built
     for path in EXAMPLES:
         text = path.read_text(encoding="utf-8")
@@ -105,17 +105,18 @@ def test_a_damaged_tables_entry_is_rebuilt_never_used(cache_dir, damage):
     else:
         blob = b""
     entry.write_bytes(blob)
-    assert parser._load_tables(entry.name) is None
+    assert parser._load_tables(entry.name, parser._OPTIONS) is None
     parser._lark.cache_clear()
     ast_file, diags = parser.parse((ROOT / "examples" / "farm.mod").read_text(encoding="utf-8"), "farm.mod")
     assert not diags and ast_file.robots[0].name.text == "farm"
-    assert parser._load_tables(entry.name) is not None  # rewritten whole
+    assert parser._load_tables(entry.name, parser._OPTIONS) is not None  # rewritten whole
 
 
 def test_the_tables_key_is_the_grammar_and_lark(cache_dir):
-    a = parser._tables_name("start: NAME", "1.3.1")
-    assert a != parser._tables_name("start: NAME ", "1.3.1")
-    assert a != parser._tables_name("start: NAME", "1.3.2")
+    a = parser._tables_name("start: NAME", parser._OPTIONS, "1.3.1")
+    assert a != parser._tables_name("start: NAME ", parser._OPTIONS, "1.3.1")
+    assert a != parser._tables_name("start: NAME", parser._OPTIONS, "1.3.2")
+    assert a != parser._tables_name("start: NAME", {**parser._OPTIONS, "keep_all_tokens": True}, "1.3.1")
 
 
 # --- the library ------------------------------------------------------------------------------------
@@ -201,3 +202,15 @@ def test_model_copy_construct_and_dump_behave_as_pydantic_did():
     dump = r.model_dump()
     assert "span" not in dump and "torque" not in dump and dump["units"][0]["name"] == "H1"
     assert "span" not in repr(r) and "name='arm'" in repr(r)
+
+
+def test_the_formatter_s_own_tables_are_cached_and_format_alike(cache_dir):
+    from modc.syntax import format as fmt
+
+    text = (ROOT / "examples" / "farm.mod").read_text(encoding="utf-8").replace("    chain", "  chain", 1)
+    fmt._lark.cache_clear()
+    built = fmt.format_text(text, "farm.mod")  # a miss: built, stored
+    assert len(list((cache_dir / "grammar").glob("*.lalr"))) >= 1
+    fmt._lark.cache_clear()
+    assert fmt.format_text(text, "farm.mod") == built and built[0] is not None and "\n    chain" in built[0]
+    fmt._lark.cache_clear()

@@ -58,11 +58,11 @@ _COMMENT = re.compile(r"#[^\n]*")
 
 @cache
 def _lark():
-    from lark import Lark
+    from .parser import cached_lark
 
     text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
     # The parser's own instance drops punctuation and keywords; the formatter needs every token.
-    return Lark(text, parser="lalr", keep_all_tokens=True, maybe_placeholders=True, cache=True, start="start")
+    return cached_lark(text, {"parser": "lalr", "keep_all_tokens": True, "maybe_placeholders": True, "start": "start"})
 
 
 @dataclass(slots=True)

@@ -36,25 +36,31 @@ _OPTIONS = {"parser": "lalr", "propagate_positions": True, "maybe_placeholders":
 
 @cache
 def _lark():
+    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
+    return cached_lark(text, _OPTIONS)
+
+
+def cached_lark(text: str, options: dict):
+    """Lark's LALR parser of the grammar text with these options, its tables from modc's cache
+    when they are there (else built and stored)."""
     import lark
 
-    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
-    name = _tables_name(text, lark.__version__)
-    parser = _load_tables(name)
+    name = _tables_name(text, options, lark.__version__)
+    parser = _load_tables(name, options)
     if parser is None:
-        parser = lark.Lark(text, **_OPTIONS)
+        parser = lark.Lark(text, **options)
         _save_tables(name, parser)
     return parser
 
 
-def _tables_name(text: str, lark_version: str) -> str:
+def _tables_name(text: str, options: dict, lark_version: str) -> str:
     """The cache entry of the grammar's LALR tables: keyed by the grammar, the options, lark's
     version and Python's (marshal's format is Python's)."""
     import sys
 
     from ..cache import key
 
-    return key(text, repr(sorted(_OPTIONS.items())), lark_version, repr(sys.version_info[:2])) + ".lalr"
+    return key(text, repr(sorted(options.items())), lark_version, repr(sys.version_info[:2])) + ".lalr"
 
 
 # Building the LALR tables is most of a cold `modc lint` (benchmarks/bench_startup.py). They are
@@ -63,7 +69,7 @@ def _tables_name(text: str, lark_version: str) -> str:
 _TABLES = "grammar"
 
 
-def _load_tables(name: str):
+def _load_tables(name: str, options: dict):
     import hashlib
     import marshal
 
@@ -79,7 +85,7 @@ def _load_tables(name: str):
 
     try:
         data, memo = marshal.loads(payload)
-        return Lark._load_from_dict(data, memo, propagate_positions=_OPTIONS["propagate_positions"])
+        return Lark._load_from_dict(data, memo, propagate_positions=options.get("propagate_positions", False))
     except Exception:  # an entry of another lark, or not ours: build the tables instead
         return None
 
