@@ -4,26 +4,11 @@ Backends read only this (and the library it points to), never the syntax.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any, ClassVar, Literal, TypeVar
+from typing import ClassVar, Literal
 
-from .. import names
 from ..diagnostics import NOWHERE, Span
+from .base import InvalidModel, Value, floats, grid3, hidden, optional, vec3  # noqa: F401 (InvalidModel re-exported)
 from .library import Library
-from .record import Record, as_plain, field
-
-
-class InvalidModel(ValueError):
-    """A model value that breaks the model's own rules (a bad name): lowering reports these as
-    diagnostics first, so this is the guarantee that no backend sees one, not the user's path."""
-
-
-def _identifier(text: str) -> str:
-    problem = names.identifier_problem(text)
-    if problem:
-        raise InvalidModel(problem)
-    return text
-
 
 # Every user-given name in the model (robot, unit, pose, target, obstacle, joint reference) is one
 # of these: lowering reports a bad one as invalid-name, so no backend can ever see another string.
@@ -31,90 +16,20 @@ Name = str
 Vec3 = tuple[float, float, float]
 
 
-def _vec3(v: Any) -> Vec3:
-    x, y, z = v
-    return (float(x), float(y), float(z))
-
-
-def _floats(v: Any) -> tuple[float, ...]:
-    return tuple(float(x) for x in v)
-
-
-def _grid(v: Any) -> tuple[int, int, int]:
-    i, j, k = v
-    return (int(i), int(j), int(k))
-
-
-def _optional(convert: Callable[[Any], Any]) -> Callable[[Any], Any]:
-    return lambda v: None if v is None else convert(v)
-
-
-def _hidden(default: Any = None, *, default_factory: Callable[[], Any] | None = None) -> Any:
-    """A field left out of repr and model_dump (spans, analyses' results)."""
-    if default_factory is not None:
-        return field(default_factory=default_factory, hidden=True)
-    return field(default=default, hidden=True)
-
-
-_T = TypeVar("_T", bound="_M")
-
-
-class _M(Record):
-    """The checked model's values: frozen records, checked when built (names, numbers as
-    floats, sequences as tuples) and never after. The methods are those of pydantic's models
-    (which these types were) that callers use."""
-
-    _names: ClassVar[tuple[str, ...]] = ()  # fields that are identifiers
-    _convert: ClassVar[tuple[tuple[str, Callable[[Any], Any]], ...]] = ()  # (field, to its type)
-
-    def __post_init__(self) -> None:
-        for f in self._names:
-            _identifier(getattr(self, f))
-        for f, convert in self._convert:
-            object.__setattr__(self, f, convert(getattr(self, f)))
-
-    def model_copy(self: _T, update: dict[str, Any] | None = None) -> _T:
-        """A copy with some fields replaced, unchecked (as pydantic's model_copy)."""
-        new = object.__new__(type(self))
-        new.__dict__.update(self.__dict__)
-        for k, v in (update or {}).items():
-            if k not in new.__dict__:
-                raise TypeError(f"{type(self).__name__} has no field {k!r}")
-            new.__dict__[k] = v
-        return new
-
-    @classmethod
-    def model_construct(cls: type[_T], **values: Any) -> _T:
-        """An instance built unchecked, missing fields at their defaults (as pydantic's)."""
-        new = object.__new__(cls)
-        for name in cls._fields:
-            if name in values:
-                new.__dict__[name] = values[name]
-            elif name in cls._defaults:
-                new.__dict__[name] = cls._defaults[name]
-            elif name in cls._factories:
-                new.__dict__[name] = cls._factories[name]()
-        return new
-
-    def model_dump(self) -> dict[str, Any]:
-        """The fields as plain values, spans and analyses' results left out."""
-        return as_plain(self, hidden=False)
-
-
-class Transform(_M):
+class Transform(Value):
     """A placement: position (m) then fixed-axis roll-pitch-yaw (rad), as in URDF."""
 
-    _convert = (("xyz", _vec3), ("rpy", _vec3))
+    _convert = (("xyz", vec3), ("rpy", vec3))
 
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
 
 
-class UnitSpec(_M):
+class UnitSpec(Value):
     """One modular unit of the chain, e.g. H4(pivot=-90deg, port=45deg)."""
 
     _names = ("name",)
-    _convert = (("kind", int), ("pivot", float), ("port", float), ("link", _optional(float)))
+    _convert = (("kind", int), ("pivot", float), ("port", float), ("link", optional(float)))
 
     name: Name
     variant: str = ""  # filled once the library is known
@@ -122,11 +37,11 @@ class UnitSpec(_M):
     pivot: float = 0.0  # rad, twist in the adaptive twist unit (rotation about y, eq. 4)
     port: float = 0.0  # rad, twist at the connection port after the link (rotation about x, eq. 6)
     link: float | None = None  # m, link-module length; None = the library's default
-    span: Span = _hidden(NOWHERE)
-    param_spans: dict[str, Span] = _hidden(default_factory=dict)
+    span: Span = hidden(NOWHERE)
+    param_spans: dict[str, Span] = hidden(default_factory=dict)
 
 
-class DHRow(_M):
+class DHRow(Value):
     """One row of a standard DH table: Rz(theta) Tz(d) Tx(a) Rx(alpha), SI units."""
 
     _convert = (("a", float), ("alpha", float), ("d", float), ("theta", float))
@@ -135,46 +50,46 @@ class DHRow(_M):
     alpha: float
     d: float
     theta: float = 0.0
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
-class Payload(_M):
-    _convert = (("mass", float), ("com", _vec3))
+class Payload(Value):
+    _convert = (("mass", float), ("com", vec3))
 
     mass: float  # kg
     com: Vec3 = (0.0, 0.0, 0.0)  # m, in the tool0 frame
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
-class Pose(_M):
+class Pose(Value):
     _names = ("name",)
-    _convert = (("q", _floats),)
+    _convert = (("q", floats),)
 
     name: Name
     q: tuple[float, ...]  # rad, joint_1 first
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
-class JointLimit(_M):
+class JointLimit(Value):
     _names = ("joint",)
     _convert = (("lower", float), ("upper", float))
 
     joint: Name
     lower: float
     upper: float
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
-class Obstacle(_M):
+class Obstacle(Value):
     _names = ("name",)
-    _convert = (("size", _floats),)
+    _convert = (("size", floats),)
     SHAPES: ClassVar[tuple[str, ...]] = ("box", "sphere", "cylinder")
 
     name: Name
     shape: Literal["box", "sphere", "cylinder"]
     size: tuple[float, ...]  # box: (x, y, z); sphere: (r,); cylinder: (r, length along z)
     origin: Transform
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -186,9 +101,9 @@ POSITION_TOLERANCE = 0.005  # m: default distance of tool0 from a target that co
 ORIENTATION_TOLERANCE = 0.034906585039886591  # rad (2°): default for a target with an orientation
 
 
-class Target(_M):
+class Target(Value):
     _names = ("name",)
-    _convert = (("xyz", _vec3), ("rpy", _optional(_vec3)), ("position_tolerance", float),
+    _convert = (("xyz", vec3), ("rpy", optional(vec3)), ("position_tolerance", float),
                 ("orientation_tolerance", float))
 
     name: Name
@@ -196,18 +111,18 @@ class Target(_M):
     rpy: Vec3 | None = None  # rad, tool0's orientation in base_link (URDF fixed axes); None: position only
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
 MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; beyond this, a typo
 
 
-class Region(_M):
+class Region(Value):
     """`region NAME box size … at … grid nx x ny x nz`: targets evenly spaced over an axis-aligned
     box, faces included; an axis with one point holds it at the box's centre."""
 
     _names = ("name",)
-    _convert = (("size", _vec3), ("center", _vec3), ("grid", _grid), ("rpy", _optional(_vec3)),
+    _convert = (("size", vec3), ("center", vec3), ("grid", grid3), ("rpy", optional(vec3)),
                 ("position_tolerance", float), ("orientation_tolerance", float))
 
     name: Name
@@ -217,7 +132,7 @@ class Region(_M):
     rpy: Vec3 | None = None  # every point's tool0 orientation
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
     def indices(self) -> list[tuple[int, int, int]]:
         """Every point's (i, j, k), in order: k fastest, then j, then i."""
@@ -240,7 +155,7 @@ class Region(_M):
         return [self.point(ix) for ix in self.indices()]
 
 
-class Task(_M):
+class Task(Value):
     """`task NAME { visit … }`: the targets tool0 visits in order (region names expanded to their
     points), joined by collision-free joint-space motions."""
 
@@ -249,10 +164,10 @@ class Task(_M):
 
     name: Name
     visits: tuple[str, ...]  # target names and region point names (`tray[0,1,0]`)
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
-class StraightPath(_M):
+class StraightPath(Value):
     """`path NAME from a to b straight`: tool0 along the segment a -> b, orientation interpolated."""
 
     _names = ("name",)
@@ -260,20 +175,20 @@ class StraightPath(_M):
     name: Name
     start: str
     end: str
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
 
-class BaseGrid(_M):
+class BaseGrid(Value):
     """`base within box size … at … step … [yaw lo to hi step s]` (design blocks): the base
     positions (and yaws) to try, in the cell frame."""
 
-    _convert = (("size", _vec3), ("center", _vec3), ("step", float), ("yaws", _floats))
+    _convert = (("size", vec3), ("center", vec3), ("step", float), ("yaws", floats))
 
     size: Vec3
     center: Vec3
     step: float  # m
     yaws: tuple[float, ...] = (0.0,)  # rad
-    span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
 
     def positions(self) -> list[Vec3]:
         axes = []
@@ -292,10 +207,10 @@ def default_position(lower: float, upper: float) -> float:
     return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
 
 
-class Robot(_M):
+class Robot(Value):
     _names = ("name",)
     _convert = (*((f, tuple) for f in ("units", "poses", "limits", "obstacles", "targets", "regions", "tasks",
-                                       "paths")), ("dh", _optional(tuple)), ("allow", frozenset))
+                                       "paths")), ("dh", optional(tuple)), ("allow", frozenset))
 
     name: Name
     library_ref: str = "mark2"
@@ -315,10 +230,10 @@ class Robot(_M):
     regions: tuple[Region, ...] = ()
     tasks: tuple[Task, ...] = ()
     paths: tuple[StraightPath, ...] = ()
-    torque: tuple | None = _hidden(None)  # set by check_torque
-    span: Span = _hidden(NOWHERE)
-    name_span: Span = _hidden(NOWHERE)
-    library_span: Span = _hidden(NOWHERE)  # the `library` statement, where library errors point
+    torque: tuple | None = hidden(None)  # set by check_torque
+    span: Span = hidden(NOWHERE)
+    name_span: Span = hidden(NOWHERE)
+    library_span: Span = hidden(NOWHERE)  # the `library` statement, where library errors point
 
     @property
     def dof(self) -> int:
@@ -390,12 +305,12 @@ RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest
 TASK_RANK_KEYS = ("cycle_time", "energy", "coverage")  # objectives of tasks: ranked only when named
 
 
-class Problem(_M):
+class Problem(Value):
     """A `design` block: the cell (a robot without units: library, base, tool, payload,
     obstacles, targets) and the bounds and objectives of the search for its chains."""
 
     _names = ("name",)
-    _convert = (("min_units", int), ("max_units", int), ("modules", _optional(tuple)), ("links", _optional(_floats)),
+    _convert = (("min_units", int), ("max_units", int), ("modules", optional(tuple)), ("links", optional(floats)),
                 ("rank", tuple))
 
     name: Name
@@ -406,13 +321,13 @@ class Problem(_M):
     links: tuple[float, ...] | None = None  # m, link-module lengths to try; None: the library's default
     rank: tuple[str, ...] = RANK_KEYS
     base_grid: BaseGrid | None = None  # `base within …`: base poses to try (cell frame); None: the base as written
-    span: Span = _hidden(NOWHERE)
-    name_span: Span = _hidden(NOWHERE)
+    span: Span = hidden(NOWHERE)
+    name_span: Span = hidden(NOWHERE)
     # where each bound was written ("units", "links", "module:H9"), for the library checks
-    bound_spans: dict[str, Span] = _hidden(default_factory=dict)
+    bound_spans: dict[str, Span] = hidden(default_factory=dict)
 
 
-class Design(_M):
+class Design(Value):
     """Everything one input file defines."""
 
     _convert = (("robots", tuple), ("problems", tuple))
