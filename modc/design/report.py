@@ -37,8 +37,8 @@ def _cell(objective: str, d) -> str:
 def _share(share: float | None, worst_m: float | None) -> str:
     if share is None:
         return "—"
-    mm = "" if worst_m is None else f" ({worst_m * 1000:.3g} mm)"
-    return f"{share * 100:.0f} % of tolerance{mm}"
+    mm = "" if worst_m is None else f" ({worst_m * 1000:.2f} mm)" if worst_m >= 5e-6 else " (< 0.01 mm)"
+    return f"{share * 100:.0f} % of tolerance{mm}" if share >= 0.005 else f"< 1 % of tolerance{mm}"
 
 
 def _svg(o: Outcome) -> str:
