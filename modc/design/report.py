@@ -60,7 +60,7 @@ def _svg(o: Outcome) -> str:
              f'<text x="{W / 2}" y="{H - 12}" text-anchor="middle" font-size="12">'
              'arm mass (kg, axis from 0), lighter is better</text>',
              f'<text x="14" y="{H / 2}" transform="rotate(-90 14 {H / 2})" text-anchor="middle" font-size="12">'
-             'torque margin (%, axis from 0), higher is better</text>']
+             f'torque margin (%, axis from {y0:.0f}), higher is better</text>']
     for k in range(5):  # ticks at 0, ¼, ½, ¾ and the end of each axis
         x, y = x1 * k / 4, y0 + (y1 - y0) * k / 4
         tx, _ = px(x, y0)
