@@ -126,14 +126,22 @@ def _png() -> bytes:
     return buf.getvalue()
 
 
-@pytest.mark.slow
-def test_report_and_ranking_say_why_and_show_the_reference(tmp_path):
-    from modc.design import reference, run, write
-    from modc.design.rank import worst_share
+@pytest.fixture(scope="module")
+def small():
+    """The small cell's search (about 30 s on a loaded machine), shared by the tests below."""
+    from modc.design import run
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        o = run.design(problem(), top=3, seed=0)
+        return run.design(problem(), top=3, seed=0)
+
+
+@pytest.mark.slow
+def test_report_and_ranking_say_why_and_show_the_reference(small):
+    from modc.design import reference, write
+    from modc.design.rank import worst_share
+
+    o = small
     assert len(o.designs) >= 2
     files = write.files([o], {"small_1.mod": _png()})
     ranking = json.loads(files["ranking.json"])
@@ -177,3 +185,30 @@ def test_report_and_ranking_say_why_and_show_the_reference(tmp_path):
     assert r is not None and r.feasible and r.chain == best.chain()
     assert r.mass == pytest.approx(best.mass) and r.margin == pytest.approx(best.margin)
     assert r.worst_share() is not None and r.worst_share() <= 1
+
+
+@pytest.mark.slow
+def test_the_report_opens_in_headless_chromium(small, tmp_path):
+    """report.html as a browser shows it (the view tests' Chromium helper): the table's rows, the
+    plot drawn, every picture decoded, nothing fetched from elsewhere."""
+    from test_view_browser import BROWSER, _wait, chromium
+
+    if BROWSER is None:
+        pytest.skip("no Chromium installed (Debian: apt-get install chromium)")
+    from modc.design import write
+
+    files = write.files([small], {"small_1.mod": _png()})
+    page = tmp_path / "report.html"
+    page.write_text(files["report.html"], encoding="utf-8")
+    with chromium() as browser:
+        browser.call("Network.enable")
+        browser.call("Page.navigate", url=page.as_uri())
+        _wait(lambda: browser.js("document.readyState") == "complete", 60, "the report to load")
+        rows = browser.js("[...document.querySelectorAll('tr')].map(r => r.cells[0].textContent)")
+        assert rows == ["rank", *[str(k) for k in range(1, len(small.designs) + 1)], "reference"]
+        assert browser.js("document.querySelector('svg').getBoundingClientRect().height") > 200
+        assert browser.js("[...document.images].every(i => i.complete && i.naturalWidth > 0)")
+        assert browser.js("document.querySelector('figcaption').textContent") == f"rank 1: {small.designs[0].chain()}"
+        sent = [e for e in browser.events if e.get("method") == "Network.requestWillBeSent"]
+        asked = [e["params"]["request"]["url"] for e in sent]
+        assert all(u.startswith(("file:", "data:")) for u in asked), asked
