@@ -20,4 +20,5 @@ design farm_cell {
 
     units 2 to 3
     rank modules, mass, margin
+    compare with chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)  # the paper's arm
 }

@@ -34,11 +34,12 @@ __all__ = ["ModLexer"]
 #: Keyword that opens a robot block.
 DECLARATIONS = ("design", "robot")
 #: Keywords that start a statement inside a robot block (`row` starts a row of a `dh` block).
-STATEMENTS = ("allow", "base", "box", "chain", "cylinder", "dh", "library", "limit", "links", "modules",
-              "path", "payload", "pose", "rank", "region", "row", "sphere", "target", "task", "tool", "units")
+STATEMENTS = ("allow", "base", "box", "chain", "compare", "cylinder", "dh", "library", "limit", "links",
+              "modules", "path", "payload", "pose", "rank", "region", "row", "sphere", "target", "task",
+              "tool", "units")
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
 CLAUSES = ("at", "fit-links", "from", "grid", "length", "radius", "rpy", "size", "step", "straight", "to",
-           "visit", "within", "x", "yaw")
+           "visit", "with", "within", "x", "yaw")
 #: Every keyword of the language.
 KEYWORDS = frozenset(DECLARATIONS + STATEMENTS + CLAUSES)
 #: Units of measure (modc.model.quantities.ALL).

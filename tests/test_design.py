@@ -311,7 +311,7 @@ def test_report_html_shows_the_top_design(tmp_path, capsys):
     html = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
     pngs = re.findall(r'src="data:image/png;base64,([A-Za-z0-9+/=]+)"', html)
     assert len(pngs) == 1 and base64.b64decode(pngs[0]).startswith(b"\x89PNG")
-    assert "<svg" in html and "small_1.mod" in html and "<script" not in html
+    assert "<svg" in html and "<figcaption>rank 1: H1" in html and "<script" not in html
 
 
 def test_compiling_a_design_problem_points_to_modc_design(tmp_path, capsys):

@@ -107,3 +107,91 @@ def pareto(points: list[tuple[float, float]]) -> list[bool]:
     for i, (a, b) in enumerate(points):
         out.append(not any((c <= a and d <= b) and (c < a or d < b) for j, (c, d) in enumerate(points) if j != i))
     return out
+
+
+# How report.html and ranking.json show an objective: its words, its value (in the unit shown)
+# and the unit. An objective not listed here (a newer registry entry) shows its ranking key.
+SHOWN: dict[str, tuple[str, Callable[[Any], float], str]] = {
+    "modules": ("modules", lambda d: d.modules, ""),
+    "mass": ("mass", lambda d: d.mass, " kg"),
+    "margin": ("torque margin", lambda d: d.margin * 100, " %"),
+    "cycle_time": ("cycle time", lambda d: d.cycle_time, " s"),
+    "energy": ("energy", lambda d: d.energy, " J"),
+}
+
+
+def shown(objective: str, d: Any) -> tuple[str, float, str]:
+    """(words, value, unit) of one objective of a design."""
+    if objective in SHOWN:
+        words, value, unit = SHOWN[objective]
+        return words, float(value(d)), unit
+    v = getattr(d, objective, None)
+    return objective.replace("_", " "), float(v if isinstance(v, int | float) else OBJECTIVES[objective](d)), ""
+
+
+def _pair(a: float, b: float, unit: str) -> tuple[str, str]:
+    """Two different values written with just enough decimals to differ (99.4 % vs 99.1 %, not 99 % vs 99 %)."""
+    digits = 0 if unit in ("", " %") else 3
+    for k in range(digits, digits + 7):
+        x, y = f"{a:.{k}f}", f"{b:.{k}f}"
+        if x != y:
+            break
+    return x + unit, y + unit
+
+
+def versus(objectives: tuple[str, ...], d: Any, other: Any) -> tuple[list[str], str | None, tuple[str, str]]:
+    """The objectives d ties `other` on, in ranking order, the first one that tells them apart
+    (None: every one ties) and the two values of that one as shown."""
+    ties: list[str] = []
+    for o in objectives:
+        if OBJECTIVES[o](d) != OBJECTIVES[o](other):
+            _, a, unit = shown(o, d)
+            _, b, _ = shown(o, other)
+            return ties, o, _pair(a, b, unit)
+        ties.append(shown(o, d)[0])
+    return ties, None, ("", "")
+
+
+def _and(words: list[str]) -> str:
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+def why(designs: list, objectives: tuple[str, ...]) -> list[str]:
+    """Per rank, in words, what decided it against the next rank (the last: against the one
+    before), by the same keys `order` sorts on: "ties rank 2 on modules and mass; ahead by
+    torque margin 99 % vs 97 %"."""
+    out = []
+    for i, d in enumerate(designs):
+        if len(designs) == 1:
+            out.append("the only design found")
+            continue
+        last = i == len(designs) - 1
+        j = i - 1 if last else i + 1
+        ties, decided, (a, b) = versus(objectives, d, designs[j])
+        said = f"ties rank {j + 1} on {_and(ties)}" if ties else ""
+        if decided is None:
+            said = f"ties rank {j + 1} on every objective"
+            step = f"{'after' if last else 'before'} it by the chain's name ({d.chain()})"
+        else:
+            side = "behind" if last else "ahead"
+            step = (f"{side} by {shown(decided, d)[0]} {a} vs {b}" if ties
+                    else f"{'behind' if last else 'ahead of'} rank {j + 1} by {shown(decided, d)[0]} {a} vs {b}")
+        out.append(f"{said}; {step}" if said else step)
+    return out
+
+
+def target_share(got: dict, target) -> float:
+    """A target's error as a share of its tolerance (0: dead on, 1: at the edge): position against
+    the position tolerance, orientation (when it has one) against the orientation tolerance."""
+    import math
+
+    share = got["position_error_m"] / max(target.position_tolerance, 1e-12)
+    if got.get("orientation_error_deg") is not None:
+        share = max(share, math.radians(got["orientation_error_deg"]) / max(target.orientation_tolerance, 1e-12))
+    return share
+
+
+def worst_share(targets: dict[str, dict], cell_targets) -> float:
+    """A design's worst target error as a share of its tolerance."""
+    tol = {t.name: t for t in cell_targets}
+    return max((target_share(got, tol[name]) for name, got in targets.items()), default=0.0)

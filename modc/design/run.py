@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -57,6 +58,7 @@ class Outcome:
     unfinished: list[str] = field(default_factory=list)  # shapes whose search did not run to the end
     coarse: list[str] = field(default_factory=list)  # shapes searched on a coarse grid
     targets: dict[str, dict] = field(default_factory=dict)  # per target: hit, clear, closest, excluded_by
+    reference: Any = None  # modc.design.reference.Reference: the block's `compare with` arm, evaluated
 
     def why_none(self) -> str:
         return why_none(self)
@@ -176,16 +178,18 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     A cell with tasks or paths: the static search (ranked by the objectives it knows) returns
     its best designs, more of them when a task objective ranks (tasks.candidates); each is then
     planned and timed (tasks.plan_all) and the survivors ranked by every objective."""
-    from . import tasks
+    from . import reference, tasks
 
     if not tasks.has_tasks(problem):
-        return _search(problem, max_units, top, seed, executor, progress, deadline)
-    t0 = time.perf_counter()
-    screen = problem.model_copy(update={"rank": static(problem.rank)})
-    out = _search(screen, max_units, tasks.candidates(problem, top), seed, executor, progress, deadline)
-    out.problem = problem
-    tasks.plan_all(out, top, seed, deadline, _stopping)
-    out.seconds = time.perf_counter() - t0
+        out = _search(problem, max_units, top, seed, executor, progress, deadline)
+    else:
+        t0 = time.perf_counter()
+        screen = problem.model_copy(update={"rank": static(problem.rank)})
+        out = _search(screen, max_units, tasks.candidates(problem, top), seed, executor, progress, deadline)
+        out.problem = problem
+        tasks.plan_all(out, top, seed, deadline, _stopping)
+        out.seconds = time.perf_counter() - t0
+    out.reference = reference.evaluate(problem, seed)
     return out
 
 

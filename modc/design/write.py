@@ -8,7 +8,7 @@ import json
 import math
 
 from .evaluate import pose_name
-from .rank import Design
+from .rank import Design, why, worst_share
 from .run import Outcome
 
 
@@ -50,11 +50,14 @@ def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
 def ranking(outcomes: list[Outcome]) -> dict:
     designs = []
     for o in outcomes:
-        for rank, d in enumerate(o.designs, start=1):
+        reasons = why(o.designs, o.problem.rank)
+        for rank, (d, said) in enumerate(zip(o.designs, reasons, strict=True), start=1):
             designs.append({
                 "rank": rank, "file": file_name(o.problem.name, rank), "design": o.problem.name, "chain": d.chain(),
                 "modules": d.modules, "mass_kg": round(d.mass, 6), "torque_margin": round(d.margin, 6),
                 "targets": d.verified.targets, **task_figures(o, rank, d),
+                "worst_error_share": round(worst_share(d.verified.targets, o.problem.cell.targets), 6),
+                "why": said,  # in words: what decided this rank against the next (the last: the one before)
                 "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
                                  for a in d.alternatives],
             })
@@ -69,7 +72,10 @@ def ranking(outcomes: list[Outcome]) -> dict:
             "complete": all(o.complete for o in outcomes),
             "stopped": next((o.stopped for o in outcomes if o.stopped), None),
             "unfinished_shapes": [s for o in outcomes for s in shapes(o, o.unfinished)],
-            "coarse_shapes": [s for o in outcomes for s in shapes(o, o.coarse)]}
+            "coarse_shapes": [s for o in outcomes for s in shapes(o, o.coarse)],
+            # `compare with chain …`: per design block naming one, its arm evaluated on the cell
+            **({"reference": refs} if (refs := {o.problem.name: o.reference.to_json() for o in outcomes
+                                                if o.reference is not None}) else {})}
 
 
 def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> dict[str, str | bytes]:

@@ -96,6 +96,9 @@ KEYWORDS = {
     "modules": "`modules H1, H3, L4` — (design) the unit types a chain may use.",
     "links": "`links 150 mm to 300 mm step 50 mm` — (design) the link-module lengths to try.",
     "rank": "`rank modules, mass, margin` — (design) the objectives in order of importance.",
+    "compare": "`compare with chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)` — (design) a reference arm, "
+    "checked on the cell as the designs are and shown beside them in report.html and ranking.json.",
+    "with": "`compare with chain …` — (design) the reference arm's chain follows.",
     "to": "`… to …` — the upper end of a range (`units 1 to 3`, `links 150 mm to 300 mm`).",
     "step": "`step 50 mm` — the spacing of the link lengths a design search tries.",
     "within": "`within 5 mm, 2 deg` — a target's position (and orientation) tolerance (default 5 mm, 2°).",

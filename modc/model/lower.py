@@ -276,9 +276,12 @@ class _Lowerer:
         seen: dict[str, object] = {}
         acc = self._acc(source_dir)
         search: list = []
+        compare: list[ast.Compare] = []
         for st in d.body:
             if isinstance(st, ast.Units | ast.Modules | ast.Links | ast.Rank):
                 search.append(st)
+            elif isinstance(st, ast.Compare):
+                compare.append(st)
             else:
                 self.cell_statement(st, _say(d.name), fields, seen, acc)
         if not acc["targets"] and not any(isinstance(st, ast.Target | ast.Region) for st in d.body):
@@ -297,7 +300,24 @@ class _Lowerer:
         if not (named and acc["named"]):
             return None
         cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)
+        reference = self._reference(compare, cell, _say(d.name))
+        if reference is False:
+            return None
+        bounds["reference"] = reference
         return Problem(name=d.name.text, cell=cell, span=d.span, name_span=d.name.span, **bounds)
+
+    def _reference(self, compare: list[ast.Compare], cell: Robot, block: str) -> Robot | None | bool:
+        """`compare with chain …`: the cell with that chain (its checks are the robot chain's,
+        once the library is known: modc.passes.check_problems); False when a unit name is invalid."""
+        for st in compare[1:]:
+            self.error(codes.DUPLICATE_STATEMENT.at(st.span, what="compare with", robot=block))
+        if not compare:
+            return None
+        units = [self.unit(u) for u in compare[0].chain.units]
+        if None in units:
+            return False
+        return cell.model_copy(update={"name": "reference", "units": tuple(u for u in units if u is not None),
+                                       "span": compare[0].span, "name_span": compare[0].chain.span})
 
     def obstacle(self, st) -> Obstacle | None:
         name = _say(st.name)

@@ -321,6 +321,7 @@ class Problem(Value):
     links: tuple[float, ...] | None = None  # m, link-module lengths to try; None: the library's default
     rank: tuple[str, ...] = RANK_KEYS
     base_grid: BaseGrid | None = None  # `base within …`: base poses to try (cell frame); None: the base as written
+    reference: Robot | None = None  # `compare with chain …`: the cell with that chain, evaluated beside the designs
     span: Span = hidden(NOWHERE)
     name_span: Span = hidden(NOWHERE)
     # where each bound was written ("units", "links", "module:H9"), for the library checks

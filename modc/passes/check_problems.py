@@ -10,7 +10,7 @@ import difflib
 from pathlib import Path
 
 from ..diagnostics import codes
-from ..model import Design, Problem
+from ..model import Design, Problem, Robot
 from ..model import library as lib
 from .context import Context
 
@@ -60,6 +60,23 @@ def _check(p: Problem, library, ctx: Context) -> None:
             break
 
 
+def _reference(ref: Robot, cell: Robot, library, ctx: Context) -> Robot:
+    """`compare with chain …`: its units tagged and checked as a robot block's chain is (the
+    library's modules, the assembly rules, the twists), diagnostics at the units as written."""
+    from . import check_assembly, check_modules, check_twists
+
+    units = []
+    for u in ref.units:
+        vk = library.split(u.name)
+        units.append(u.model_copy(update={"variant": vk[0], "kind": vk[1]}) if vk else u)
+    ref = cell.model_copy(update={"name": ref.name, "units": tuple(units), "span": ref.span,
+                                  "name_span": ref.name_span})
+    alone = Design(path=ref.span.file, robots=(ref,))
+    for check in (check_modules, check_assembly, check_twists):
+        check.run(alone, ctx)
+    return ref
+
+
 def run(design: Design, ctx: Context) -> Design:
     problems = []
     for p in design.problems:
@@ -71,5 +88,7 @@ def run(design: Design, ctx: Context) -> Design:
                 path = ctx.library_override not in lib.BUILTIN
                 update |= {"library_ref": ctx.library_override, "library_dir": str(Path.cwd()) if path else None}
             p = p.model_copy(update={"cell": p.cell.model_copy(update=update)})
+            if p.reference is not None:
+                p = p.model_copy(update={"reference": _reference(p.reference, p.cell, library, ctx)})
         problems.append(p)
     return design.model_copy(update={"problems": tuple(problems)})

@@ -190,6 +190,15 @@ class Rank:
 
 
 @dataclass(frozen=True, slots=True)
+class Compare:
+    """`compare with chain H1 - L4(…) - L3` (design blocks): a reference arm, evaluated on the cell
+    with the ranking's own checks and shown beside the designs found."""
+
+    chain: Chain
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
 class PointRef:
     """A target or region named in a task or path: `plant`, `tray`, `tray[1,0,0]` (index 0-based)."""
 
@@ -273,7 +282,7 @@ class Robot:
 
 DesignStatement = (
     Library | Placement | Payload | Box | Sphere | Cylinder | Target | Allow | Units | Modules | Links | Rank
-    | TaskStatement
+    | Compare | TaskStatement
 )
 
 

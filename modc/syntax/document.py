@@ -150,6 +150,8 @@ class DesignDoc(_Doc):
     links: str | None = Field(None, description='link lengths to try: "220 mm" or "150 mm to 300 mm step 50 mm"')
     rank: list[str] | None = Field(
         None, description="objectives in order: modules, mass, margin, cycle_time, energy, coverage")
+    compare_with: list[str | UnitItem] | None = Field(
+        None, description='a reference arm shown beside the designs, units base first: ["H1", "L4(pivot=-90deg)"]')
 
 
 class Document(_Doc):

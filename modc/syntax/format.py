@@ -139,7 +139,7 @@ def _statement(tree, level: int, out: list[_Tok]) -> None:
             t.attach = t.text[:1] not in ("e", "E")
         if "point_index" in parents:  # tray[1,0,0]: a point's name is written as one word
             t.attach = True
-        if tree.data == "chain":
+        if tree.data in ("chain", "compare"):  # `compare with chain …` wraps as a chain does
             t.unit_start, after_dash = after_dash, t.type == "MINUS"
         out.append(t)
 

@@ -64,6 +64,9 @@ class ToAst:
     def rank(self, meta, items):
         return ast.Rank(tuple(self._name(t) for t in items), self._span(meta))
 
+    def compare(self, meta, items):
+        return ast.Compare(items[0], self._span(meta))
+
     def within(self, meta, items):
         return ("within", ast.Within(items[0], items[1], self._span(meta)))
 

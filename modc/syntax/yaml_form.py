@@ -84,7 +84,7 @@ class _Reader:
         return _respan(node, span)
 
     def robot(self, r, path: tuple) -> ast.Robot:
-        body: list = [self._chain(r, path)]
+        body: list = [self._chain(r.chain, path + ("chain",))]
         body += self._cell(r, path)
         for name, text in r.poses.items():
             v = self._vec(text, path + ("poses", name))
@@ -137,6 +137,9 @@ class _Reader:
         if d.rank is not None:
             p = path + ("rank",)
             body.append(ast.Rank(tuple(ast.Name(k, self.span(p + (i,))) for i, k in enumerate(d.rank)), self.span(p)))
+        if d.compare_with is not None:
+            p = path + ("compare_with",)
+            body.append(ast.Compare(self._chain(d.compare_with, p), self.span(p)))
         return ast.DesignBlock(ast.Name(d.name, self.span(path + ("name",))), tuple(body), self.span(path))
 
     def _count(self, text: str, path: tuple):
@@ -168,10 +171,10 @@ class _Reader:
             return None
         return ast.Target(key, at, self.span(p), rpy, within)
 
-    def _chain(self, r, path: tuple) -> ast.Chain:
+    def _chain(self, items, path: tuple) -> ast.Chain:
         units = []
-        for i, item in enumerate(r.chain):
-            p = path + ("chain", i)
+        for i, item in enumerate(items):
+            p = path + (i,)
             if isinstance(item, str):
                 u = self._sub("unit_text", item, p)
             else:
@@ -187,7 +190,7 @@ class _Reader:
                 u = ast.Unit(ast.Name(item.unit, self.span(p + ("unit",))), tuple(params), self.span(p))
             if u is not None:
                 units.append(u)
-        return ast.Chain(tuple(units), self.span(path + ("chain",)))
+        return ast.Chain(tuple(units), self.span(path))
 
     def _cell(self, r, path: tuple) -> list:
         """Statements robots and designs share: library, placements, payload, obstacles, targets, allow."""

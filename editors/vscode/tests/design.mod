@@ -15,6 +15,11 @@ design cell {
 #                          ^^^^ keyword.other.step.mod
     rank modules, mass, margin
 #   ^^^^ keyword.control.rank.mod
+    compare with chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)
+#   ^^^^^^^ keyword.control.compare.mod
+#           ^^^^ keyword.other.with.mod
+#                ^^^^^ keyword.control.chain.mod
+#                      ^^ support.type.unit.mod
     target tray at (0.3, -0.08, 0.22) m rpy (0, 90, 0) deg within 3 mm, 1 deg
 #   ^^^^^^ keyword.control.target.mod
 #                                       ^^^ keyword.other.rpy.mod
