@@ -153,7 +153,7 @@ def bench_candidates(count: int) -> dict:
 
     spec = Spec.of(problem())
     whole = Shape((1, 4, 3), (None, None, None))
-    search.search_part(spec, whole, 0, 256, 0)  # warm up (imports, caches)
+    search.search_part(spec, whole, ((0, 256),), 0)  # warm up (imports, caches)
     t = time.process_time()
     res = search.search_shape(spec, whole, 0)
     cpu = time.process_time() - t
@@ -164,7 +164,7 @@ def bench_candidates(count: int) -> dict:
     shape = Shape((4, 4, 3), (None, None, None))
     lo = search.size(spec, shape) // 3
     t = time.process_time()
-    part = search.search_part(spec, shape, lo, lo + count, 0)
+    part = search.search_part(spec, shape, ((lo, lo + count),), 0)
     cpu = time.process_time() - t
     out["hard"] = {"shape": shape.label(), "settings": count, "ms_per_candidate": 1e3 * cpu / count,
                    "screened": part.screened, "excluded": part.excluded}
@@ -339,7 +339,7 @@ def bench_dask(shapes: int) -> dict | None:
 
     prob = _problem(NOTHING.replace("units 1 to 3", "units 5"))
     spec = Spec.of(prob)
-    work = [(s, lo, hi) for s in space.shapes(prob, 5)[:shapes] for lo, hi in search.parts_of(spec, s)]
+    work = [w for s in space.shapes(prob, 5)[:shapes] for w in search.parts_of(spec, s)]
     out: dict = {"tasks": len(work)}
     for n in (1, 2):
         with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,

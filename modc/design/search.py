@@ -54,7 +54,8 @@ class Found:
 
 @dataclass(frozen=True)
 class Part:
-    """What one unit of work found: a range [lo, hi) of a shape's settings, done up to `upto`."""
+    """What one unit of work found: its settings (a few ranges of the shape's numbers) are
+    numbered lo … hi-1 in their order, done up to `upto`."""
 
     shape: Shape
     lo: int
@@ -151,7 +152,7 @@ class Plan:
     excluded whole by modc.design.prefix), and whether that covers every setting."""
 
     axes: Axes
-    ranges: tuple[tuple[int, int], ...]  # units of work, at most WORK settings each
+    ranges: tuple[tuple[tuple[int, int], ...], ...]  # units of work: ranges, at most WORK settings each
     total: int  # settings of the shape (of the coarse grid when not complete)
     excluded: int  # settings excluded whole, before any is listed
 
@@ -180,8 +181,20 @@ def plan(spec: Spec, shape: Shape) -> Plan:
     return cache[shape]
 
 
-def _split(ranges: list[tuple[int, int]]) -> tuple[tuple[int, int], ...]:
-    return tuple((lo, min(lo + WORK, hi)) for a, hi in ranges for lo in range(a, hi, WORK))
+def _split(ranges: list[tuple[int, int]]) -> tuple[tuple[tuple[int, int], ...], ...]:
+    """Ranges grouped into units of at most WORK settings (a long range cut, short ones joined:
+    a unit's cost is its settings, not its ranges)."""
+    units: list[list[tuple[int, int]]] = []
+    room = 0
+    for a, b in ranges:
+        while a < b:
+            if room == 0:
+                units.append([])
+                room = WORK
+            take = min(room, b - a)
+            units[-1].append((a, a + take))
+            a, room = a + take, room - take
+    return tuple(tuple(u) for u in units)
 
 
 def _plan(spec: Spec, shape: Shape) -> Plan:
@@ -197,7 +210,7 @@ def _plan(spec: Spec, shape: Shape) -> Plan:
     fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p)
     total = full.count
     if fam.settings <= COMPLETE:
-        ranges = _split(fam.ranges()) or ((0, 0),)
+        ranges = _split(fam.ranges()) or ((),)
         return Plan(full, ranges, total, total - fam.settings)
     coarse = coarse_axes(spec, shape)
     return Plan(coarse, _split([(0, coarse.count)]), coarse.count, 0)
@@ -234,18 +247,24 @@ def estimate(spec: Spec, shape: Shape) -> int:
 
 
 def _settings(ax: Axes, n: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
-    idx = np.unravel_index(np.arange(lo, hi), [len(a) for a in ax.values])
-    pivots = np.zeros((hi - lo, n))
-    ports = np.zeros((hi - lo, n))
+    return _settings_at(ax, n, np.arange(lo, hi))
+
+
+def _settings_at(ax: Axes, n: int, numbers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    idx = np.unravel_index(numbers, [len(a) for a in ax.values])
+    pivots = np.zeros((len(numbers), n))
+    ports = np.zeros((len(numbers), n))
     for a, i, (role, pos) in zip(ax.values, idx, ax.roles, strict=True):
         (pivots if role == "pivot" else ports)[:, pos] = a[i]
     return pivots, ports
 
 
-def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline: float | None = None,
-                full: bool = True) -> Part:
-    """Screen settings lo … hi-1 of a shape (on its full axes, or its coarse grid), BLOCK at a
-    time, until done or the deadline (time.time())."""
+def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], seed: int,
+                deadline: float | None = None, full: bool = True) -> Part:
+    """Screen the settings in ranges ([lo, hi) of the shape's numbers, on its full axes or its
+    coarse grid), BLOCK at a time, until done or the deadline (time.time())."""
+    numbers = np.concatenate([np.arange(a, b, dtype=np.int64) for a, b in ranges] or [np.zeros(0, np.int64)])
+    lo, hi = 0, len(numbers)
     lib = spec.problem.cell.library
     assert lib is not None
     ax = axes(spec, shape, full)
@@ -264,7 +283,7 @@ def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline:
         if STOP.is_set() or (deadline is not None and time.time() > deadline):
             break
         end = min(start + BLOCK, hi)
-        piv, por = _settings(ax, shape.n, start, end)
+        piv, por = _settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
         ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
         excluded += int((~ok).sum())
@@ -289,19 +308,19 @@ def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline:
                 tuple(bool(x) for x in hit), tuple(bool(x) for x in clear))
 
 
-Work = tuple[Shape, int, int, bool]  # a shape, a range of its settings, on its full axes or not
+Work = tuple[Shape, tuple[tuple[int, int], ...], bool]  # a shape, ranges of its settings, full axes or not
 
 
 def parts_of(spec: Spec, shape: Shape) -> list[Work]:
     """The shape's units of work (its plan's ranges; one empty range when every setting is
     excluded whole, so that the shape still reports)."""
     p = plan(spec, shape)
-    return [(shape, lo, hi, p.complete) for lo, hi in p.ranges]
+    return [(shape, r, p.complete) for r in p.ranges]
 
 
 def listed(spec: Spec, shape: Shape) -> int:
     """Settings of the shape that units of work go through one by one."""
-    return sum(hi - lo for lo, hi in plan(spec, shape).ranges)
+    return sum(hi - lo for unit in plan(spec, shape).ranges for lo, hi in unit)
 
 
 def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
@@ -330,4 +349,4 @@ def search_shape(spec: Spec, shape: Shape, seed: int, deadline: float | None = N
 
 def search_chunk(spec: Spec, work: list[Work], seed: int, deadline: float | None = None) -> list[Part]:
     """A worker's unit of work: ranges of shapes' settings, one after the other."""
-    return [search_part(spec, s, lo, hi, seed, deadline, full) for s, lo, hi, full in work]
+    return [search_part(spec, s, r, seed, deadline, full) for s, r, full in work]
