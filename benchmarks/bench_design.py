@@ -112,6 +112,15 @@ NOTHING = """design nothing {
 }
 """
 
+# Two targets about 2 m out: within every offset laid end to end of the longest six-unit chains
+# (2.24 m), beyond what any of their twist settings reaches (at most 1.83 m).
+FAR = """design far {
+    target a at (1.90, 0.35, 0.40) m
+    target b at (-1.20, 1.50, 0.30) m
+    units 1 to 6
+}
+"""
+
 WALLED = """design walled {
     box floor size (6, 6, 0.03) m at (0, 0, -0.02) m
     target a at (0.30, 0.10, -0.25) m
@@ -144,7 +153,7 @@ def bench_candidates(count: int) -> dict:
 
     spec = Spec.of(problem())
     whole = Shape((1, 4, 3), (None, None, None))
-    search.search_part(spec, whole, 0, 256, 0)  # warm up (imports, caches)
+    search.search_part(spec, whole, ((0, 256),), 0)  # warm up (imports, caches)
     t = time.process_time()
     res = search.search_shape(spec, whole, 0)
     cpu = time.process_time() - t
@@ -155,7 +164,7 @@ def bench_candidates(count: int) -> dict:
     shape = Shape((4, 4, 3), (None, None, None))
     lo = search.size(spec, shape) // 3
     t = time.process_time()
-    part = search.search_part(spec, shape, lo, lo + count, 0)
+    part = search.search_part(spec, shape, ((lo, lo + count),), 0)
     cpu = time.process_time() - t
     out["hard"] = {"shape": shape.label(), "settings": count, "ms_per_candidate": 1e3 * cpu / count,
                    "screened": part.screened, "excluded": part.excluded}
@@ -200,9 +209,9 @@ def bench_reference(count: int) -> dict:
     spec = Spec.of(problem())
     lib = spec.problem.cell.library
     shape = Shape((4, 4, 3), (None, None, None))
-    ax, where, _ = search.axes(spec, shape)
+    ax = search.axes(spec, shape)
     lo = search.size(spec, shape) // 3
-    piv, por = search._settings(ax, where, 3, lo, lo + count)
+    piv, por = search._settings(ax, 3, lo, lo + count)
     units = [lib.units[k] for k in shape.kinds]
     limit = np.full(3, spec.upper)
     q0 = seeds(3, 4, -limit, limit, 0)
@@ -288,17 +297,20 @@ def bench_library(sample: int, whole: bool) -> dict:
 
     out: dict = {}
     if whole:
-        with tempfile.TemporaryDirectory() as tmp:
-            src = Path(tmp) / "walled.mod"
-            src.write_text(WALLED, encoding="utf-8")
-            all_cpus = os.sched_getaffinity(0) | set(range(os.cpu_count() or 1))
-            t = time.perf_counter()
-            p = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(Path(tmp) / "out"),
-                                "--workers", "2", "-q", "--no-render"], capture_output=True, text=True,
-                               env=child_env(), preexec_fn=lambda: os.sched_setaffinity(0, all_cpus), timeout=3600)
-            out["walled_workers2_wall_s"] = time.perf_counter() - t
-            out["walled_exit"] = p.returncode
-            out["walled_message"] = next((ln for ln in p.stderr.splitlines() if "no-design" in ln), p.stderr[-300:])
+        all_cpus = os.sched_getaffinity(0) | set(range(os.cpu_count() or 1))
+        for name, text in (("walled", WALLED), ("far", FAR)):
+            with tempfile.TemporaryDirectory() as tmp:
+                src = Path(tmp) / f"{name}.mod"
+                src.write_text(text, encoding="utf-8")
+                t = time.perf_counter()
+                p = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(Path(tmp) / "out"),
+                                    "--workers", "2", "-q", "--no-render"], capture_output=True, text=True,
+                                   env=child_env(), preexec_fn=lambda: os.sched_setaffinity(0, all_cpus),
+                                   timeout=3600)
+                out[f"{name}_workers2_wall_s"] = time.perf_counter() - t
+                out[f"{name}_exit"] = p.returncode
+                out[f"{name}_message"] = next((ln for ln in p.stderr.splitlines() if "no-design" in ln),
+                                              p.stderr[-300:])
     prob = _problem(NOTHING.replace("units 1 to 3", "units 6"))
     spec = Spec.of(prob)
     shapes = space.shapes(prob, 6)
@@ -327,7 +339,7 @@ def bench_dask(shapes: int) -> dict | None:
 
     prob = _problem(NOTHING.replace("units 1 to 3", "units 5"))
     spec = Spec.of(prob)
-    work = [(s, lo, hi) for s in space.shapes(prob, 5)[:shapes] for lo, hi in search.parts_of(spec, s)]
+    work = [w for s in space.shapes(prob, 5)[:shapes] for w in search.parts_of(spec, s)]
     out: dict = {"tasks": len(work)}
     for n in (1, 2):
         with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -392,6 +404,8 @@ def main() -> None:
     if "walled_workers2_wall_s" in lib:
         lines.append(f"library    walled cell, units 1-6, --workers 2: {lib['walled_workers2_wall_s']:.1f} s wall "
                      f"(exit {lib['walled_exit']})")
+        lines.append(f"library    far cell (targets ~2 m out), units 1-6, every unit type, --workers 2: "
+                     f"{lib['far_workers2_wall_s']:.1f} s wall (exit {lib['far_exit']}): {lib['far_message'][-160:]}")
     lines.append(f"library    6-unit shapes on a cell the bounds cannot close: {lib['six_unit_cpu_s_per_shape']:.2f} s "
                  f"CPU per shape ({lib['six_unit_settings_per_shape']:.0f} settings, coarse grid); "
                  f"{lib['shapes_in_library']} shapes on 2 workers ~ "

@@ -121,7 +121,7 @@ def test_pyproject_light_and_full():
     core = {d.split(">")[0].split("<")[0].split("=")[0].strip() for d in project["dependencies"]}
     assert core == {"lark", "pydantic", "jinja2", "numpy", "pyyaml", "click", "rich", "pygls"}
     full = {d.split(">")[0].split("<")[0].strip() for d in project["optional-dependencies"]["full"]}
-    assert {"pin", "pybullet", "ompl", "pillow", "mujoco", "viser", "cma", "dask", "distributed"} <= full
+    assert {"pin", "pybullet", "ompl", "pillow", "mujoco", "viser", "dask", "distributed", "toppra"} <= full
     for doc in ("README.md", ".ci/run"):  # the documented setup still installs everything
         assert ".[full" in (ROOT / doc).read_text(encoding="utf-8"), doc
 

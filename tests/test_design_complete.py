@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from modc.compiler import check_text
+from modc.kinematics import transform
 
 PIVOTS = np.radians(np.arange(-90.0, 90.1, 15.0))
 PORTS = np.radians(np.arange(-180.0, 180.0, 15.0))
@@ -209,6 +210,29 @@ def test_a_target_walled_off_or_buried_is_named_without_a_search(cell):
     assert o.targets["a"]["ruled_out_by"] == "obstacles" and o.targets["b"]["reached_alone"]
 
 
+@pytest.mark.parametrize("units", [4, 5])
+def test_shapes_of_many_units_whose_every_family_is_out_of_reach_are_complete(units):
+    """Two targets beyond what any twist setting of `units` units reaches, but within every
+    offset laid end to end (the old shape-level bound): the search rules every setting out by
+    families, so it is complete with no coarse grid, and says the targets are out of reach."""
+    from modc.design import run
+    from modc.design.screen import reach_bound
+
+    r = {4: 1.3, 5: 1.6}[units]
+    p = _problem(f"design d {{\n    target a at ({r}, 0.0, 0.3) m\n    target b at (0.0, {r}, 0.2) m\n"
+                 f"    units {units}\n}}\n")
+    lib = p.cell.library
+    longest = reach_bound([lib.units[4]] * units, [lib.units[4].x23] * units, (0.0, 0.0, 0.0))
+    assert longest > 1.05 * float(np.hypot(r, 0.3))  # the old bound would search these shapes
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        o = run.design(p, top=1, seed=0)
+    assert not o.designs and o.complete and not o.coarse and o.screened == 0
+    assert o.evaluated == o.excluded > 10**8  # every setting of the long shapes, none listed
+    why = o.why_none()
+    assert "target 'a'" in why and "target 'b'" in why and "out of reach" in why and "inf" not in why
+
+
 @pytest.mark.slow
 def test_top_designs_are_distinct_arms_with_variant_swaps_as_alternatives():
     """H1-H1-L3 and H1-L1-L3 are one arm (H and L units of a type share their geometry): one entry,
@@ -236,3 +260,68 @@ def test_top_designs_are_distinct_arms_with_variant_swaps_as_alternatives():
     assert all(identity(a) == identity(d) and a.chain() != d.chain() for a in d.alternatives)
     entry = ranking([o])["designs"][o.designs.index(d)]
     assert entry["alternatives"][0]["chain"] == d.alternatives[0].chain()
+
+
+def test_families_excluded_whole_never_hold_a_reaching_setting():
+    """modc.design.prefix rules out a family of settings (a prefix of the chain fixed, the rest
+    free) by one test: for random settings of random shapes, the point their tool0 reaches stays
+    possible for every family the setting belongs to, at every depth; and the option lists the
+    families are built from multiply to the shape's settings."""
+    from modc.design import bounds, prefix, search, space
+    from modc.design.batch import geometry
+    from modc.design.evaluate import Spec
+
+    prob = _problem("design d {\n    tool at (0.05, 0.01, -0.02) m\n    target a at (0.3, 0, 0.2) m\n"
+                    "    units 1 to 6\n}\n")
+    lib, spec = prob.cell.library, Spec.of(prob)
+    rng = np.random.default_rng(7)
+    for n in range(1, 7):
+        kinds = tuple(int(k) for k in rng.integers(1, 5, n))
+        shape = space.Shape(kinds, (None,) * n)
+        ax = search.full_axes(spec, shape)
+        types = [lib.units[k] for k in kinds]
+        units = [library_units()[k] for k in kinds]
+        links = [t.x23 for t in types]
+        lv = prefix.levels(types, links, ax.values[0], PORTS, space.port_free(prob, shape, lib),
+                           transform((0.05, 0.01, -0.02), (0.0, 0.0, 0.0)))
+        assert math.prod(len(level.t) for level in lv) == ax.count
+        C = 300
+        piv = PIVOTS[rng.integers(len(PIVOTS), size=(C, n))]
+        por = PORTS[rng.integers(len(PORTS), size=(C, n))] * np.array(space.port_free(prob, shape, lib))
+        x = fk(units, piv, por, rng.uniform(-LIMIT, LIMIT, (C, n)), (0.05, 0.01, -0.02))
+        f = bounds.frames(geometry(types, piv, por, links, (0.05, 0.01, -0.02), (0.0, 0.0, 0.0)))
+        U = prefix.tails(lv)
+        for k in range(1, n + 2):
+            family = bounds.Frames(f.R[:, :k], f.t[:, :k])
+            ok = bounds.possible(family, x, np.zeros(C), U[k - 1] if k <= n else None)
+            assert np.diag(ok).all(), (kinds, k)
+        far = prefix.refine(lv, np.array([[2.5, 0.0, 0.3]]), np.array([0.005]))
+        assert far.settings == 0  # a point beyond every setting's reach: every family excluded
+
+
+def test_a_setting_that_reaches_the_target_lies_in_a_family_left_alive():
+    """The numbering of families is the search's numbering of settings: for a setting picked at
+    random (by its number), a target put where its tool0 gets lies in a range left alive."""
+    from modc.design import prefix, search, space
+    from modc.design.batch import forward, geometry
+    from modc.design.evaluate import Spec
+
+    prob = _problem("design d {\n    target a at (0.25, 0.1, 0.3) m\n    units 4\n}\n")
+    lib, spec = prob.cell.library, Spec.of(prob)
+    rng = np.random.default_rng(3)
+    for kinds in [(4, 1, 3), (3, 4, 2), (4, 3, 4, 3), (1, 4, 2, 3)]:
+        shape = space.Shape(kinds, (None,) * len(kinds))
+        ax = search.full_axes(spec, shape)
+        types = [lib.units[k] for k in kinds]
+        links = [t.x23 for t in types]
+        lv = prefix.levels(types, links, ax.values[0], space.twist_values(lib.twists.port),
+                           space.port_free(prob, shape, lib), np.eye(4))
+        for _ in range(5):
+            i = int(rng.integers(ax.count))
+            piv, por = search._settings(ax, len(kinds), i, i + 1)
+            q = rng.uniform(-LIMIT, LIMIT, (1, 1, 1, len(kinds)))
+            x = forward(geometry(types, piv, por, links, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), q)[2][0, 0, 0, :3, 3]
+            fam = prefix.refine(lv, x[None], np.array([1e-4]), cap=20_000)
+            if len(kinds) == 3:
+                assert fam.settings < ax.count  # a point target does rule families out
+            assert any(lo <= i < hi for lo, hi in fam.ranges()), (kinds, i)

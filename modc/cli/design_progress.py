@@ -17,7 +17,7 @@ def _duration(s: float | None) -> str:
 
 
 def line(name: str, st) -> str:
-    return (f"{name}: {st.shapes_done}/{st.shapes_total} shapes, {st.screened:,} settings screened, "
+    return (f"{name}: {st.shapes_done}/{st.shapes_total} shapes, {st.screened:,} settings screened or excluded, "
             f"{st.feasible} feasible, best {st.best or '—'}, ETA {_duration(st.eta)}")
 
 

@@ -73,11 +73,26 @@ def _interval(f: Frames, first: int, last: int, end: np.ndarray | None = None):
     return lo, hi
 
 
-def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray) -> np.ndarray:
+def _reach(f: Frames, first: int, tail: tuple[float, float] | None):
+    """Range (lo, hi) of |v_first| = |tool - p_first|. Without a tail every K_j is fixed (exact
+    for the last two joints); with one, f holds K_0 … K_(k-1) and tail bounds |v_k| over every
+    choice of the free K_k … K_n, so the triangle inequality carries it back to joint first."""
+    if tail is None:
+        return _interval(f, first, f.t.shape[1] - 1)
+    k = f.t.shape[1]
+    lo, hi = np.full(len(f.t), tail[0]), np.full(len(f.t), tail[1])
+    for j in range(k - 1, first - 1, -1):
+        a = np.linalg.norm(f.t[:, j], axis=-1)
+        lo, hi = np.maximum.reduce([np.zeros_like(a), a - hi, lo - a]), a + hi
+    return lo, hi
+
+
+def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float, float] | None = None) -> np.ndarray:
     """(C, T): False where no joint vector (limits or not) brings tool0 within tol of target xyz
-    (T, 3) for that setting."""
-    C, n1 = f.t.shape[:2]
-    n = n1 - 1
+    (T, 3) for that setting - or, with a tail, for any setting that starts with f's K_0 …
+    K_(k-1) and whose free rest keeps |v_k| within tail (modc.design.prefix)."""
+    C, k = f.t.shape[:2]
+    n = k - 1 if tail is None else k  # joints whose origin p_j is fixed by f
     p1 = f.t[:, 0]  # (C, 3)
     z1 = f.R[:, 0, :, 2]
     x = xyz[None]  # (1, T, 3)
@@ -85,19 +100,23 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray) -> np.ndarray:
     ok = np.ones((C, len(xyz)), bool)
     # D_1: p_1 fixed
     d1 = np.linalg.norm(x - p1[:, None], axis=-1)
-    lo, hi = _interval(f, 1, n)
+    lo, hi = _reach(f, 1, tail)
     ok &= (d1 <= hi[:, None] + tl) & (d1 >= lo[:, None] - tl)
+    if k < 2:
+        return ok
     # height along joint 1's axis
     h_x = np.einsum("cti,ci->ct", x - p1[:, None], z1)
     a1 = f.t[:, 1]
-    if n == 1:
+    if tail is None and n == 1:
         h_lo = h_hi = a1[:, 2]
+    elif k == 2:  # v_2 free: its component along any axis is at most |v_2|
+        h_lo, h_hi = a1[:, 2] - tail[1], a1[:, 2] + tail[1]  # type: ignore[index]
     else:
         c = f.R[:, 1, 2, :]  # R(K_1)^T e_z, as a row of R(K_1)
         b = f.t[:, 2]
         mid = a1[:, 2] + c[:, 2] * b[:, 2]
         amp = np.hypot(c[:, 0], c[:, 1]) * np.hypot(b[:, 0], b[:, 1])
-        rest = _interval(f, 3, n)[1] if n >= 3 else 0.0
+        rest = _reach(f, 3, tail)[1] if (tail is not None or n >= 3) else 0.0
         h_lo, h_hi = mid - amp - rest, mid + amp + rest
     ok &= (h_x <= h_hi[:, None] + tl) & (h_x >= h_lo[:, None] - tl)
     if n < 2:
@@ -118,7 +137,7 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray) -> np.ndarray:
             ulo, uhi = _interval(f, 2, j - 1)
             dlo = np.maximum.reduce([np.zeros_like(dlo2), dlo2 - uhi[:, None], ulo[:, None] - dhi2])
             dhi = dhi2 + uhi[:, None]
-        wlo, whi = _interval(f, j, n)
+        wlo, whi = _reach(f, j, tail)
         ok &= (dlo <= whi[:, None] + tl) & (dhi >= wlo[:, None] - tl)
     return ok
 

@@ -52,11 +52,11 @@ def _probe(problem: Problem, spec: Spec, t: int, seed: int, until: float, free: 
         one = dataclasses.replace(one, lower=-math.pi, upper=math.pi)
     res: dict[str, Any] = {"hit": False, "clear": False, "closest": math.inf, "screened": 0, "finished": True}
     for s in _shapes_for(problem, t, min(problem.max_units, lib.rules.max_dof)):
-        for lo, hi in parts_of(one, s):
+        for _, ranges, full in parts_of(one, s):
             if time.time() > until:
                 res["finished"] = False
                 return res
-            p = search_part(one, s, lo, hi, seed, until)
+            p = search_part(one, s, ranges, seed, until, full)
             res["hit"] |= p.hit[0]
             res["clear"] |= p.clear[0]
             res["closest"] = min(res["closest"], p.closest[0])

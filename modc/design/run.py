@@ -23,7 +23,7 @@ from .diagnose import diagnose, why_none
 from .evaluate import Spec
 from .rank import Design, distinct, key, static
 from .screen import reach_bound
-from .search import STOP, TICK, Part, ShapeResult, merge, parts_of, search_chunk, size
+from .search import STOP, TICK, Part, ShapeResult, estimate, listed, merge, parts_of, search_chunk
 from .verify_order import Verifier
 
 ROUND = 16  # shapes in a tier's first round of search between exact checks; rounds double up to ROUND_MAX
@@ -222,7 +222,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
                                     float(spec.radii.min()), longest, starts)
     tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest)
     total_shapes = sum(len(s) for _, _, s in tiers)
-    total_settings = sum(size(spec, s) for _, _, shapes in tiers for _, _, s in shapes)
+    total_settings = sum(estimate(spec, s) for _, _, shapes in tiers for _, _, s in shapes)
     early = problem.rank[:2] == ("modules", "mass")
     tally = Verifier(problem, top, out, _mass)
     state: dict = {"done": 0, "settings": 0, "best": ""}
@@ -246,13 +246,15 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     for n, splits, shapes in tiers:
         rounds = _rounds(shapes) if early else [shapes]
         for k, batch in enumerate(rounds):
-            work = [(s, lo, hi_) for _, _, s in batch for lo, hi_ in parts_of(spec, s)]
+            work = [w for _, _, s in batch for w in parts_of(spec, s)]
             pending: dict[str, list[Part]] = {}
             expected = {s.label(): len(parts_of(spec, s)) for _, _, s in batch}
 
             def each(p: Part, n=n, splits=splits, pending=pending, expected=expected) -> None:
                 out.evaluated += p.screened + p.excluded
-                state["settings"] += p.upto - p.lo
+                # progress in the units of total_settings: this part's share of its shape
+                state["settings"] += estimate(spec, p.shape) * max(p.upto - p.lo, p.hi == p.lo) \
+                    / max(listed(spec, p.shape), 1)
                 pending.setdefault(p.shape.label(), []).append(p)
                 if len(pending[p.shape.label()]) == expected[p.shape.label()]:
                     res = merge(spec, p.shape, pending.pop(p.shape.label()))
@@ -307,6 +309,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
 
 def _absorb(out: Outcome, res: ShapeResult, names, closest, hit, clear, searched) -> None:
     out.excluded += res.excluded
+    out.evaluated += res.evaluated - sum(p.screened + p.excluded for p in res.parts)  # families excluded whole
     searched.append(res)
     for i, name in enumerate(names):
         closest[name] = min(closest[name], res.closest[i])

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kinematics import rpy_matrix
+from ..physical.constants import GRAVITY_VECTOR
 
 
 def reach_bound(unit_types, links, tool_xyz) -> float:
@@ -99,9 +100,6 @@ def collides(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: 
     return out
 
 
-G = 9.81  # m/s²
-
-
 def _part_com(part) -> np.ndarray:
     """A part's centre of mass in its frame: its primitives' centroids weighted by volume (uniform
     density, as the URDF's inertials are derived)."""
@@ -119,7 +117,7 @@ def static_torques(robot, qs) -> np.ndarray:
 
     lib = robot.library
     chain = Chain(robot)
-    g = rpy_matrix(robot.base.rpy).T @ np.array([0.0, 0.0, -G])
+    g = rpy_matrix(robot.base.rpy).T @ np.array(GRAVITY_VECTOR)
     per_unit = [unit_parts(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units]
     out = np.zeros((len(qs), robot.dof))
     for k, q in enumerate(qs):

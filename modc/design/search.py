@@ -1,14 +1,17 @@
 """The twist search of one shape: every pivot and port setting, in blocks.
 
-Complete within its bounds: every setting of a shape with up to COMPLETE settings is either
-screened (batched IK per target within the joint limits, then the obstacle screen) or excluded
-by a sound bound (modc.design.bounds: no joint vector, limits or not, brings tool0 within
-tolerance of some target). Exact reductions (modc.design.space) remove settings that cannot
-change tool0. A shape with more settings than that (4 or more units with links) is searched on
-a deterministic coarse grid of its twists and reported as not complete.
+Complete within its bounds: every setting of a shape is either screened (batched IK per target
+within the joint limits, then the obstacle screen) or excluded by a sound bound - whole
+families of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free),
+then setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0
+within tolerance of some target). Exact reductions (modc.design.space) remove settings that
+cannot change tool0. A shape whose families left alive still hold more than COMPLETE settings
+(4 or more units with links, targets in reach) is searched on a deterministic coarse grid of
+its twists and reported as not complete.
 
-A shape's settings are numbered (first unit outermost); a unit of work is a range of those
-numbers (WORK settings), so a large shape spreads over many workers. Everything here is a
+A shape's settings are numbered unit by unit (unit 1's pivot outermost, then its port, unit 2's
+pivot, …); a unit of work is a range of those numbers (WORK settings), so a large shape spreads
+over many workers. Everything here is a
 function of (spec, shape, range, seed): the same inputs give the same answer in any process.
 Within a shape the settings are ordered by how deep inside the tolerances their worst target
 lies, then simplest twists first.
@@ -19,12 +22,14 @@ import functools
 import math
 import threading
 import time
+import weakref
 import zlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import bounds
+from ..kinematics import transform
+from . import bounds, prefix
 from .batch import geometry
 from .evaluate import Spec, screen_batch
 from .space import Shape, port_free, twist_values
@@ -49,7 +54,8 @@ class Found:
 
 @dataclass(frozen=True)
 class Part:
-    """What one unit of work found: a range [lo, hi) of a shape's settings, done up to `upto`."""
+    """What one unit of work found: its settings (a few ranges of the shape's numbers) are
+    numbered lo … hi-1 in their order, done up to `upto`."""
 
     shape: Shape
     lo: int
@@ -102,20 +108,117 @@ def _coarse_index(count: int, i0: int, stride: int) -> list[int]:
     return [i for i in range(count) if (i - i0) % stride == 0]
 
 
-def axes(spec: Spec, shape: Shape) -> tuple[list[np.ndarray], list[int], bool]:
-    """The twist values per variable (each pivot, then each port that matters), the positions of
-    those ports, and whether the grid is complete."""
+@dataclass(frozen=True)
+class Axes:
+    """The twist values per axis, unit by unit (its pivot, then its port when that matters),
+    which twist each axis sets, and whether they are every realisable value (not a coarse grid)."""
+
+    values: tuple[np.ndarray, ...]
+    roles: tuple[tuple[str, int], ...]  # ("pivot" | "port", position)
+    full: bool
+
+    @property
+    def count(self) -> int:
+        return math.prod(len(a) for a in self.values)
+
+
+def full_axes(spec: Spec, shape: Shape) -> Axes:
     lib = spec.problem.cell.library
     assert lib is not None
     pivot_set, port_set = twist_values(lib.twists.pivot), twist_values(lib.twists.port)
     free = port_free(spec.problem, shape, lib)
-    where = [i for i, f in enumerate(free) if f]
-    out = [pivot_set] * shape.n + [port_set] * len(where)
-    if int(np.prod([len(a) for a in out], dtype=float)) <= COMPLETE:
-        return out, where, True
-    zero = [int(np.argmin(np.abs(a))) for a in out]
-    strides = _strides(tuple(len(a) for a in out), tuple(zero))
-    return [a[_coarse_index(len(a), z, s)] for a, z, s in zip(out, zero, strides, strict=True)], where, False
+    values: list[np.ndarray] = []
+    roles: list[tuple[str, int]] = []
+    for i in range(shape.n):
+        values.append(pivot_set)
+        roles.append(("pivot", i))
+        if free[i]:
+            values.append(port_set)
+            roles.append(("port", i))
+    return Axes(tuple(values), tuple(roles), True)
+
+
+def coarse_axes(spec: Spec, shape: Shape) -> Axes:
+    ax = full_axes(spec, shape)
+    zero = [int(np.argmin(np.abs(a))) for a in ax.values]
+    strides = _strides(tuple(len(a) for a in ax.values), tuple(zero))
+    return Axes(tuple(a[_coarse_index(len(a), z, s)] for a, z, s in zip(ax.values, zero, strides, strict=True)),
+                ax.roles, False)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """How a shape is searched: on which axes, which ranges of their settings (the rest
+    excluded whole by modc.design.prefix), and whether that covers every setting."""
+
+    axes: Axes
+    ranges: tuple[tuple[tuple[int, int], ...], ...]  # units of work: ranges, at most WORK settings each
+    total: int  # settings of the shape (of the coarse grid when not complete)
+    excluded: int  # settings excluded whole, before any is listed
+
+    @property
+    def complete(self) -> bool:
+        return self.axes.full
+
+
+_PLANS: dict[int, tuple[weakref.ref, dict[Shape, Plan]]] = {}
+
+
+def plan(spec: Spec, shape: Shape) -> Plan:
+    """The shape's plan (computed once per spec object in this process)."""
+    key = id(spec)
+    entry = _PLANS.get(key)
+    if entry is None or entry[0]() is not spec:
+
+        def forget(_ref: weakref.ref, key: int = key) -> None:
+            _PLANS.pop(key, None)
+
+        entry = (weakref.ref(spec, forget), {})
+        _PLANS[key] = entry
+    cache = entry[1]
+    if shape not in cache:
+        cache[shape] = _plan(spec, shape)
+    return cache[shape]
+
+
+def _split(ranges: list[tuple[int, int]]) -> tuple[tuple[tuple[int, int], ...], ...]:
+    """Ranges grouped into units of at most WORK settings (a long range cut, short ones joined:
+    a unit's cost is its settings, not its ranges)."""
+    units: list[list[tuple[int, int]]] = []
+    room = 0
+    for a, b in ranges:
+        while a < b:
+            if room == 0:
+                units.append([])
+                room = WORK
+            take = min(room, b - a)
+            units[-1].append((a, a + take))
+            a, room = a + take, room - take
+    return tuple(tuple(u) for u in units)
+
+
+def _plan(spec: Spec, shape: Shape) -> Plan:
+    full = full_axes(spec, shape)
+    lib = spec.problem.cell.library
+    assert lib is not None
+    types = [lib.units[k] for k in shape.kinds]
+    links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
+    tool = spec.problem.cell.tool
+    free = port_free(spec.problem, shape, lib)
+    lv = prefix.levels(types, links, twist_values(lib.twists.pivot), twist_values(lib.twists.port), free,
+                       transform(tool.xyz, tool.rpy))
+    fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p)
+    total = full.count
+    if fam.settings <= COMPLETE:
+        ranges = _split(fam.ranges()) or ((),)
+        return Plan(full, ranges, total, total - fam.settings)
+    coarse = coarse_axes(spec, shape)
+    return Plan(coarse, _split([(0, coarse.count)]), coarse.count, 0)
+
+
+def axes(spec: Spec, shape: Shape, full: bool = True) -> Axes:
+    """The axes a unit of work enumerates (cheap: no bound is computed)."""
+    return full_axes(spec, shape) if full else coarse_axes(spec, shape)
 
 
 @functools.lru_cache(maxsize=256)
@@ -133,23 +236,38 @@ def _strides(lengths: tuple[int, ...], zero: tuple[int, ...]) -> tuple[int, ...]
 
 
 def size(spec: Spec, shape: Shape) -> int:
-    return int(np.prod([len(a) for a in axes(spec, shape)[0]]))
+    return plan(spec, shape).total
 
 
-def _settings(ax: list[np.ndarray], where: list[int], n: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
-    idx = np.unravel_index(np.arange(lo, hi), [len(a) for a in ax])
-    values = np.stack([a[i] for a, i in zip(ax, idx, strict=True)], -1).reshape(hi - lo, len(ax))
-    pivots = values[:, :n]
-    ports = np.zeros((hi - lo, n))
-    ports[:, where] = values[:, n:]
+def estimate(spec: Spec, shape: Shape) -> int:
+    """The shape's settings before any bound (its coarse grid's when too many): cheap, for
+    progress and ordering, where size() would run the family bounds of every shape."""
+    full = full_axes(spec, shape)
+    return full.count if full.count <= COMPLETE else min(full.count, COARSE)
+
+
+def _settings(ax: Axes, n: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
+    return _settings_at(ax, n, np.arange(lo, hi))
+
+
+def _settings_at(ax: Axes, n: int, numbers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    idx = np.unravel_index(numbers, [len(a) for a in ax.values])
+    pivots = np.zeros((len(numbers), n))
+    ports = np.zeros((len(numbers), n))
+    for a, i, (role, pos) in zip(ax.values, idx, ax.roles, strict=True):
+        (pivots if role == "pivot" else ports)[:, pos] = a[i]
     return pivots, ports
 
 
-def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline: float | None = None) -> Part:
-    """Screen settings lo … hi-1 of a shape, BLOCK at a time, until done or the deadline (time.time())."""
+def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], seed: int,
+                deadline: float | None = None, full: bool = True) -> Part:
+    """Screen the settings in ranges ([lo, hi) of the shape's numbers, on its full axes or its
+    coarse grid), BLOCK at a time, until done or the deadline (time.time())."""
+    numbers = np.concatenate([np.arange(a, b, dtype=np.int64) for a, b in ranges] or [np.zeros(0, np.int64)])
+    lo, hi = 0, len(numbers)
     lib = spec.problem.cell.library
     assert lib is not None
-    ax, where, _ = axes(spec, shape)
+    ax = axes(spec, shape, full)
     types = [lib.units[k] for k in shape.kinds]
     links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     tool = spec.problem.cell.tool
@@ -165,7 +283,7 @@ def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline:
         if STOP.is_set() or (deadline is not None and time.time() > deadline):
             break
         end = min(start + BLOCK, hi)
-        piv, por = _settings(ax, where, shape.n, start, end)
+        piv, por = _settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
         ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
         excluded += int((~ok).sum())
@@ -190,14 +308,25 @@ def search_part(spec: Spec, shape: Shape, lo: int, hi: int, seed: int, deadline:
                 tuple(bool(x) for x in hit), tuple(bool(x) for x in clear))
 
 
-def parts_of(spec: Spec, shape: Shape) -> list[tuple[int, int]]:
-    total = size(spec, shape)
-    return [(lo, min(lo + WORK, total)) for lo in range(0, total, WORK)]
+Work = tuple[Shape, tuple[tuple[int, int], ...], bool]  # a shape, ranges of its settings, full axes or not
+
+
+def parts_of(spec: Spec, shape: Shape) -> list[Work]:
+    """The shape's units of work (its plan's ranges; one empty range when every setting is
+    excluded whole, so that the shape still reports)."""
+    p = plan(spec, shape)
+    return [(shape, r, p.complete) for r in p.ranges]
+
+
+def listed(spec: Spec, shape: Shape) -> int:
+    """Settings of the shape that units of work go through one by one."""
+    return sum(hi - lo for unit in plan(spec, shape).ranges for lo, hi in unit)
 
 
 def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
     """One shape's result from its parts (in any order: the merge sorts)."""
     T = len(spec.targets.names)
+    p_ = plan(spec, shape)
     found = sorted((f for p in parts for f in p.found), key=order_key)[:KEEP]
     closest = np.full(T, np.inf)
     hit, clear = np.zeros(T, bool), np.zeros(T, bool)
@@ -206,19 +335,18 @@ def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
         hit |= np.array(p.hit, bool)
         clear |= np.array(p.clear, bool)
     screened = sum(p.screened for p in parts)
-    excluded = sum(p.excluded for p in parts)
-    finished = all(p.upto >= p.hi for p in parts) and len(parts) == len(parts_of(spec, shape))
-    complete = axes(spec, shape)[2] and finished
+    finished = all(p.upto >= p.hi for p in parts) and len(parts) == len(p_.ranges)
+    excluded = sum(p.excluded for p in parts) + (p_.excluded if finished else 0)
+    complete = p_.complete and finished
     return ShapeResult(shape, tuple(found), screened + excluded, tuple(float(x) for x in closest),
-                       0.0 if found else 1.0, screened, excluded, size(spec, shape), complete, finished,
+                       0.0 if found else 1.0, screened, excluded, p_.total, complete, finished,
                        tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), list(parts))
 
 
 def search_shape(spec: Spec, shape: Shape, seed: int, deadline: float | None = None) -> ShapeResult:
-    return merge(spec, shape, [search_part(spec, shape, lo, hi, seed, deadline) for lo, hi in parts_of(spec, shape)])
+    return merge(spec, shape, search_chunk(spec, parts_of(spec, shape), seed, deadline))
 
 
-def search_chunk(spec: Spec, work: list[tuple[Shape, int, int]], seed: int,
-                 deadline: float | None = None) -> list[Part]:
+def search_chunk(spec: Spec, work: list[Work], seed: int, deadline: float | None = None) -> list[Part]:
     """A worker's unit of work: ranges of shapes' settings, one after the other."""
-    return [search_part(spec, s, lo, hi, seed, deadline) for s, lo, hi in work]
+    return [search_part(spec, s, r, seed, deadline, full) for s, r, full in work]

@@ -21,7 +21,8 @@ import math
 
 import numpy as np
 
-ACCEL_RAMP_TIME = 0.5  # s: acceleration limit = velocity limit / this (modc.backends.ros uses the same)
+from ..physical.constants import ACCEL_RAMP_TIME  # acceleration limit = velocity limit / this
+
 SAMPLE_PERIOD = 0.05  # s between output points (at most)
 MIN_MOTION = 1e-9  # rad: a segment whose joints all move less than this is skipped (a repeated vertex)
 

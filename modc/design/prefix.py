@@ -1,0 +1,148 @@
+"""Branch and bound over a shape's twist settings: whole families of settings - a prefix of
+the chain fixed, the rest free - excluded by one sound test, before any setting is listed.
+
+In the notation of modc.design.bounds, a setting is the sequence of fixed transforms
+K_0 … K_n, and each K_j is chosen by its own twists: K_0 by unit 1's pivot, K_j (0 < j < n) by
+unit j's port and unit j+1's pivot, K_n by unit n's port. The settings are numbered in that
+order (unit 1's pivot outermost, then its port, unit 2's pivot, …), so the settings that share
+K_0 … K_(k-1) are one contiguous range of numbers.
+
+For the free rest, U_k bounds |v_k| = |tool - p_k| over every choice of K_k … K_n and every
+joint angle: exact (modc.design.bounds._pair) over every pair K_(n-1), K_n, then the triangle
+inequality with the shortest and longest |t(K_j)| on offer. bounds.possible with that tail is
+then a test that holds for every setting of the family at once: a family it rules out for some
+target holds no setting that could serve that target, and is excluded whole. Families are
+refined a level at a time while at most CAP of them are alive; what survives is listed
+setting by setting (and meets the exact per-setting bound) by modc.design.search.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import bounds
+from .batch import pre_post
+
+CAP = 200_000  # live families per level (memory: ~100 bytes each per fixed transform)
+
+
+@dataclass(frozen=True)
+class Level:
+    """The options of one K_j: rotations (m, 3, 3), translations (m, 3), and the twist axes
+    that choose it (their lengths multiply to m, the first axis outermost)."""
+
+    R: np.ndarray
+    t: np.ndarray
+    axes: tuple[int, ...]
+
+
+def levels(types, links, pivot_set: np.ndarray, port_set: np.ndarray, free: list[bool],
+           flange_tool: np.ndarray) -> list[Level]:
+    """K_0 … K_n of a shape as option lists. Axes are numbered unit by unit: pivot, then port
+    (a port that cannot matter has one value, 0, and no axis)."""
+    n = len(types)
+    axis = 0
+    out: list[Level] = []
+    pivot_axis: list[int] = []
+    port_axis: list[int | None] = []
+    for i in range(n):
+        pivot_axis.append(axis)
+        axis += 1
+        port_axis.append(axis if free[i] else None)
+        axis += int(free[i])
+
+    def unit(i, piv, por):
+        m = len(piv)
+        return pre_post([types[i]], np.asarray(piv, float).reshape(m, 1), np.asarray(por, float).reshape(m, 1),
+                        [links[i]])
+
+    pr, pt, _, _ = unit(0, pivot_set, np.zeros(len(pivot_set)))
+    out.append(Level(pr[:, 0], pt[:, 0], (pivot_axis[0],)))
+    for j in range(1, n + 1):
+        ports = port_set if free[j - 1] else np.zeros(1)
+        pa = port_axis[j - 1]
+        axes: tuple[int, ...] = () if pa is None else (pa,)
+        _, _, qR, qt = unit(j - 1, np.zeros(len(ports)), ports)
+        qR, qt = qR[:, 0], qt[:, 0]
+        if j == n:
+            R = qR @ flange_tool[:3, :3]
+            t = qt + qR @ flange_tool[:3, 3]
+        else:
+            pR, pt_, _, _ = unit(j, pivot_set, np.zeros(len(pivot_set)))
+            pR, pt_ = pR[:, 0], pt_[:, 0]
+            R = (qR[:, None] @ pR[None]).reshape(-1, 3, 3)
+            t = (qt[:, None] + np.einsum("aij,bj->abi", qR, pt_)).reshape(-1, 3)
+            axes = axes + (pivot_axis[j],)
+        out.append(Level(R, t, axes))
+    return out
+
+
+def tails(lv: list[Level]) -> list[tuple[float, float]]:
+    """U_1 … U_n (index k-1 holds U_k): bounds of |v_k| over every choice of K_k … K_n."""
+    n = len(lv) - 1
+    U: dict[int, tuple[float, float]] = {}
+    a = np.linalg.norm(lv[n].t, axis=-1)
+    U[n] = (float(a.min()), float(a.max()))
+    if n >= 2:
+        last = lv[n]
+        prev = lv[n - 1]
+        P, M = len(prev.t), len(last.t)
+        lo, hi = bounds._pair(np.repeat(prev.t, M, 0), np.repeat(prev.R, M, 0), np.tile(last.t, (P, 1)))
+        U[n - 1] = (float(lo.min()), float(hi.max()))
+    for j in range(n - 2, 0, -1):
+        a = np.linalg.norm(lv[j].t, axis=-1)
+        lo_n, hi_n = U[j + 1]
+        U[j] = (max(0.0, float(a.min()) - hi_n, lo_n - float(a.max())), float(a.max()) + hi_n)
+    return [U[k] for k in range(1, n + 1)]
+
+
+@dataclass(frozen=True)
+class Families:
+    """The families of settings still alive: prefixes over the first `depth` levels (numbers in
+    the row-major order of their axes), and how many settings each holds."""
+
+    depth: int
+    alive: np.ndarray  # sorted prefix numbers
+    per: int  # settings per family
+
+    def ranges(self) -> list[tuple[int, int]]:
+        """The alive settings as [lo, hi) ranges, neighbours merged."""
+        out: list[tuple[int, int]] = []
+        for i in self.alive.tolist():
+            lo, hi = i * self.per, (i + 1) * self.per
+            if out and out[-1][1] == lo:
+                out[-1] = (out[-1][0], hi)
+            else:
+                out.append((lo, hi))
+        return out
+
+    @property
+    def settings(self) -> int:
+        return len(self.alive) * self.per
+
+
+def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP) -> Families:
+    """Families alive after refining level by level while at most cap of them are tested."""
+    n = len(lv) - 1
+    U = tails(lv)
+    sizes = [len(level.t) for level in lv]
+    total = int(np.prod(sizes, dtype=object))
+    R = lv[0].R[:, None]
+    t = lv[0].t[:, None]
+    alive = np.arange(sizes[0])
+    depth = 1
+    while True:
+        tail = U[depth - 1] if depth <= n else None
+        ok = bounds.possible(bounds.Frames(R, t), xyz, tol, tail).all(-1)
+        R, t, alive = R[ok], t[ok], alive[ok]
+        if depth == n + 1 or len(alive) == 0 or len(alive) * sizes[depth] > cap:
+            break
+        m = sizes[depth]
+        nxt = lv[depth]
+        R = np.concatenate([np.repeat(R, m, 0), np.tile(nxt.R, (len(alive), 1, 1))[:, None]], 1)
+        t = np.concatenate([np.repeat(t, m, 0), np.tile(nxt.t, (len(alive), 1))[:, None]], 1)
+        alive = (alive[:, None] * m + np.arange(m)[None]).reshape(-1)
+        depth += 1
+    per = total // int(np.prod(sizes[:depth], dtype=object))
+    return Families(depth, alive, int(per))
