@@ -21,11 +21,12 @@ thread), so other load on the machine does not count; wall figures are time.perf
 2. solve       run.design (top 1) on the three-target cell with at most 3 modules: CPU s.
 3. complete    run.design on a cell where nothing is feasible, units 1 to 3, every unit type:
                every setting of every shape screened or excluded (CPU s, settings, excluded).
-4. library     `modc design --workers 2` on two targets nothing reaches (below a floor), units 1
-               to 6, every unit type: wall s (a subprocess on two cores). And the per-shape CPU of
+4. library     `modc design --workers 2` on two cells nothing can serve, units 1 to 6, every unit
+               type: targets below a floor, and targets about 2 m out (inside every offset laid
+               end to end, beyond every setting's reach): wall s (a subprocess on two cores). And the per-shape CPU of
                six-unit shapes on a cell the bounds cannot close (sampled), extrapolated to the
                whole space on 2 workers.
-5. dask        the same units of work (ranges of settings) on a Dask LocalCluster of 1 and 2
+5. dask        units of work (five-unit shapes of the three-target cell) on a Dask LocalCluster of 1 and 2
                single-thread worker processes: wall s, and the extrapolation to 64 workers.
 6. anchor      Timor-python 1.1.1 (TUM) in its own venv: per design, assemble a 3-DoF chain
                from geometric_primitive_modules, build its pinocchio robot, IK for three targets
@@ -337,9 +338,12 @@ def bench_dask(shapes: int) -> dict | None:
     from modc.design import search, space
     from modc.design.evaluate import Spec
 
-    prob = _problem(NOTHING.replace("units 1 to 3", "units 5"))
+    # five-unit shapes of the three-target cell searched on their coarse grid: targets in reach, so
+    # each is real work of one size (a cell the family bounds close would time only the scheduling)
+    prob = _problem(CELL.replace("units 2 to 3", "units 5"))
     spec = Spec.of(prob)
-    work = [w for s in space.shapes(prob, 5)[:shapes] for w in search.parts_of(spec, s)]
+    coarse = [s for s in space.shapes(prob, 5)[::-1] if not search.plan(spec, s).complete][:shapes]
+    work = [w for s in coarse for w in search.parts_of(spec, s)]
     out: dict = {"tasks": len(work)}
     for n in (1, 2):
         with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
