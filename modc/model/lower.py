@@ -290,10 +290,7 @@ class _Lowerer:
         elif acc["base_within"]:
             from .lower_task import base_grid
 
-            bounds["base_grid"] = base_grid(self, acc["base_within"][0])
-            if bounds["base_grid"] is not None:  # (one with errors is reported for them)
-                self.error(codes.DESIGN_UNSUPPORTED.at(acc["base_within"][0].span, what="`base within`",
-                                                       name=_say(d.name)))
+            bounds["base_grid"] = base_grid(self, acc["base_within"][0], acc["regions"], _say(d.name))
         if not (named and acc["named"]):
             return None
         cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)

@@ -71,7 +71,9 @@ def region(low, st: ast.Region) -> Region | None:
                   **tol)
 
 
-def base_grid(low, st: ast.BaseWithin) -> BaseGrid | None:
+def base_grid(low, st: ast.BaseWithin, regions=(), block: str = "") -> BaseGrid | None:
+    """The base grid; a yawed base with regions is refused (an axis-aligned region box would turn
+    with the base, which its statement cannot say in the emitted robot's base frame)."""
     size = low.vec3(st.size, "a length", "size of the base's box")
     at = low.vec3(st.at, "a length", "position of the base's box")
     step = low.quantity(st.step, "a length", "base step")
@@ -93,6 +95,9 @@ def base_grid(low, st: ast.BaseWithin) -> BaseGrid | None:
         low.error(codes.DESIGN_BOUND.at(st.span, what=f"{n:,} base poses are too many to search",
                                         hint=f"use a coarser step or a smaller box: at most {MAX_BASE_POSES:,} poses"))
         return None
+    if regions and any(abs(math.remainder(y, 2 * math.pi)) > 1e-12 for y in yaws):
+        low.error(codes.DESIGN_UNSUPPORTED.at(st.yaw.span if st.yaw is not None else st.span,
+                                              what="`base within … yaw` with a region", name=block))
     return grid
 
 
