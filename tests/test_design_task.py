@@ -1,6 +1,6 @@
 """`modc design` with tasks: the cell's tasks planned and timed for the designs the static search
 returns, `rank … cycle_time` / `energy`, the trajectory and task keys written, and the design
-statements not searched yet (`rank coverage`; `base within … yaw` with a region) refused with a diagnostic."""
+statement not searched yet (`base within … yaw` with a region) refused with a diagnostic."""
 from __future__ import annotations
 
 import json
@@ -118,7 +118,6 @@ def test_modc_design_writes_the_timed_task(tmp_path):
     ("region r box size (0.1, 0, 0) m at (0.3, 0, 0.2) m grid 2 x 1 x 1\n"
      "    base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 50 mm yaw 0 to 90 deg step 90 deg",
      "`base within … yaw` with a region"),
-    ("rank coverage", "`rank coverage`"),
 ])
 def test_statements_not_searched_yet_are_refused(tmp_path, statement, what):
     text = TASKED.replace("    rank modules, cycle_time\n", f"    {statement}\n")

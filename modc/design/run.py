@@ -182,8 +182,9 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     from . import placement, tasks
 
     t0 = time.perf_counter()
-    tasked = tasks.has_tasks(problem)
-    screen = problem.model_copy(update={"rank": static(problem.rank)}) if tasked else problem
+    tasked = tasks.has_tasks(problem) or "coverage" in problem.rank
+    screen, points = tasks.with_points(problem)  # every region point required: screened as a target
+    screen = screen.model_copy(update={"rank": static(problem.rank)}) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
 
     def one(p: Problem, units: int | None, k: int) -> Outcome:
@@ -197,6 +198,7 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
         hi = min(max_units or problem.max_units, lib.rules.max_dof)
         out = placement.search(screen, max_units, n, longest_reach(problem, hi), one)
     out.problem = problem
+    tasks.restore(out, points)
     if tasked:
         tasks.plan_all(out, top, seed, deadline, _stopping)
     out.seconds = time.perf_counter() - t0

@@ -24,11 +24,11 @@ def task_figures(o: Outcome, rank: int, d: Design) -> dict:
     """ranking.json's task keys of a planned design: cycle time and energy summed over the
     cell's tasks and paths, the figures per task, and which task the .traj.json holds."""
     if not d.plans:
-        return base_figures(o, d)
+        return {**base_figures(o, d), **({"coverage": round(d.coverage, 6)} if "coverage" in o.problem.rank else {})}
     return {**base_figures(o, d, always=True),
             "cycle_time_s": round(d.cycle_time, 6), "energy_j": round(d.energy, 6),
             "peak_torque_share": round(max(p.peak_share for p in d.plans), 6),
-            "coverage": 1.0,  # every task planned: every point of every task reached
+            "coverage": round(d.coverage, 6),  # share of the region points reached (1 unless `rank coverage`)
             "tasks": [{"task": p.task, "kind": p.kind, "cycle_time_s": round(p.cycle_time, 6),
                        "energy_j": round(p.energy, 6), "peak_torque_share": round(p.peak_share, 6),
                        "segments": [s.to_json() for s in p.segments]} for p in d.plans],
