@@ -37,8 +37,8 @@ DECLARATIONS = ("design", "robot")
 STATEMENTS = ("allow", "base", "box", "chain", "cylinder", "dh", "library", "limit", "links", "modules",
               "path", "payload", "pose", "rank", "region", "row", "sphere", "target", "task", "tool", "units")
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
-CLAUSES = ("at", "fit-links", "from", "grid", "length", "radius", "rpy", "size", "step", "straight", "to",
-           "visit", "within", "x", "yaw")
+CLAUSES = ("at", "fit-links", "from", "grid", "length", "pointing", "radius", "rpy", "size", "step",
+           "straight", "to", "visit", "within", "x", "yaw")
 #: Every keyword of the language.
 KEYWORDS = frozenset(DECLARATIONS + STATEMENTS + CLAUSES)
 #: Units of measure (modc.model.quantities.ALL).

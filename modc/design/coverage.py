@@ -29,8 +29,9 @@ def reached(robot: Robot, seed: int) -> tuple[set[str], int]:
     for t in points:
         rotation = None if t.rpy is None else rpy_matrix(t.rpy)
         solver = plan_ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper,
-                                    rotation)
-        tol = (t.position_tolerance, t.orientation_tolerance if t.rpy is not None else np.inf)
+                                    rotation, t.pointing)
+        oriented = t.rpy is not None or t.pointing is not None
+        tol = (t.position_tolerance, t.orientation_tolerance if oriented else np.inf)
         sols, _best = plan_ik.solve(solver, t.xyz, home, IK_SEEDS_PER_JOINT * robot.dof, seed,
                                     batches=IK_BATCHES, enough=checker.valid, tolerance=tol)
         if any(checker.valid(s.q) for s in sols):

@@ -48,6 +48,14 @@ def _to_base(R: np.ndarray, p: np.ndarray, xyz, rpy) -> tuple[Vec, Vec | None]:
     return xyz_b, matrix_rpy(R.T @ rpy_matrix(rpy))
 
 
+def _turn(R: np.ndarray, d) -> Vec | None:
+    """A cell-frame direction in the base frame."""
+    if d is None:
+        return None
+    v = R.T @ np.asarray(d, float)
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
 def cell_at(cell: Robot, pose: Transform) -> Robot:
     """The cell written in the frame of a base at `pose` (cell frame), with `base at` the pose.
 
@@ -62,11 +70,11 @@ def cell_at(cell: Robot, pose: Transform) -> Robot:
     targets = []
     for t in cell.targets:
         xyz, rpy = _to_base(R, p, t.xyz, t.rpy)
-        targets.append(t.model_copy(update={"xyz": xyz, "rpy": rpy}))
+        targets.append(t.model_copy(update={"xyz": xyz, "rpy": rpy, "pointing": _turn(R, t.pointing)}))
     regions = []
     for r in cell.regions:
         xyz, rpy = _to_base(R, p, r.center, r.rpy)
-        regions.append(r.model_copy(update={"center": xyz, "rpy": rpy}))
+        regions.append(r.model_copy(update={"center": xyz, "rpy": rpy, "pointing": _turn(R, r.pointing)}))
     return cell.model_copy(update={"base": pose, "obstacles": tuple(obstacles), "targets": tuple(targets),
                                    "regions": tuple(regions)})
 
