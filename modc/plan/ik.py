@@ -74,6 +74,7 @@ class PositionIK:
 
     def _axis_error(self, M) -> np.ndarray:
         """The shortest turn taking tool0's x axis onto self.axis (its norm: the angle between them)."""
+        assert self.axis is not None
         x = np.array(M.rotation)[:, 0]
         v = np.cross(x, self.axis)
         s = float(np.linalg.norm(v))
