@@ -66,6 +66,25 @@ def test_base_poses_beyond_reach_are_skipped_soundly_and_nearest_first():
     assert np.linalg.norm(np.subtract(p.cell.targets[0].xyz, far.xyz)) - 0.005 > longest
 
 
+def test_poses_after_the_top_designs_are_not_searched(monkeypatch):
+    """First fit: poses nearest first, each searched completely, until `top` designs are found."""
+    from modc.design import placement, run
+
+    calls = []
+    real = run._search
+
+    def counted(p, *a, **kw):
+        calls.append(p.cell.base.xyz)
+        return real(p, *a, **kw)
+
+    monkeypatch.setattr(run, "_search", counted)
+    wide = SHIFTED.replace("target a at (0.75, 0.05, 0.20) m\n", "").replace("modules H1, L3", "modules H1, L3, L4")
+    o = run.design(problem(wide), top=1)
+    assert len(o.designs) == 1 and o.bases_searched == len(calls) == 1
+    assert calls[0] == placement.poses(problem(wide), run.longest_reach(problem(wide), 3))[0][0].xyz
+    assert o.bases_total == 5 and o.designs[0].verified.robot.base.xyz == calls[0]
+
+
 def test_no_base_pose_in_reach_is_no_design_with_the_reason():
     from modc.design import run
 
@@ -91,6 +110,8 @@ def test_only_a_shifted_base_reaches_and_its_file_places_the_same_cell(tmp_path)
                         "--no-render", "--top", "2"], capture_output=True, text=True, env=env, timeout=900)
     assert r.returncode == 0, r.stderr
     ranking = json.loads((tmp_path / "out" / "ranking.json").read_text())
+    bases = ranking["bases"]["shifted"]
+    assert bases["poses"] == 5 and bases["pruned_by_reach"] == 1 and 1 <= bases["searched"] <= 4
     cell = problem().cell
     for d in ranking["designs"]:
         assert d["base"]["xyz_m"][0] > 0.05 and d["base"]["rpy_deg"] == [0.0, 0.0, 0.0]

@@ -9,9 +9,11 @@ states its `base at …` and holds the same cell around it, so it compiles, plan
 same world as every other design.
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
-bounds is skipped (sound: no chain could reach it from there), poses are searched closest cell
-first, and once `top` designs are found with the ranking led by `modules`, later poses search
-only chains of at most as many units as the last of them.
+bounds is skipped (sound: no chain could reach it from there), and poses are searched closest
+cell first (the farthest point of the cell nearest), each completely, until `top` designs are
+found: the poses after that are not searched (first fit, not the best pose of the grid; ranking.json
+"bases" says how many poses were searched, skipped by reach, left). So 25 poses cost what the
+poses without `top` designs cost, plus one.
 """
 from __future__ import annotations
 
@@ -114,20 +116,16 @@ def search(problem: Problem, max_units: int | None, top: int, longest: float,
 
     kept, pruned = poses(problem, longest)
     outs = []
-    cap = max_units
     designs: list[Design] = []
     for pose in kept:
         sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None})
-        o = one(sub, cap, top)
+        o = one(sub, max_units, top)
         outs.append(o)
         designs = _best_per_chain(designs + list(o.designs), problem.rank)
-        if len(designs) >= top and problem.rank[:1] == ("modules",):
-            # a chain of more units than the top-th design found cannot enter the ranking
-            cap = min(cap or problem.max_units, designs[top - 1].modules)
-        if o.stopped:
+        if o.stopped or len(designs) >= top:
             break
     out = Outcome(problem, designs[:top])
-    out.bases_searched, out.bases_pruned = len(outs), pruned
+    out.bases_searched, out.bases_pruned, out.bases_total = len(outs), pruned, len(kept) + pruned
     names = [t.name for t in problem.cell.targets]
     out.closest = {t: min((o.closest.get(t, math.inf) for o in outs), default=math.inf) for t in names}
     if not outs:  # every pose ruled out by reach: how far the nearest pose leaves the cell

@@ -59,6 +59,7 @@ class Outcome:
     targets: dict[str, dict] = field(default_factory=dict)  # per target: hit, clear, closest, excluded_by
     bases_searched: int | None = None  # `base within`: base poses searched (None: the base as written)
     bases_pruned: int = 0  # base poses ruled out by the reach bound
+    bases_total: int = 0  # base poses of the grid
 
     def why_none(self) -> str:
         return why_none(self)

@@ -75,7 +75,9 @@ def ranking(outcomes: list[Outcome]) -> dict:
     def shapes(o: Outcome, labels: list[str]) -> list[str]:
         return [f"{o.problem.name}/{s}" if prefix else s for s in labels]
 
-    return {"designs": designs, "evaluated": sum(o.evaluated for o in outcomes),
+    bases = {o.problem.name: {"poses": o.bases_total, "searched": o.bases_searched, "pruned_by_reach": o.bases_pruned}
+             for o in outcomes if o.bases_searched is not None}
+    return {"designs": designs, **({"bases": bases} if bases else {}), "evaluated": sum(o.evaluated for o in outcomes),
             "excluded_by_bounds": sum(o.excluded for o in outcomes),
             "seconds": round(sum(o.seconds for o in outcomes), 3),
             "complete": all(o.complete for o in outcomes),
