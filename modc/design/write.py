@@ -50,7 +50,8 @@ def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
 
     name = f"{outcome.problem.name}_{rank}"
     robot = d.verified.robot.model_copy(update={"name": name})
-    targets = ", ".join(f"{pose_name(t)} reaches {t}" for t in d.verified.targets)
+    # (region points are screened with poses of their own, which the robot file does not keep)
+    targets = ", ".join(f"{pose_name(t)} reaches {t}" for t in d.verified.targets if robot.pose(pose_name(t)))
     comments = [f"Design {rank} of `modc design` for '{outcome.problem.name}': {d.modules} modules, "
                 f"{d.mass:.3f} kg, torque margin {d.margin * 100:.0f} %.", f"Poses: {targets}."]
     if outcome.problem.base_grid is not None:  # the cell was given in the frame of the base's box
