@@ -10,10 +10,11 @@ same world as every other design.
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
 bounds is skipped (sound: no chain could reach it from there), and poses are searched closest
-cell first (the farthest point of the cell nearest), each completely, until `top` designs are
-found: the poses after that are not searched (first fit, not the best pose of the grid; ranking.json
-"bases" says how many poses were searched, skipped by reach, left). So 25 poses cost what the
-poses without `top` designs cost, plus one.
+cell first (the farthest point of the cell nearest), each completely, until `top` (pose, chain)
+designs are found: the poses after that are not searched (first fit, not the best pose of the grid;
+ranking.json "bases" says how many poses were searched and skipped by reach). So 25 poses cost
+what the poses searched before `top` designs cost, plus one; the ranking keeps one entry per
+chain (its best pose), so it may hold fewer than `top` designs.
 """
 from __future__ import annotations
 
@@ -117,12 +118,14 @@ def search(problem: Problem, max_units: int | None, top: int, longest: float,
     kept, pruned = poses(problem, longest)
     outs = []
     designs: list[Design] = []
+    found = 0  # (pose, chain) designs found
     for pose in kept:
         sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None})
         o = one(sub, max_units, top)
         outs.append(o)
+        found += len(o.designs)
         designs = _best_per_chain(designs + list(o.designs), problem.rank)
-        if o.stopped or len(designs) >= top:
+        if o.stopped or found >= top:
             break
     out = Outcome(problem, designs[:top])
     out.bases_searched, out.bases_pruned, out.bases_total = len(outs), pruned, len(kept) + pruned
