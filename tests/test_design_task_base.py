@@ -58,8 +58,8 @@ def test_base_poses_beyond_reach_are_skipped_soundly_and_nearest_first():
 
     p = problem()
     longest = run.longest_reach(p, 3)
-    kept, pruned = placement.poses(p, longest)
-    assert pruned == 1 and [k.xyz[0] for k in kept] == pytest.approx([0.2, 0.1, 0.0, -0.1])
+    kept, pruned, touching = placement.poses(p, longest)
+    assert pruned == 1 and touching == 0 and [k.xyz[0] for k in kept] == pytest.approx([0.2, 0.1, 0.0, -0.1])
     # a pose is skipped only when a target is farther than the longest arm's reach bound from it
     far = p.base_grid.poses()[0]
     assert far.xyz[0] == pytest.approx(-0.2)
@@ -82,7 +82,20 @@ def test_poses_after_the_top_designs_are_not_searched(monkeypatch):
     o = run.design(problem(wide), top=1)
     assert len(o.designs) == 1 and o.bases_searched == len(calls) == 1
     assert calls[0] == placement.poses(problem(wide), run.longest_reach(problem(wide), 3))[0][0].xyz
+    assert o.bases_touching == 0
     assert o.bases_total == 5 and o.designs[0].verified.robot.base.xyz == calls[0]
+
+
+def test_a_base_pose_inside_an_obstacle_is_skipped():
+    from modc.design import placement, run
+    from modc.model import Transform
+
+    text = SHIFTED.replace("    units 3\n", "    box block size (0.2, 0.2, 0.2) m at (0.2, 0, 0.05) m\n    units 3\n")
+    p = problem(text)
+    assert placement.base_blocked(p, Transform(xyz=(0.2, 0.0, 0.0)))
+    assert not placement.base_blocked(p, Transform(xyz=(-0.2, 0.0, 0.0)))
+    kept, _pruned, touching = placement.poses(p, run.longest_reach(p, 3))
+    assert touching == 2 and all(k.xyz[0] < 0.05 for k in kept)  # x = 0.1 and 0.2 sit in the block
 
 
 def test_no_base_pose_in_reach_is_no_design_with_the_reason():

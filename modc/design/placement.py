@@ -9,7 +9,8 @@ states its `base at …` and holds the same cell around it, so it compiles, plan
 same world as every other design.
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
-bounds is skipped (sound: no chain could reach it from there), and poses are searched closest
+bounds is skipped (sound: no chain could reach it from there), so is one where base_link sinks
+into the cell whatever the first unit (sound: the exact check would reject every design), and poses are searched closest
 cell first (the farthest point of the cell nearest), each completely, until `top` (pose, chain)
 designs are found: the poses after that are not searched (first fit, not the best pose of the grid;
 ranking.json "bases" says how many poses were searched and skipped by reach). So 25 poses cost
@@ -94,20 +95,48 @@ def gap(cell: Robot, pose: Transform, longest: float) -> float:
                 for t in points(cell)), default=-1.0)
 
 
-def poses(problem: Problem, longest: float) -> tuple[list[Transform], int]:
-    """The grid's poses worth a search, closest cell first, and how many the reach bound ruled out."""
+def base_blocked(problem: Problem, pose: Transform) -> bool:
+    """Does base_link, at pose, sink into the cell whatever the first unit (every allowed variant
+    and type)? The exact check rejects every design there ("base_link touches the cell"), so
+    the pose is not worth a search (sound)."""
+    from ..model import UnitSpec
+    from ..plan.collision import CollisionChecker
+    from . import space
+
+    lib = problem.cell.library
+    assert lib is not None
+    if not problem.cell.obstacles:
+        return False
+    cell = cell_at(problem.cell, pose)
+    for v in lib.variants:
+        for k in lib.units:
+            if not space.allowed(problem, v, k):
+                continue
+            robot = cell.model_copy(update={"units": (UnitSpec(name=f"{v}{k}", variant=v, kind=k),)})
+            if not CollisionChecker(robot).static_contacts():
+                return False
+    return True
+
+
+def poses(problem: Problem, longest: float) -> tuple[list[Transform], int, int]:
+    """The grid's poses worth a search, closest cell first, how many the reach bound ruled out
+    and how many base_link's contact with the cell did."""
     grid = problem.base_grid
     assert grid is not None
     cell = problem.cell
     kept = []
+    touching = 0
     for i, pose in enumerate(grid.poses()):
         if gap(cell, pose, longest) > 0:
+            continue
+        if base_blocked(problem, pose):
+            touching += 1
             continue
         p = np.asarray(pose.xyz, float)
         far = max((float(np.linalg.norm(np.asarray(t.xyz, float) - p)) for t in points(cell)), default=0.0)
         kept.append((round(far, 9), i, pose))
     kept.sort(key=lambda e: e[:2])
-    return [k[2] for k in kept], len(grid.poses()) - len(kept)
+    return [k[2] for k in kept], len(grid.poses()) - len(kept) - touching, touching
 
 
 def search(problem: Problem, max_units: int | None, top: int, longest: float,
@@ -115,7 +144,7 @@ def search(problem: Problem, max_units: int | None, top: int, longest: float,
     """The merged outcome of one(sub_problem, max_units, top) over the kept base poses."""
     from .run import Outcome
 
-    kept, pruned = poses(problem, longest)
+    kept, pruned, touching = poses(problem, longest)
     outs = []
     designs: list[Design] = []
     found = 0  # (pose, chain) designs found
@@ -128,7 +157,8 @@ def search(problem: Problem, max_units: int | None, top: int, longest: float,
         if o.stopped or found >= top:
             break
     out = Outcome(problem, designs[:top])
-    out.bases_searched, out.bases_pruned, out.bases_total = len(outs), pruned, len(kept) + pruned
+    out.bases_searched, out.bases_pruned, out.bases_total = len(outs), pruned, len(kept) + pruned + touching
+    out.bases_touching = touching
     names = [t.name for t in problem.cell.targets]
     out.closest = {t: min((o.closest.get(t, math.inf) for o in outs), default=math.inf) for t in names}
     if not outs:  # every pose ruled out by reach: how far the nearest pose leaves the cell

@@ -60,6 +60,7 @@ class Outcome:
     bases_searched: int | None = None  # `base within`: base poses searched (None: the base as written)
     bases_pruned: int = 0  # base poses ruled out by the reach bound
     bases_total: int = 0  # base poses of the grid
+    bases_touching: int = 0  # base poses where base_link sinks into the cell
 
     def why_none(self) -> str:
         return why_none(self)

@@ -76,7 +76,8 @@ def ranking(outcomes: list[Outcome]) -> dict:
     def shapes(o: Outcome, labels: list[str]) -> list[str]:
         return [f"{o.problem.name}/{s}" if prefix else s for s in labels]
 
-    bases = {o.problem.name: {"poses": o.bases_total, "searched": o.bases_searched, "pruned_by_reach": o.bases_pruned}
+    bases = {o.problem.name: {"poses": o.bases_total, "searched": o.bases_searched, "pruned_by_reach": o.bases_pruned,
+                              "pruned_by_contact": o.bases_touching}
              for o in outcomes if o.bases_searched is not None}
     return {"designs": designs, **({"bases": bases} if bases else {}), "evaluated": sum(o.evaluated for o in outcomes),
             "excluded_by_bounds": sum(o.excluded for o in outcomes),
