@@ -26,7 +26,8 @@ design farm_cell {
     # x axis) pointing down within 5 deg; the turn about that axis is free. (A 3-joint arm points
     # its tool straight down only on a surface of revolution: a row across the arm's reach lies on
     # it, a second row 3 cm further out no longer does, so the tray is served row by row.)
-    region tray box size (0.10, 0, 0) m at (0, -0.31, -0.05) m grid 3 x 1 x 1 pointing (0, 0, -1) within 5 mm, 5 deg
+    region tray box size (0.10, 0, 0) m at (0, -0.31, -0.05) m grid 3 x 1 x 1  # 5 cm apart
+            pointing (0, 0, -1) within 5 mm, 5 deg
 
     task serve { visit plant, tray, plant }
     units 3
