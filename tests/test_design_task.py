@@ -1,6 +1,6 @@
 """`modc design` with tasks: the cell's tasks planned and timed for the designs the static search
 returns, `rank … cycle_time` / `energy`, the trajectory and task keys written, and the design
-statements not searched yet (`base within`, `rank coverage`) refused with a diagnostic."""
+statement not searched yet (`base within … yaw` with a region) refused with a diagnostic."""
 from __future__ import annotations
 
 import json
@@ -93,7 +93,7 @@ def test_modc_design_writes_the_timed_task(tmp_path):
     d = ranking["designs"][0]
     assert d["traj"] == "small_1.traj.json" and d["traj_task"] == "serve" and d["coverage"] == 1.0
     assert d["cycle_time_s"] > 0 and d["energy_j"] >= 0
-    assert d["base"] == {"xyz": [0.0, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}
+    assert d["base"] == {"xyz_m": [0.0, 0.0, 0.0], "rpy_deg": [0.0, 0.0, 0.0]}
     assert d["cycle_time_s"] == pytest.approx(sum(t["cycle_time_s"] for t in d["tasks"]), abs=1e-5)
     traj, errors = trajectory.load(out / d["traj"])
     assert traj is not None and not errors
@@ -115,8 +115,9 @@ def test_modc_design_writes_the_timed_task(tmp_path):
 
 
 @pytest.mark.parametrize("statement, what", [
-    ("base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 50 mm", "`base within`"),
-    ("rank coverage", "`rank coverage`"),
+    ("region r box size (0.1, 0, 0) m at (0.3, 0, 0.2) m grid 2 x 1 x 1\n"
+     "    base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 50 mm yaw 0 to 90 deg step 90 deg",
+     "`base within … yaw` with a region"),
 ])
 def test_statements_not_searched_yet_are_refused(tmp_path, statement, what):
     text = TASKED.replace("    rank modules, cycle_time\n", f"    {statement}\n")
@@ -124,6 +125,6 @@ def test_statements_not_searched_yet_are_refused(tmp_path, statement, what):
     assert r.returncode == 1
     assert "Traceback" not in r.stderr
     assert f"error[design-unsupported]: {what} is parsed but not searched yet by modc design" in r.stderr
-    line = text.splitlines().index(f"    {statement}") + 1
+    line = text.splitlines().index(f"    {statement.splitlines()[-1].strip()}") + 1
     assert f"cell.mod:{line}:" in r.stderr
     assert not (tmp_path / "out").exists()

@@ -704,7 +704,7 @@ def test_keyword_classes_are_read_from_the_grammar():
     )
     assert language.statements("dh") == ("row",)
     assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links", "within", "to", "step",
-                                          "grid", "x", "visit", "from", "straight", "yaw", "with"}
+                                          "grid", "x", "visit", "from", "straight", "yaw", "with", "pointing"}
     assert language.statements("design") == (
         "library", "base", "tool", "payload", "box", "sphere", "cylinder", "target", "allow", "region", "task", "path",
         "units", "modules", "links", "rank", "compare",

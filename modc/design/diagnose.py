@@ -124,6 +124,13 @@ def _finite(x: float) -> float | None:
 
 def why_none(o) -> str:
     head = f"the search stopped ({o.stopped}) before finding one; " if o.stopped else ""
+    if o.bases_searched == 0 and o.bases_touching:
+        return head + (f"of the {o.bases_total} base poses, {o.bases_touching} put base_link into the cell and "
+                       f"{o.bases_pruned} leave some target beyond the reach of the longest arm in the bounds")
+    if o.bases_searched == 0:
+        far = max(o.closest.values(), default=0.0)
+        return head + (f"from every one of the {o.bases_pruned} base poses some target lies beyond the reach of "
+                       f"the longest arm in the bounds (by {_length(far)} at least)")
     bad = [(n, t) for n, t in o.targets.items() if not t["reached_alone"]]
     if bad:
         return head + "; ".join(f"target '{n}': {t['detail']}" + (f" ({t['ruled_out_by']})"

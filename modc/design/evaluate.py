@@ -68,8 +68,7 @@ class Screened:
 
 
 def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
-    k = slice(t, t + 1)
-    return reach.Targets(tg.xyz[k], tg.R[k], tg.oriented[k], tg.tol_p[k], tg.tol_r[k], tg.names[k])
+    return tg.take(slice(t, t + 1))
 
 
 def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray, seed: int,
@@ -205,9 +204,12 @@ def verify(problem: Problem, cand: Candidate) -> Verified | str:
         T = chain.T_base_tool(np.asarray(q))
         perr = float(np.linalg.norm(T[:3, 3] - np.asarray(target.xyz)))
         oerr = None
-        if target.rpy is not None:
-            E = rpy_matrix(target.rpy) @ T[:3, :3].T
-            oerr = float(np.degrees(np.arccos(np.clip((np.trace(E) - 1) / 2, -1.0, 1.0))))
+        if target.rpy is not None or target.pointing is not None:
+            if target.rpy is not None:
+                E = rpy_matrix(target.rpy) @ T[:3, :3].T
+                oerr = float(np.degrees(np.arccos(np.clip((np.trace(E) - 1) / 2, -1.0, 1.0))))
+            else:  # only tool0's x axis (the approach) is constrained
+                oerr = float(np.degrees(np.arccos(np.clip(T[:3, 0] @ np.asarray(target.pointing), -1.0, 1.0))))
             if oerr > np.degrees(target.orientation_tolerance) + 1e-9:
                 return f"target '{target.name}' orientation off by {oerr:.2g}°"
         if perr > target.position_tolerance + 1e-12:

@@ -20,6 +20,7 @@ class Design:
     verified: Verified
     alternatives: tuple[Design, ...] = ()  # the same arm with other H/L variants, best first
     plans: tuple[Any, ...] = ()  # modc.plan.task.TaskPlan per task and path of the cell, once planned
+    coverage: float = 1.0  # share of the cell's region points reached (modc.design.coverage)
 
     @property
     def cycle_time(self) -> float:
@@ -70,8 +71,9 @@ OBJECTIVES: dict[str, Callable[[Any], float]] = {
     "margin": lambda d: 0.0 if d.margin is None else -round(d.margin, 9),
     "cycle_time": lambda d: round(d.cycle_time, 9),
     "energy": lambda d: round(d.energy, 9),
+    "coverage": lambda d: -round(getattr(d, "coverage", 1.0), 9),  # larger first; the static search: all
 }
-TASK = frozenset({"cycle_time", "energy"})  # known only once the design's tasks are planned
+TASK = frozenset({"cycle_time", "energy", "coverage"})  # known only once the design's tasks are planned
 
 
 def key(objectives: tuple[str, ...], d: Design | Screened) -> tuple:

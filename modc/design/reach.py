@@ -8,7 +8,7 @@ chosen joint vectors are then checked exactly by modc.design.evaluate.verify.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -28,6 +28,9 @@ class Targets:
     tol_p: np.ndarray  # (T,) m
     tol_r: np.ndarray  # (T,) rad
     names: tuple[str, ...]
+    # (T, 3) unit vectors, (T,) bool: targets that constrain only tool0's x axis (`pointing`; oriented too)
+    axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    pointed: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
 
     @classmethod
     def of(cls, targets) -> Targets:
@@ -35,10 +38,34 @@ class Targets:
 
         return cls(np.array([t.xyz for t in targets], float).reshape(-1, 3),
                    np.array([rpy_matrix(t.rpy or (0.0, 0.0, 0.0)) for t in targets]).reshape(-1, 3, 3),
-                   np.array([t.rpy is not None for t in targets], bool),
+                   np.array([t.rpy is not None or _axis(t) is not None for t in targets], bool),
                    np.array([t.position_tolerance for t in targets], float),
                    np.array([t.orientation_tolerance for t in targets], float),
-                   tuple(t.name for t in targets))
+                   tuple(t.name for t in targets),
+                   np.array([_axis(t) or (1.0, 0.0, 0.0) for t in targets], float).reshape(-1, 3),
+                   np.array([_axis(t) is not None for t in targets], bool))
+
+    def take(self, k) -> Targets:
+        """The targets k (a slice or an index array)."""
+        return Targets(self.xyz[k], self.R[k], self.oriented[k], self.tol_p[k], self.tol_r[k],
+                       tuple(np.asarray(self.names, object)[k]), self.axis[k], self.pointed[k])
+
+
+def _axis(t):
+    return getattr(t, "pointing", None) if t.rpy is None else None
+
+
+def axis_error(x, d):
+    """Rotation vectors (3, B) of the shortest turn taking tool0's x axis x (3, B) onto d (3, B):
+    the orientation error of a `pointing` target (angle = its norm; no part about the axis)."""
+    v = np.cross(x, d, axis=0)
+    s = np.sqrt((v ** 2).sum(0))
+    angle = np.arctan2(s, (x * d).sum(0))
+    # opposite axes: any perpendicular turn (the cross product vanishes; take one off x)
+    alt = np.cross(x, np.where(np.abs(x[0:1]) < 0.9, np.array([[1.0], [0.0], [0.0]]), np.array([[0.0], [1.0], [0.0]])),
+                   axis=0)
+    v = np.where(s > 1e-12, v, alt)
+    return v * (angle / np.maximum(np.sqrt((v ** 2).sum(0)), 1e-300))
 
 
 def seeds(n: int, count: int, lower, upper, seed: int) -> np.ndarray:
@@ -65,20 +92,37 @@ class _Runs:
         self.R = np.ascontiguousarray(np.moveaxis(tg.R[ti], 0, -1))
         self.oriented = tg.oriented[ti].astype(float)
         self.any_oriented = bool(tg.oriented[ti].any())
+        pointed = tg.pointed if tg.pointed.size else np.zeros(len(tg.names), bool)
+        axis = tg.axis if tg.axis.size else np.zeros((len(tg.names), 3))
+        self.pointed = pointed[ti]
+        self.axis = np.ascontiguousarray(axis[ti].T)
+        self.any_pointed = bool(self.pointed.any())
 
     def take(self, keep):
         out = object.__new__(_Runs)
         out.xyz, out.R, out.oriented = self.xyz[:, keep], self.R[..., keep], self.oriented[keep]
-        out.any_oriented = self.any_oriented
+        out.pointed, out.axis = self.pointed[keep], self.axis[:, keep]
+        out.any_oriented, out.any_pointed = self.any_oriented, self.any_pointed
         return out
 
     def residual(self, R_tool, t_tool):
         e_p = self.xyz - t_tool
         if self.any_oriented:
             e_r = _rotation_error(self.R, R_tool) * self.oriented
+            if self.any_pointed:
+                e_r = np.where(self.pointed, axis_error(R_tool[:, 0], self.axis), e_r)
         else:
             e_r = np.zeros_like(e_p)
         return e_p, e_r
+
+    def rotation_rows(self, z, R_tool):
+        """The rotation rows of J (n, 3, b): the joint axes z; for a `pointing` run without their
+        part about tool0's x axis (turning about it changes nothing the target asks for)."""
+        Jr = z * self.oriented
+        if self.any_pointed:
+            x = R_tool[:, 0]
+            Jr = np.where(self.pointed, Jr - x[None] * (Jr * x[None]).sum(1, keepdims=True), Jr)
+        return Jr
 
 
 def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
@@ -106,6 +150,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     give_up = np.asarray(tg.tol_p, float)[t_idx] * STALL_FACTOR
     ref = np.full(B, np.inf)
     p, z, R_tool, t_tool = forward_flat(f, q)
+    R_tool = np.array(R_tool)  # kept per run (the `pointing` rows of J need tool0's x axis)
     e_p, e_r = runs.residual(R_tool, t_tool)
     cost = (e_p ** 2).sum(0) + w * w * (e_r ** 2).sum(0)
     lam = np.full(B, LAMBDA0)
@@ -122,6 +167,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
             live, q, f, runs = live[active], q[:, active], f.take(active), runs.take(active)
             tol_p, tol_r, give_up, ref = tol_p[active], tol_r[active], give_up[active], ref[active]
             p, z, t_tool, e_p, e_r = p[..., active], z[..., active], t_tool[:, active], e_p[:, active], e_r[:, active]
+            R_tool = R_tool[..., active]
             cost, lam = cost[active], lam[active]
             active = active[active]
             if live.size == 0:
@@ -130,7 +176,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
             break
         # J columns: position z_i x (p_tool - p_i), rotation z_i (weighted, oriented targets only)
         Jp = np.cross(z, t_tool[None] - p, axis=1)  # (n, 3, b)
-        J = np.concatenate([Jp, z * (w * runs.oriented)], axis=1)  # (n, 6, b)
+        J = np.concatenate([Jp, w * runs.rotation_rows(z, R_tool)], axis=1)  # (n, 6, b)
         e = np.concatenate([e_p, w * e_r], axis=0)  # (6, b)
         A = np.einsum("ikb,jkb->bij", J, J)
         A[:, np.arange(n), np.arange(n)] += lam[:, None]
@@ -142,6 +188,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
         cost_n = (e_pn ** 2).sum(0) + w * w * (e_rn ** 2).sum(0)
         ok = (cost_n < cost) & active
         q[:, ok], p[..., ok], z[..., ok], t_tool[:, ok] = qn[:, ok], pn[..., ok], zn[..., ok], tn[:, ok]
+        R_tool[..., ok] = Rn[..., ok]
         e_p[:, ok], e_r[:, ok], cost[ok] = e_pn[:, ok], e_rn[:, ok], cost_n[ok]
         lam = np.where(ok, np.maximum(lam / 3.0, 1e-9), lam * 4.0)
     return q_all.T.reshape(C, T, S, n), ep_all.reshape(C, T, S), er_all.reshape(C, T, S)

@@ -59,6 +59,10 @@ class Outcome:
     coarse: list[str] = field(default_factory=list)  # shapes searched on a coarse grid
     targets: dict[str, dict] = field(default_factory=dict)  # per target: hit, clear, closest, excluded_by
     reference: Any = None  # modc.design.reference.Reference: the block's `compare with` arm, evaluated
+    bases_searched: int | None = None  # `base within`: base poses searched (None: the base as written)
+    bases_pruned: int = 0  # base poses ruled out by the reach bound
+    bases_total: int = 0  # base poses of the grid
+    bases_touching: int = 0  # base poses where base_link sinks into the cell
 
     def why_none(self) -> str:
         return why_none(self)
@@ -177,20 +181,43 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
 
     A cell with tasks or paths: the static search (ranked by the objectives it knows) returns
     its best designs, more of them when a task objective ranks (tasks.candidates); each is then
-    planned and timed (tasks.plan_all) and the survivors ranked by every objective."""
-    from . import reference, tasks
+    planned and timed (tasks.plan_all) and the survivors ranked by every objective. With
+    `base within`, the static search runs per base pose (modc.design.placement)."""
+    from . import placement, reference, tasks
 
-    if not tasks.has_tasks(problem):
-        out = _search(problem, max_units, top, seed, executor, progress, deadline)
+    t0 = time.perf_counter()
+    tasked = tasks.has_tasks(problem) or "coverage" in problem.rank
+    screen, points = tasks.with_points(problem)  # every region point required: screened as a target
+    screen = screen.model_copy(update={"rank": static(problem.rank)}) if tasked else screen
+    n = tasks.candidates(problem, top) if tasked else top
+
+    def one(p: Problem, units: int | None, k: int) -> Outcome:
+        return _search(p, units, k, seed, executor, progress, deadline)
+
+    if problem.base_grid is None:
+        out = one(screen, max_units, n)
     else:
-        t0 = time.perf_counter()
-        screen = problem.model_copy(update={"rank": static(problem.rank)})
-        out = _search(screen, max_units, tasks.candidates(problem, top), seed, executor, progress, deadline)
-        out.problem = problem
+        lib = problem.cell.library
+        assert lib is not None
+        hi = min(max_units or problem.max_units, lib.rules.max_dof)
+        out = placement.search(screen, max_units, n, longest_reach(problem, hi), one)
+    out.problem = problem
+    tasks.restore(out, points)
+    if tasked:
         tasks.plan_all(out, top, seed, deadline, _stopping)
-        out.seconds = time.perf_counter() - t0
     out.reference = reference.evaluate(problem, seed)
+    out.seconds = time.perf_counter() - t0
     return out
+
+
+def longest_reach(problem: Problem, hi: int) -> float:
+    """m: the reach bound of the longest arm of at most hi units in the bounds (0 if none)."""
+    lib = problem.cell.library
+    assert lib is not None
+    return max((reach_bound([lib.units[k] for k in s.kinds], [x or lib.units[k].x23 for k, x in
+                            zip(s.kinds, s.links, strict=True)], problem.cell.tool.xyz)
+                for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
+                for s in _longest(problem, n)), default=0.0)
 
 
 def _search(problem: Problem, max_units: int | None, top: int, seed: int, executor: Executor | None,
@@ -213,10 +240,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     hit = dict.fromkeys(names, False)
     clear = dict.fromkeys(names, False)
     tg = spec.targets
-    longest = max((reach_bound([lib.units[k] for k in s.kinds], [x or lib.units[k].x23 for k, x in
-                                zip(s.kinds, s.links, strict=True)], problem.cell.tool.xyz)
-                   for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
-                   for s in _longest(problem, n)), default=0.0)
+    longest = longest_reach(problem, hi)
     starts = np.array([(u.x01, 0.0, u.z01) for u in lib.units.values()], float)
     blocked, walls = bounds_blocked(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(problem.cell.tool.xyz)),
                                     float(spec.radii.min()), longest, starts)

@@ -27,12 +27,66 @@ def task_names(robot) -> list[str]:
     return [t.name for t in (*robot.tasks, *robot.paths)]
 
 
-def plan_design(d: Design, seed: int, deadline: float | None) -> Design | str:
-    """d with its plans, or why one of its tasks cannot be planned."""
+def with_points(problem):
+    """The problem whose cell also holds every region point as a target when every point is
+    required (no `rank coverage`), so that the static search screens them; and the names given
+    to them (a point's own name, `tray[1,0,0]`, is no identifier), new name -> point name."""
+    cell = problem.cell
+    if "coverage" in problem.rank or not cell.regions:
+        return problem, {}
+    taken = {t.name for t in cell.targets} | {r.name for r in cell.regions} | set(task_names(cell))
+    names: dict[str, str] = {}
+    extra = []
+    for r in cell.regions:
+        for ix in r.indices():
+            stem = f"{r.name}_{ix[0]}_{ix[1]}_{ix[2]}"[:60]
+            name, k = stem, 2
+            while name in taken:
+                name, k = f"{stem}_{k}", k + 1
+            taken.add(name)
+            names[name] = r.point_name(ix)
+            extra.append(r.point(ix).model_copy(update={"name": name}))
+    return problem.model_copy(update={"cell": cell.model_copy(update={"targets": cell.targets + tuple(extra)})}), names
+
+
+def restore(out, names: dict[str, str]) -> None:
+    """The outcome of a search on with_points' problem, told in the cell's names: each design's
+    robot without the region points as targets (its regions hold them), its figures under the
+    points' names."""
+    from .evaluate import pose_name
+
+    if not names:
+        return
+    drop = set(names) | {pose_name(n) for n in names}
+    designs = []
+    for d in out.designs:
+        v = d.verified
+        robot = v.robot.model_copy(update={"targets": tuple(t for t in v.robot.targets if t.name not in drop),
+                                           "poses": tuple(p for p in v.robot.poses if p.name not in drop)})
+        targets = {names.get(k, k): x for k, x in v.targets.items()}
+        designs.append(replace(d, verified=replace(v, robot=robot, targets=targets)))
+    out.designs = designs
+    out.closest = {names.get(k, k): x for k, x in out.closest.items()}
+    out.targets = {names.get(k, k): x for k, x in out.targets.items()}
+
+
+def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = False) -> Design | str:
+    """d with its plans, or why one of its tasks cannot be planned. With `coverage`, the region
+    points it does not reach are dropped from its tasks and its coverage recorded."""
     from ..plan.errors import PlanError
     from ..plan.task import plan_task_robot
+    from . import coverage as cov
 
     robot = d.verified.robot
+    if coverage and robot.regions:
+        points, total = cov.reached(robot, seed)
+        if not points:
+            return "reaches no point of the cell's regions"
+        missing = cov.missing_ends(robot, points)
+        if missing:
+            return f"a straight path ends at region point {missing[0]}, which it does not reach"
+        robot = cov.served(robot, points)
+        d = replace(d, coverage=len(points) / total, verified=replace(d.verified, robot=robot))
     plans = []
     for name in task_names(robot):
         left = None if deadline is None else max(deadline - time.time(), 1.0)
@@ -52,7 +106,7 @@ def plan_all(out, top: int, seed: int, deadline: float | None, stopping) -> None
         if why:
             out.stopped = out.stopped or why
             break
-        p = plan_design(d, seed, deadline)
+        p = plan_design(d, seed, deadline, "coverage" in out.problem.rank)
         if isinstance(p, str):
             out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {p}")
             continue

@@ -24,16 +24,25 @@ def task_figures(o: Outcome, rank: int, d: Design) -> dict:
     """ranking.json's task keys of a planned design: cycle time and energy summed over the
     cell's tasks and paths, the figures per task, and which task the .traj.json holds."""
     if not d.plans:
-        return {}
-    base = d.verified.robot.base  # the base as written (`base within` is not searched yet)
-    return {"base": {"xyz": [round(v, 9) for v in base.xyz], "rpy": [round(v, 9) for v in base.rpy]},
+        return {**base_figures(o, d), **({"coverage": round(d.coverage, 6)} if "coverage" in o.problem.rank else {})}
+    return {**base_figures(o, d, always=True),
             "cycle_time_s": round(d.cycle_time, 6), "energy_j": round(d.energy, 6),
             "peak_torque_share": round(max(p.peak_share for p in d.plans), 6),
-            "coverage": 1.0,  # every task planned: every point of every task reached
+            "coverage": round(d.coverage, 6),  # share of the region points reached (1 unless `rank coverage`)
             "tasks": [{"task": p.task, "kind": p.kind, "cycle_time_s": round(p.cycle_time, 6),
                        "energy_j": round(p.energy, 6), "peak_torque_share": round(p.peak_share, 6),
                        "segments": [s.to_json() for s in p.segments]} for p in d.plans],
             "traj": traj_name(o.problem.name, rank), "traj_task": d.plans[0].task}
+
+
+def base_figures(o: Outcome, d: Design, always: bool = False) -> dict:
+    """ranking.json's "base" (`base within`, or a cell with tasks): where the design's base_link
+    stands in the cell frame, m and deg (the `base at` of its robot file)."""
+    if not always and o.problem.base_grid is None:
+        return {}
+    base = d.verified.robot.base
+    return {"base": {"xyz_m": [round(v, 9) + 0.0 for v in base.xyz],
+                     "rpy_deg": [round(math.degrees(v), 6) + 0.0 for v in base.rpy]}}
 
 
 def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
@@ -41,9 +50,13 @@ def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
 
     name = f"{outcome.problem.name}_{rank}"
     robot = d.verified.robot.model_copy(update={"name": name})
-    targets = ", ".join(f"{pose_name(t)} reaches {t}" for t in d.verified.targets)
+    # (region points are screened with poses of their own, which the robot file does not keep)
+    targets = ", ".join(f"{pose_name(t)} reaches {t}" for t in d.verified.targets if robot.pose(pose_name(t)))
     comments = [f"Design {rank} of `modc design` for '{outcome.problem.name}': {d.modules} modules, "
                 f"{d.mass:.3f} kg, torque margin {d.margin * 100:.0f} %.", f"Poses: {targets}."]
+    if outcome.problem.base_grid is not None:  # the cell was given in the frame of the base's box
+        comments.append("The base pose was searched (`base within`): the cell below is in base_link, "
+                        "the frame of `base at`.")
     return robot_file_text(robot, comments)
 
 
@@ -66,7 +79,10 @@ def ranking(outcomes: list[Outcome]) -> dict:
     def shapes(o: Outcome, labels: list[str]) -> list[str]:
         return [f"{o.problem.name}/{s}" if prefix else s for s in labels]
 
-    return {"designs": designs, "evaluated": sum(o.evaluated for o in outcomes),
+    bases = {o.problem.name: {"poses": o.bases_total, "searched": o.bases_searched, "pruned_by_reach": o.bases_pruned,
+                              "pruned_by_contact": o.bases_touching}
+             for o in outcomes if o.bases_searched is not None}
+    return {"designs": designs, **({"bases": bases} if bases else {}), "evaluated": sum(o.evaluated for o in outcomes),
             "excluded_by_bounds": sum(o.excluded for o in outcomes),
             "seconds": round(sum(o.seconds for o in outcomes), 3),
             "complete": all(o.complete for o in outcomes),

@@ -55,6 +55,7 @@ QUANTITY_KINDS = {
     "to": "a length",  # `links 150 mm to 300 mm` (`units 1 to 3` takes plain numbers)
     "step": "a length",
     "yaw": "an angle",  # `base within … yaw 0 to 90 deg step 45 deg`
+    "pointing": "a direction",  # `pointing (0, 0, -1)`: no unit
 }
 # Name-taking statements whose name refers to something (a joint) rather than declaring one.
 REFERS = frozenset({"limit", "rank"})  # rank names objectives, not things it declares
@@ -140,6 +141,7 @@ MEASURES = {
 }
 assert set(MEASURES) == set(quantities.ALL)
 KIND_MEASURES = {kind: list(table) for kind, table in quantities.KINDS.items()}
+KIND_MEASURES["a direction"] = []  # a `pointing` vector takes no unit
 
 
 def keyword_doc(keyword: str) -> str:

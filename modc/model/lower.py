@@ -157,9 +157,13 @@ class _Lowerer:
                                                          value=f"{q.value:g} {q.unit}"))
                 elif value is not None:
                     tol[key] = value
-        if not self.name(st.name, "target") or xyz is None or (st.rpy is not None and rpy is None):
+        from .lower_task import direction
+
+        pointing = direction(self, st.pointing, f"approach of {what}")
+        if not self.name(st.name, "target") or xyz is None or (st.rpy is not None and rpy is None) or \
+                (st.pointing is not None and pointing is None):
             return None
-        return Target(name=st.name.text, xyz=xyz, rpy=rpy, span=st.span, **tol)
+        return Target(name=st.name.text, xyz=xyz, rpy=rpy, pointing=pointing, span=st.span, **tol)
 
     def cell_statement(self, st, block: str, fields: dict, seen: dict, acc: dict) -> None:
         """Statements robots and design blocks share (library, placements, payload, poses,
@@ -293,10 +297,7 @@ class _Lowerer:
         elif acc["base_within"]:
             from .lower_task import base_grid
 
-            bounds["base_grid"] = base_grid(self, acc["base_within"][0])
-            if bounds["base_grid"] is not None:  # (one with errors is reported for them)
-                self.error(codes.DESIGN_UNSUPPORTED.at(acc["base_within"][0].span, what="`base within`",
-                                                       name=_say(d.name)))
+            bounds["base_grid"] = base_grid(self, acc["base_within"][0], acc["regions"], _say(d.name))
         if not (named and acc["named"]):
             return None
         cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)

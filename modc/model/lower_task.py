@@ -41,6 +41,8 @@ def region(low, st: ast.Region) -> Region | None:
     at = low.vec3(st.at, "a length", f"position of {what}")
     rpy = low.vec3(st.rpy, "an angle", f"orientation of {what}") if st.rpy is not None else None
     tol = _tolerances(low, st.within, what)
+    pointing = direction(low, st.pointing, f"approach of {what}")
+    ok = st.pointing is None or pointing is not None
     grid: list[int] = []
     for axis, q in zip("xyz", st.grid, strict=True):
         if q.value != int(q.value) or q.value < 1:
@@ -49,7 +51,7 @@ def region(low, st: ast.Region) -> Region | None:
                                            hint="write e.g. `grid 3 x 2 x 1`"))
         else:
             grid.append(int(q.value))
-    ok = len(grid) == 3
+    ok = ok and len(grid) == 3
     if ok and math.prod(grid) > MAX_REGION_POINTS:
         low.error(codes.REGION_GRID.at(st.span, what=f"{what} has {math.prod(grid):,} points, more than "
                                                      f"{MAX_REGION_POINTS:,}",
@@ -67,11 +69,31 @@ def region(low, st: ast.Region) -> Region | None:
                 ok = False
     if not low.name(st.name, "region") or not ok or size is None or at is None or (st.rpy is not None and rpy is None):
         return None
-    return Region(name=st.name.text, size=size, center=at, grid=(grid[0], grid[1], grid[2]), rpy=rpy, span=st.span,
-                  **tol)
+    return Region(name=st.name.text, size=size, center=at, grid=(grid[0], grid[1], grid[2]), rpy=rpy,
+                  pointing=pointing, span=st.span, **tol)
 
 
-def base_grid(low, st: ast.BaseWithin) -> BaseGrid | None:
+def direction(low, v: ast.Vector | None, what: str) -> tuple[float, float, float] | None:
+    """`pointing (0, 0, -1)`: a direction, no unit, any non-zero length (normalised)."""
+    if v is None:
+        return None
+    if v.unit is not None:
+        low.error(codes.WRONG_UNIT.at(v.span, what=what, kind="a direction without a unit", unit=v.unit,
+                                      allowed="none (write e.g. `pointing (0, 0, -1)`)"))
+        return None
+    if len(v.values) != 3:
+        low.error(codes.VECTOR_ARITY.at(v.span, what=what, expected=3, got=len(v.values), example="(0, 0, -1)"))
+        return None
+    n = math.sqrt(sum(x * x for x in v.values))
+    if not math.isfinite(n) or n < 1e-9:
+        low.error(codes.NONPOSITIVE_SIZE.at(v.span, what=f"the length of the {what}", value="0"))
+        return None
+    return (v.values[0] / n, v.values[1] / n, v.values[2] / n)
+
+
+def base_grid(low, st: ast.BaseWithin, regions=(), block: str = "") -> BaseGrid | None:
+    """The base grid; a yawed base with regions is refused (an axis-aligned region box would turn
+    with the base, which its statement cannot say in the emitted robot's base frame)."""
     size = low.vec3(st.size, "a length", "size of the base's box")
     at = low.vec3(st.at, "a length", "position of the base's box")
     step = low.quantity(st.step, "a length", "base step")
@@ -93,6 +115,9 @@ def base_grid(low, st: ast.BaseWithin) -> BaseGrid | None:
         low.error(codes.DESIGN_BOUND.at(st.span, what=f"{n:,} base poses are too many to search",
                                         hint=f"use a coarser step or a smaller box: at most {MAX_BASE_POSES:,} poses"))
         return None
+    if regions and any(abs(math.remainder(y, 2 * math.pi)) > 1e-12 for y in yaws):
+        low.error(codes.DESIGN_UNSUPPORTED.at(st.yaw.span if st.yaw is not None else st.span,
+                                              what="`base within … yaw` with a region", name=block))
     return grid
 
 

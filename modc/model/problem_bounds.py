@@ -91,8 +91,6 @@ def lower_bounds(low, statements: list, block: str) -> dict:
                         low.error(codes.UNKNOWN_OBJECTIVE.at(k.span, name=k.text, known=known))
                     elif k.text not in keys:
                         keys.append(k.text)
-                        if k.text == "coverage":  # every design reaches every point: nothing to rank yet
-                            low.error(codes.DESIGN_UNSUPPORTED.at(k.span, what="`rank coverage`", name=block))
                 # objectives not named keep their default order after the named ones
                 out["rank"] = tuple(keys) + tuple(k for k in RANK_KEYS if k not in keys)
     return out

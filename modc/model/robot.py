@@ -112,6 +112,7 @@ class Target(Value):
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
     span: Span = hidden(NOWHERE)
+    pointing: Vec3 | None = None  # unit vector in base_link: tool0's x axis (the approach) only; never with rpy
 
 
 MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; beyond this, a typo
@@ -130,6 +131,7 @@ class Region(Value):
     center: Vec3  # m, in base_link
     grid: tuple[int, int, int]
     rpy: Vec3 | None = None  # every point's tool0 orientation
+    pointing: Vec3 | None = None  # or every point's approach direction only (Target.pointing)
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
     span: Span = hidden(NOWHERE)
@@ -148,7 +150,7 @@ class Region(Value):
         for c, s, n, i in zip(self.center, self.size, self.grid, index, strict=True):
             xyz.append(c if n == 1 else c - s / 2 + s * i / (n - 1))
         return Target.model_construct(name=self.point_name(index), xyz=(xyz[0], xyz[1], xyz[2]), rpy=self.rpy,
-                                      position_tolerance=self.position_tolerance,
+                                      pointing=self.pointing, position_tolerance=self.position_tolerance,
                                       orientation_tolerance=self.orientation_tolerance, span=self.span)
 
     def points(self) -> list[Target]:

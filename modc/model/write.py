@@ -76,15 +76,20 @@ def _obstacle(o) -> str:
     return f"    cylinder {o.name} radius {_num(o.size[0])} m length {_num(o.size[1])} m {at}{rpy}"
 
 
+def _pointing(d) -> str:
+    return "" if d is None else " pointing (" + ", ".join(_num(v) for v in d) + ")"
+
+
 def target_text(t) -> str:
     from .robot import ORIENTATION_TOLERANCE, POSITION_TOLERANCE
 
     s = f"    target {t.name} at {vec([_num(v) for v in t.xyz], 'm')}"
     if t.rpy is not None:
         s += " rpy " + vec([_num(math.degrees(v)) for v in t.rpy], "deg")
+    s += _pointing(t.pointing)
     if t.position_tolerance != POSITION_TOLERANCE or t.orientation_tolerance != ORIENTATION_TOLERANCE:
         s += f" within {_num(t.position_tolerance * 1000, 6)} mm"
-        if t.rpy is not None:
+        if t.rpy is not None or t.pointing is not None:
             s += f", {_num(math.degrees(t.orientation_tolerance))} deg"
     return s
 
@@ -130,6 +135,7 @@ def task_lines(robot: Robot) -> list[str]:
              f"{vec([_num(v) for v in r.center], 'm')} grid {r.grid[0]} x {r.grid[1]} x {r.grid[2]}")
         if r.rpy is not None:
             s += " rpy " + vec([_num(math.degrees(v)) for v in r.rpy], "deg")
+        s += _pointing(r.pointing)
         if r.position_tolerance != POSITION_TOLERANCE or r.orientation_tolerance != ORIENTATION_TOLERANCE:
             s += f" within {_num(r.position_tolerance * 1000, 6)} mm, {_num(math.degrees(r.orientation_tolerance))} deg"
         lines.append(s)

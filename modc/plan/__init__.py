@@ -243,7 +243,8 @@ def _goals(job: _Job, checker, q_start):
 
     tgt = job.target
     rotation = None if tgt.rpy is None else rpy_matrix(tgt.rpy)
-    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper, rotation)
+    solver = ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper, rotation,
+                           tgt.pointing)
     verdict: dict[bytes, bool] = {}
 
     def free(q) -> bool:
@@ -260,7 +261,8 @@ def _goals(job: _Job, checker, q_start):
         job.seed,
         batches=IK_BATCHES,
         enough=free,
-        tolerance=(tgt.position_tolerance, tgt.orientation_tolerance if tgt.rpy is not None else np.inf),
+        tolerance=(tgt.position_tolerance,
+                   tgt.orientation_tolerance if tgt.rpy is not None or tgt.pointing is not None else np.inf),
     )
     if not solutions:  # say why: too far, too close, orientation or limits (advice.py)
         raise advice.unreachable(job, checker, solver, best, q_start)

@@ -62,13 +62,26 @@ def rotation_vector(R: np.ndarray) -> np.ndarray:
 class PositionIK:
     """IK of tool0 to a position, or (rotation given: a 3x3 matrix in base_link) to a full pose."""
 
-    def __init__(self, model, data, frame: int, lower, upper, rotation=None):
+    def __init__(self, model, data, frame: int, lower, upper, rotation=None, axis=None):
         import pinocchio as pin
 
         self.pin = pin
         self.model, self.data, self.frame = model, data, frame
         self.lower, self.upper = np.asarray(lower, float), np.asarray(upper, float)
         self.rotation = None if rotation is None else np.asarray(rotation, float)
+        # `pointing`: only tool0's x axis is constrained, to this unit vector (no rotation given)
+        self.axis = None if axis is None or rotation is not None else np.asarray(axis, float)
+
+    def _axis_error(self, M) -> np.ndarray:
+        """The shortest turn taking tool0's x axis onto self.axis (its norm: the angle between them)."""
+        assert self.axis is not None
+        x = np.array(M.rotation)[:, 0]
+        v = np.cross(x, self.axis)
+        s = float(np.linalg.norm(v))
+        angle = float(np.arctan2(s, float(x @ self.axis)))
+        if s < 1e-12:
+            v = np.cross(x, (1.0, 0.0, 0.0) if abs(x[0]) < 0.9 else (0.0, 1.0, 0.0))
+        return v * (angle / float(np.linalg.norm(v)))
 
     def placement(self, q):
         pin = self.pin
@@ -82,6 +95,8 @@ class PositionIK:
         """target - p(q), with the weighted rotation error appended for a full pose."""
         M = self.placement(q)
         e = target - np.array(M.translation)
+        if self.axis is not None:
+            return np.concatenate([e, ROTATION_WEIGHT * self._axis_error(M)])
         if self.rotation is None:
             return e
         return np.concatenate([e, ROTATION_WEIGHT * rotation_vector(self.rotation @ np.array(M.rotation).T)])
@@ -90,6 +105,8 @@ class PositionIK:
         """(position error m, orientation error rad; 0 without an orientation)."""
         M = self.placement(q)
         pe = float(np.linalg.norm(target - np.array(M.translation)))
+        if self.axis is not None:
+            return pe, float(np.linalg.norm(self._axis_error(M)))
         if self.rotation is None:
             return pe, 0.0
         return pe, float(np.linalg.norm(rotation_vector(self.rotation @ np.array(M.rotation).T)))
@@ -98,6 +115,10 @@ class PositionIK:
         pin = self.pin
         J = pin.computeFrameJacobian(self.model, self.data, q, self.frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         J = np.asarray(J).reshape(6, self.model.nv)  # pinocchio hands a one-joint arm's 6 x 1 back as a flat (6,)
+        if self.axis is not None:  # turning about tool0's x axis changes nothing the target asks for
+            x = np.array(self.placement(q).rotation)[:, 0]
+            Jr = np.array(J[3:]) - np.outer(x, x @ np.array(J[3:]))
+            return np.vstack([np.array(J[:3]), ROTATION_WEIGHT * Jr])
         if self.rotation is None:
             return np.array(J[:3])
         return np.vstack([np.array(J[:3]), ROTATION_WEIGHT * np.array(J[3:])])
@@ -136,7 +157,7 @@ class PositionIK:
         gradient steps in the Jacobian's null space, each re-converged; a step that leaves the
         limits or the target is dropped)."""
         n = q.size
-        if n <= (3 if self.rotation is None else 6):
+        if n <= (6 if self.rotation is not None else 5 if self.axis is not None else 3):
             return q
         for _ in range(NULL_STEPS):
             J = self.jacobian(q)

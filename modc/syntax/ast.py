@@ -146,6 +146,7 @@ class Target:
     span: Span
     rpy: Vector | None = None  # tool0's orientation in base_link (URDF fixed axes)
     within: Within | None = None
+    pointing: Vector | None = None  # tool0's x axis (the approach) only, a direction in base_link
 
 
 @dataclass(frozen=True, slots=True)
@@ -224,6 +225,7 @@ class Region:
     span: Span
     rpy: Vector | None = None
     within: Within | None = None
+    pointing: Vector | None = None  # as a target's
 
 
 @dataclass(frozen=True, slots=True)

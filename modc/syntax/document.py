@@ -68,6 +68,7 @@ class TargetDoc(_Doc):
         None, description='tool0\'s orientation in base_link (URDF fixed axes), e.g. "(0, 90, 0) deg"'
     )
     within: str | None = Field(None, description='tolerances: "5 mm" or "5 mm, 2 deg"')
+    pointing: Vector | None = Field(None, description='instead of rpy: tool0\'s x axis only, e.g. "(0, 0, -1)"')
 
 
 TargetValue = Vector | TargetDoc
@@ -81,6 +82,7 @@ class RegionDoc(_Doc):
     grid: str | list[int] = Field(description='points per axis: "3 x 2 x 1" or [3, 2, 1]')
     rpy: Vector | None = None
     within: str | None = Field(None, description='tolerances: "5 mm" or "5 mm, 2 deg"')
+    pointing: Vector | None = Field(None, description='instead of rpy: tool0\'s x axis only, e.g. "(0, 0, -1)"')
 
 
 class PathDoc(_Doc):

@@ -150,7 +150,11 @@ class ToAst:
 
     def target(self, meta, items):
         rest = dict(items[2:])
-        return ast.Target(self._name(items[0]), items[1][1], self._span(meta), rest.get("rpy"), rest.get("within"))
+        return ast.Target(self._name(items[0]), items[1][1], self._span(meta), rest.get("rpy"), rest.get("within"),
+                          rest.get("pointing"))
+
+    def pointing(self, meta, items):
+        return ("pointing", items[0])
 
     def allow(self, meta, items):
         return ast.Allow(tuple(self._name(t) for t in items), self._span(meta))
@@ -165,7 +169,8 @@ class ToAst:
         name, size, at, nx, ny, nz, *rest = items
         opt = dict(rest)
         grid = (self._count(nx), self._count(ny), self._count(nz))
-        return ast.Region(self._name(name), size, at[1], grid, self._span(meta), opt.get("rpy"), opt.get("within"))
+        return ast.Region(self._name(name), size, at[1], grid, self._span(meta), opt.get("rpy"), opt.get("within"),
+                          opt.get("pointing"))
 
     def task(self, meta, items):
         return ast.Task(self._name(items[0]), tuple(items[1:]), self._span(meta))

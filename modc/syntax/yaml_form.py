@@ -167,9 +167,13 @@ class _Reader:
             qs = [self._sub("quantity_text", x.strip(), p + ("within",)) for x in value.within.split(",")[:2]]
             if all(q is not None for q in qs):
                 within = ast.Within(qs[0], qs[1] if len(qs) > 1 else None, self.span(p + ("within",)))
-        if at is None or (value.rpy is not None and rpy is None):
+        pointing = self._vec(value.pointing, p + ("pointing",))
+        if value.rpy is not None and value.pointing is not None:
+            self.diags.append(codes.YAML_SCHEMA.at(self.span(p), detail=f"{_dotted(p)}: rpy or pointing, not both"))
             return None
-        return ast.Target(key, at, self.span(p), rpy, within)
+        if at is None or (value.rpy is not None and rpy is None) or (value.pointing is not None and pointing is None):
+            return None
+        return ast.Target(key, at, self.span(p), rpy, within, pointing)
 
     def _chain(self, items, path: tuple) -> ast.Chain:
         units = []
@@ -231,9 +235,14 @@ class _Reader:
             rpy = self._vec(reg.rpy, p + ("rpy",))
             grid = self._grid(reg.grid, p + ("grid",))
             within = self._within(reg.within, p + ("within",))
-            if size is not None and at is not None and grid is not None and (reg.rpy is None or rpy is not None):
+            pointing = self._vec(reg.pointing, p + ("pointing",))
+            if reg.rpy is not None and reg.pointing is not None:
+                self.diags.append(codes.YAML_SCHEMA.at(self.span(p), detail=f"{_dotted(p)}: rpy or pointing, not both"))
+                continue
+            if size is not None and at is not None and grid is not None and (reg.rpy is None or rpy is not None) \
+                    and (reg.pointing is None or pointing is not None):
                 body.append(ast.Region(ast.Name(name, self.span(p + ("__key__",))), size, at, grid, self.span(p), rpy,
-                                       within))
+                                       within, pointing))
         for name, visits in r.tasks.items():
             p = path + ("tasks", name)
             refs = [self._ref(v, p + (i,)) for i, v in enumerate(visits)]

@@ -1,0 +1,53 @@
+"""The `coverage` objective: the share of the cell's region points a design reaches.
+
+Without `rank coverage` every region point is required (the static search screens them as
+targets, modc.design.tasks.with_points). With it, the region points are optional: a design's
+coverage is the share of them it reaches within their tolerances, clear of the cell (the
+planner's own IK and collision model, modc.plan), its tasks visit the points it reaches (the
+others are dropped from the visits of its robot file, which keeps the regions whole) and the
+design is ranked by the share, larger first (rank.OBJECTIVES)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model import Robot
+
+
+def reached(robot: Robot, seed: int) -> tuple[set[str], int]:
+    """The names of the region points the robot reaches clear of the cell, and how many there are."""
+    from ..kinematics import rpy_matrix
+    from ..plan import IK_BATCHES, IK_SEEDS_PER_JOINT, start_pose
+    from ..plan import ik as plan_ik
+    from ..plan.collision import CollisionChecker
+
+    points = [p for r in robot.regions for p in r.points()]
+    if not points:
+        return set(), 0
+    checker = CollisionChecker(robot)
+    _where, home, _span = start_pose(robot, None)
+    out: set[str] = set()
+    for t in points:
+        rotation = None if t.rpy is None else rpy_matrix(t.rpy)
+        solver = plan_ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper,
+                                    rotation, t.pointing)
+        oriented = t.rpy is not None or t.pointing is not None
+        tol = (t.position_tolerance, t.orientation_tolerance if oriented else np.inf)
+        sols, _best = plan_ik.solve(solver, t.xyz, home, IK_SEEDS_PER_JOINT * robot.dof, seed,
+                                    batches=IK_BATCHES, enough=checker.valid, tolerance=tol)
+        if any(checker.valid(s.q) for s in sols):
+            out.add(t.name)
+    return out, len(points)
+
+
+def served(robot: Robot, points: set[str]) -> Robot:
+    """The robot with its tasks visiting only the region points in `points` (targets stay)."""
+    names = {p.name for r in robot.regions for p in r.points()}
+    tasks = tuple(t.model_copy(update={"visits": tuple(v for v in t.visits if v not in names or v in points)})
+                  for t in robot.tasks)
+    return robot.model_copy(update={"tasks": tasks})
+
+
+def missing_ends(robot: Robot, points: set[str]) -> list[str]:
+    """Region points a straight path starts or ends at that the robot does not reach (paths are required)."""
+    names = {p.name for r in robot.regions for p in r.points()}
+    return [e for p in robot.paths for e in (p.start, p.end) if e in names and e not in points]

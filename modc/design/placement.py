@@ -1,0 +1,191 @@
+"""Base placement (`base within box … step … [yaw …]`): the base pose is a design variable.
+
+The design's obstacles, targets and regions are given in the cell frame of the box. For each base
+pose of the grid the cell is written in that base's frame (base_link, the frame every robot file
+gives its environment in) with `base at` the pose, and the static search runs on it unchanged;
+the designs of all poses are merged into one ranking where a design is a (base pose, chain)
+pair, one entry per chain: its best pose (ties: the pose searched first). Each design's robot
+states its `base at …` and holds the same cell around it, so it compiles, plans and views in the
+same world as every other design.
+
+Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
+bounds is skipped (sound: no chain could reach it from there), so is one where base_link sinks
+into the cell whatever the first unit (sound: the exact check would reject every design), and poses are searched closest
+cell first (the farthest point of the cell nearest), each completely, until `top` (pose, chain)
+designs are found: the poses after that are not searched (first fit, not the best pose of the grid;
+ranking.json "bases" says how many poses were searched and skipped by reach). So 25 poses cost
+what the poses searched before `top` designs cost, plus one; the ranking keeps one entry per
+chain (its best pose), so it may hold fewer than `top` designs.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..model import Problem, Robot, Transform
+from .rank import Design, order
+
+if TYPE_CHECKING:
+    from .run import Outcome
+
+
+def _frame(pose: Transform) -> tuple[np.ndarray, np.ndarray]:
+    from ..kinematics import rpy_matrix
+
+    return rpy_matrix(pose.rpy), np.asarray(pose.xyz, float)
+
+
+Vec = tuple[float, float, float]
+
+
+def _to_base(R: np.ndarray, p: np.ndarray, xyz, rpy) -> tuple[Vec, Vec | None]:
+    """A cell-frame position (and orientation) in the base frame of pose (R, p)."""
+    from ..kinematics import matrix_rpy, rpy_matrix
+
+    x = R.T @ (np.asarray(xyz, float) - p)
+    xyz_b = (float(x[0]), float(x[1]), float(x[2]))
+    if rpy is None:
+        return xyz_b, None
+    return xyz_b, matrix_rpy(R.T @ rpy_matrix(rpy))
+
+
+def _turn(R: np.ndarray, d) -> Vec | None:
+    """A cell-frame direction in the base frame."""
+    if d is None:
+        return None
+    v = R.T @ np.asarray(d, float)
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def cell_at(cell: Robot, pose: Transform) -> Robot:
+    """The cell written in the frame of a base at `pose` (cell frame), with `base at` the pose.
+
+    Regions are axis-aligned boxes: a yawed base keeps them only at yaw 0 (modc.model.lower_task
+    refuses `base within … yaw` with regions), so a region moves, it does not turn."""
+    R, p = _frame(pose)
+    obstacles = []
+    for o in cell.obstacles:
+        xyz, rpy = _to_base(R, p, o.origin.xyz, o.origin.rpy)
+        assert rpy is not None
+        obstacles.append(o.model_copy(update={"origin": Transform(xyz=xyz, rpy=rpy)}))
+    targets = []
+    for t in cell.targets:
+        xyz, rpy = _to_base(R, p, t.xyz, t.rpy)
+        targets.append(t.model_copy(update={"xyz": xyz, "rpy": rpy, "pointing": _turn(R, t.pointing)}))
+    regions = []
+    for r in cell.regions:
+        xyz, rpy = _to_base(R, p, r.center, r.rpy)
+        regions.append(r.model_copy(update={"center": xyz, "rpy": rpy, "pointing": _turn(R, r.pointing)}))
+    return cell.model_copy(update={"base": pose, "obstacles": tuple(obstacles), "targets": tuple(targets),
+                                   "regions": tuple(regions)})
+
+
+def points(cell: Robot) -> list:
+    """Every position the arm must reach: targets and region points."""
+    return [*cell.targets, *(p for r in cell.regions for p in r.points())]
+
+
+def gap(cell: Robot, pose: Transform, longest: float) -> float:
+    """m by which the farthest point of the cell lies beyond `longest` from a base at pose (<= 0: none)."""
+    p = np.asarray(pose.xyz, float)
+    return max((float(np.linalg.norm(np.asarray(t.xyz, float) - p)) - t.position_tolerance - longest
+                for t in points(cell)), default=-1.0)
+
+
+def base_blocked(problem: Problem, pose: Transform) -> bool:
+    """Does base_link, at pose, sink into the cell whatever the first unit (every allowed variant
+    and type)? The exact check rejects every design there ("base_link touches the cell"), so
+    the pose is not worth a search (sound)."""
+    from ..model import UnitSpec
+    from ..plan.collision import CollisionChecker
+    from . import space
+
+    lib = problem.cell.library
+    assert lib is not None
+    if not problem.cell.obstacles:
+        return False
+    cell = cell_at(problem.cell, pose)
+    for v in lib.variants:
+        for k in lib.units:
+            if not space.allowed(problem, v, k):
+                continue
+            robot = cell.model_copy(update={"units": (UnitSpec(name=f"{v}{k}", variant=v, kind=k),)})
+            if not CollisionChecker(robot).static_contacts():
+                return False
+    return True
+
+
+def poses(problem: Problem, longest: float) -> tuple[list[Transform], int, int]:
+    """The grid's poses worth a search, closest cell first, how many the reach bound ruled out
+    and how many base_link's contact with the cell did."""
+    grid = problem.base_grid
+    assert grid is not None
+    cell = problem.cell
+    kept = []
+    touching = 0
+    for i, pose in enumerate(grid.poses()):
+        if gap(cell, pose, longest) > 0:
+            continue
+        if base_blocked(problem, pose):
+            touching += 1
+            continue
+        p = np.asarray(pose.xyz, float)
+        far = max((float(np.linalg.norm(np.asarray(t.xyz, float) - p)) for t in points(cell)), default=0.0)
+        kept.append((round(far, 9), i, pose))
+    kept.sort(key=lambda e: e[:2])
+    return [k[2] for k in kept], len(grid.poses()) - len(kept) - touching, touching
+
+
+def search(problem: Problem, max_units: int | None, top: int, longest: float,
+           one: Callable[[Problem, int | None, int], Outcome]) -> Outcome:
+    """The merged outcome of one(sub_problem, max_units, top) over the kept base poses."""
+    from .run import Outcome
+
+    kept, pruned, touching = poses(problem, longest)
+    outs = []
+    designs: list[Design] = []
+    found = 0  # (pose, chain) designs found
+    for pose in kept:
+        sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None})
+        o = one(sub, max_units, top)
+        outs.append(o)
+        found += len(o.designs)
+        designs = _best_per_chain(designs + list(o.designs), problem.rank)
+        if o.stopped or found >= top:
+            break
+    out = Outcome(problem, designs[:top])
+    out.bases_searched, out.bases_pruned, out.bases_total = len(outs), pruned, len(kept) + pruned + touching
+    out.bases_touching = touching
+    names = [t.name for t in problem.cell.targets]
+    out.closest = {t: min((o.closest.get(t, math.inf) for o in outs), default=math.inf) for t in names}
+    if not outs:  # every pose ruled out by reach: how far the nearest pose leaves the cell
+        grid = problem.base_grid
+        assert grid is not None
+        short = min(gap(problem.cell, p, longest) for p in grid.poses())
+        out.closest = dict.fromkeys(names, max(short, 0.0))
+    for o in outs:
+        out.evaluated += o.evaluated
+        out.shapes += o.shapes
+        out.screened += o.screened
+        out.excluded += o.excluded
+        out.rejections += o.rejections
+        out.complete &= o.complete
+        out.stopped = out.stopped or o.stopped
+        out.unfinished += [s for s in o.unfinished if s not in out.unfinished]
+        out.coarse += [s for s in o.coarse if s not in out.coarse]
+        if not out.designs and o.targets and not out.targets:
+            out.targets = o.targets
+    return out
+
+
+def _best_per_chain(designs: list[Design], objectives: tuple[str, ...]) -> list[Design]:
+    seen: set[str] = set()
+    out = []
+    for d in order(designs, objectives):  # stable: of equal designs, the pose searched first
+        if d.chain() not in seen:
+            seen.add(d.chain())
+            out.append(d)
+    return out

@@ -1,0 +1,147 @@
+"""`base within` in `modc design`: the base pose is a design variable, the cell given in the frame
+of the base's box; each design states its `base at` and the same cell around it."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modc.compiler import check_file, check_text
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# target a lies 0.78 m from the origin, beyond any 3-unit H1/L3 arm there (about 0.70 m), and
+# 0.59 m from a base at x = 0.2 m: only a shifted base reaches it
+SHIFTED = """design shifted {
+    box post size (0.05, 0.05, 0.3) m at (0.45, -0.25, 0.15) m
+    target a at (0.75, 0.05, 0.20) m
+    target b at (0.55, -0.10, 0.35) m
+    units 3
+    modules H1, L3
+    base within box size (0.4, 0, 0) m at (0, 0, 0) m step 100 mm
+}
+"""
+
+
+def problem(text: str = SHIFTED):
+    checked = check_text(text, "cell.mod")
+    assert checked.ok, [d.message for d in checked.diagnostics]
+    return checked.design.problems[0]
+
+
+def test_the_cell_is_written_in_the_frame_of_each_base_pose():
+    from modc.design.placement import cell_at
+    from modc.kinematics import rpy_matrix, transform
+    from modc.model import Transform
+
+    cell = problem(SHIFTED.replace("(0.75, 0.05, 0.20) m", "(0.75, 0.05, 0.20) m rpy (10, 90, 20) deg")).cell
+    pose = Transform(xyz=(0.1, -0.2, 0.05), rpy=(0.0, 0.0, math.radians(30)))
+    moved = cell_at(cell, pose)
+    assert moved.base == pose
+    T = transform(pose.xyz, pose.rpy)
+    for before, after in zip(cell.targets, moved.targets, strict=True):  # the same place in the cell frame
+        assert np.allclose(T[:3, :3] @ after.xyz + T[:3, 3], before.xyz, atol=1e-12)
+    a0, a1 = cell.targets[0], moved.targets[0]
+    assert np.allclose(T[:3, :3] @ rpy_matrix(a1.rpy), rpy_matrix(a0.rpy), atol=1e-12)
+    o0, o1 = cell.obstacles[0], moved.obstacles[0]
+    assert np.allclose(T @ transform(o1.origin.xyz, o1.origin.rpy), transform(o0.origin.xyz, o0.origin.rpy))
+
+
+def test_base_poses_beyond_reach_are_skipped_soundly_and_nearest_first():
+    from modc.design import placement, run
+
+    p = problem()
+    longest = run.longest_reach(p, 3)
+    kept, pruned, touching = placement.poses(p, longest)
+    assert pruned == 1 and touching == 0 and [k.xyz[0] for k in kept] == pytest.approx([0.2, 0.1, 0.0, -0.1])
+    # a pose is skipped only when a target is farther than the longest arm's reach bound from it
+    far = p.base_grid.poses()[0]
+    assert far.xyz[0] == pytest.approx(-0.2)
+    assert np.linalg.norm(np.subtract(p.cell.targets[0].xyz, far.xyz)) - 0.005 > longest
+
+
+def test_poses_after_the_top_designs_are_not_searched(monkeypatch):
+    """First fit: poses nearest first, each searched completely, until `top` designs are found."""
+    from modc.design import placement, run
+
+    calls = []
+    real = run._search
+
+    def counted(p, *a, **kw):
+        calls.append(p.cell.base.xyz)
+        return real(p, *a, **kw)
+
+    monkeypatch.setattr(run, "_search", counted)
+    wide = SHIFTED.replace("target a at (0.75, 0.05, 0.20) m\n", "").replace("modules H1, L3", "modules H1, L3, L4")
+    o = run.design(problem(wide), top=1)
+    assert len(o.designs) == 1 and o.bases_searched == len(calls) == 1
+    assert calls[0] == placement.poses(problem(wide), run.longest_reach(problem(wide), 3))[0][0].xyz
+    assert o.bases_touching == 0
+    assert o.bases_total == 5 and o.designs[0].verified.robot.base.xyz == calls[0]
+
+
+def test_a_base_pose_inside_an_obstacle_is_skipped():
+    from modc.design import placement, run
+    from modc.model import Transform
+
+    text = SHIFTED.replace("    units 3\n", "    box block size (0.2, 0.2, 0.2) m at (0.2, 0, 0.05) m\n    units 3\n")
+    p = problem(text)
+    assert placement.base_blocked(p, Transform(xyz=(0.2, 0.0, 0.0)))
+    assert not placement.base_blocked(p, Transform(xyz=(-0.2, 0.0, 0.0)))
+    kept, _pruned, touching = placement.poses(p, run.longest_reach(p, 3))
+    assert touching == 2 and all(k.xyz[0] < 0.05 for k in kept)  # x = 0.1 and 0.2 sit in the block
+
+
+def test_no_base_pose_in_reach_is_no_design_with_the_reason():
+    from modc.design import run
+
+    text = SHIFTED.replace("(0.75, 0.05, 0.20) m", "(1.75, 0.05, 0.20) m")
+    o = run.design(problem(text), top=1)
+    assert not o.designs and o.bases_searched == 0 and o.bases_pruned == 5
+    assert "from every one of the 5 base poses some target lies beyond the reach" in o.why_none()
+    assert "inf" not in o.why_none() and "nan" not in o.why_none()
+
+
+@pytest.mark.slow
+def test_only_a_shifted_base_reaches_and_its_file_places_the_same_cell(tmp_path):
+    from modc.design import run
+    from modc.kinematics import Chain, rpy_matrix, transform
+
+    fixed = problem(SHIFTED.replace("    base within box size (0.4, 0, 0) m at (0, 0, 0) m step 100 mm\n", ""))
+    assert not run.design(fixed, top=1).designs  # at the origin no arm of the bounds reaches a
+
+    src = tmp_path / "cell.mod"
+    src.write_text(SHIFTED, encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
+    r = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
+                        "--no-render", "--top", "2"], capture_output=True, text=True, env=env, timeout=900)
+    assert r.returncode == 0, r.stderr
+    ranking = json.loads((tmp_path / "out" / "ranking.json").read_text())
+    bases = ranking["bases"]["shifted"]
+    assert bases["poses"] == 5 and bases["pruned_by_reach"] == 1 and 1 <= bases["searched"] <= 4
+    cell = problem().cell
+    for d in ranking["designs"]:
+        assert d["base"]["xyz_m"][0] > 0.05 and d["base"]["rpy_deg"] == [0.0, 0.0, 0.0]
+        checked = check_file(tmp_path / "out" / d["file"])
+        assert checked.ok, [x.message for x in checked.diagnostics]
+        robot = checked.design.robots[0]
+        assert list(robot.base.xyz) == pytest.approx(d["base"]["xyz_m"])
+        T_world_base = transform(robot.base.xyz, robot.base.rpy)
+        chain = Chain(robot)
+        for t in cell.targets:  # re-measured in the cell frame, from the emitted file's own pose
+            q = np.asarray(robot.pose(f"at_{t.name}").q)
+            T = T_world_base @ chain.T_base_tool(q)
+            assert np.linalg.norm(T[:3, 3] - np.asarray(t.xyz)) <= t.position_tolerance + 1e-9
+            if t.rpy is not None:
+                E = rpy_matrix(t.rpy) @ T[:3, :3].T
+                angle = math.degrees(math.acos(np.clip((np.trace(E) - 1) / 2, -1, 1)))
+                assert angle <= math.degrees(t.orientation_tolerance) + 1e-6
+        # the obstacle stands where the cell put it
+        post = next(o for o in robot.obstacles if o.name == "post")
+        assert np.allclose(T_world_base[:3, :3] @ post.origin.xyz + T_world_base[:3, 3], (0.45, -0.25, 0.15))

@@ -1,0 +1,94 @@
+"""`rank coverage` in `modc design`: the share of region points reached ranks designs that serve
+only part of a region; without it every point of every region is required."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modc.compiler import check_file, check_text
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# the region's far point (0.9 m out) is beyond every 3-unit H1/L3 arm (reach bound 0.88 m)
+PARTLY = """design partly {
+    payload 100 g
+    target a at (0.30, -0.10, 0.25) m
+    region row box size (0.6, 0, 0) m at (0.6, 0.1, 0.25) m grid 3 x 1 x 1
+    units 3
+    modules H1, L3
+    task serve { visit a, row }
+    rank coverage, cycle_time
+}
+"""
+
+
+def problem(text: str = PARTLY):
+    checked = check_text(text, "cell.mod")
+    assert checked.ok, [d.message for d in checked.diagnostics]
+    return checked.design.problems[0]
+
+
+def test_served_drops_only_the_points_not_reached():
+    from modc.design import coverage
+
+    cell = problem().cell
+    served = coverage.served(cell, {"row[0,0,0]", "row[1,0,0]"})
+    assert served.tasks[0].visits == ("a", "row[0,0,0]", "row[1,0,0]")
+    assert served.regions == cell.regions and served.targets == cell.targets
+
+
+def test_coverage_ranks_larger_shares_first():
+    from modc.design.rank import OBJECTIVES, TASK, static
+
+    class D:
+        def __init__(self, c):
+            self.coverage = c
+
+    assert OBJECTIVES["coverage"](D(1.0)) < OBJECTIVES["coverage"](D(2 / 3)) < OBJECTIVES["coverage"](D(0.1))
+    assert "coverage" in TASK and static(("coverage", "modules")) == ("modules",)
+
+
+def test_without_coverage_every_region_point_is_required():
+    from modc.design import run
+
+    o = run.design(problem(PARTLY.replace("rank coverage, cycle_time", "rank modules")), top=1)
+    assert not o.designs
+    assert "row[2,0,0]" in o.why_none() and "row_2_0_0" not in o.why_none()
+
+
+@pytest.mark.slow
+def test_rank_coverage_ranks_a_design_that_serves_part_of_the_region(tmp_path):
+    from modc.kinematics import Chain
+    from modc.plan.collision import CollisionChecker
+
+    src = tmp_path / "cell.mod"
+    src.write_text(PARTLY, encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
+    r = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
+                        "--no-render", "--top", "2"], capture_output=True, text=True, env=env, timeout=900)
+    assert r.returncode == 0, r.stderr
+    ranking = json.loads((tmp_path / "out" / "ranking.json").read_text())
+    shares = [d["coverage"] for d in ranking["designs"]]
+    assert shares == sorted(shares, reverse=True) and 0 < shares[0] < 1
+    for d in ranking["designs"]:
+        robot = check_file(tmp_path / "out" / d["file"]).design.robots[0]
+        visits = robot.tasks[0].visits
+        assert "row[2,0,0]" not in visits and visits[:1] == ("a",)
+        points = [v for v in visits if v.startswith("row[")]
+        assert d["coverage"] == pytest.approx(len(points) / 3, abs=1e-6)
+        # each point the task visits is reached where its trajectory says, re-measured here
+        traj = json.loads((tmp_path / "out" / d["traj"]).read_text())
+        chain, checker = Chain(robot), CollisionChecker(robot)
+        for seg in traj["segments"]:
+            if seg["to"] in points:
+                end = seg["t_start_s"] + seg["duration_s"]
+                q = np.asarray(min(traj["points"], key=lambda p, end=end: abs(p["t"] - end))["q"])
+                tgt = robot.task_target(seg["to"])
+                assert np.linalg.norm(chain.T_base_tool(q)[:3, 3] - tgt.xyz) <= tgt.position_tolerance + 1e-6
+                assert checker.contacts(q, 0.0) == []
