@@ -52,7 +52,7 @@ def test_task_progress_on_stderr_and_quiet(tmp_path):
     r = _plan(tmp_path, "--task", "serve", "--json")
     assert r.returncode == 0, r.stderr
     lines = [ln for ln in r.stderr.splitlines() if ln.startswith("modc plan: task 'serve'")]
-    assert lines and lines[-1].startswith("modc plan: task 'serve': 2 segments planned and timed")
+    assert lines and lines[-1].startswith("modc plan: task 'serve': the approach and 1 segment(s) planned and timed")
     assert r.stdout.lstrip().startswith("{")  # the trajectory alone on stdout
     q = _plan(tmp_path, "--task", "serve", "--json", "-q")
     assert q.returncode == 0 and "modc plan:" not in q.stderr and q.stdout == r.stdout
@@ -73,7 +73,7 @@ def test_plain_progress_ticks_while_a_segment_is_planned(monkeypatch):
     lines = err.getvalue().splitlines()
     ticks = [ln for ln in lines if "planning the segment 1 of 2 (a -> b)" in ln]
     assert len(ticks) >= 3, lines
-    assert lines[-1].startswith("modc plan: task 'serve': 3 segments planned and timed")
+    assert lines[-1].startswith("modc plan: task 'serve': the approach and 2 segment(s) planned and timed")
     with plan_progress.progress("off", "serve") as hook:
         assert hook is None
 
@@ -83,8 +83,8 @@ def test_live_status_names_the_segment():
 
     s = Status("serve")
     assert "reading the file" in s.line()
-    s(0, 3, "approach", "home", "a")
-    assert "planning the approach (home -> a)" in s.__rich__()
+    s(0, 3, "approach", "home", "tray[1,0,0]")
+    assert "planning the approach (home -> tray[1,0,0])" in s.__rich__().plain  # not read as rich markup
     s(2, 3, "motion", "b", "c")
     assert "segment 2 of 2 (b -> c)" in s.line()
 

@@ -34,12 +34,14 @@ class Status:
         if total == 0:
             return f"task '{self.task}': reading the file, {spent}"
         if kind == "done":
-            return f"task '{self.task}': {total} segments planned and timed, {spent}"
+            return f"task '{self.task}': the approach and {total - 1} segment(s) planned and timed, {spent}"
         what = "approach" if kind == "approach" else f"segment {number} of {total - 1}"
         return f"task '{self.task}': planning the {what} ({a} -> {b}), {spent}"
 
-    def __rich__(self) -> str:  # rich's Live redraws this at every refresh: the time ticks on
-        return self.line()
+    def __rich__(self):  # rich's Live redraws this at every refresh: the time ticks on
+        from rich.text import Text
+
+        return Text(self.line())  # plain text: a target named tray[1,0,0] is no markup
 
 
 @contextmanager
