@@ -55,12 +55,16 @@ VISIT = """design visit4 {
 }
 """
 
-# A tray of 4 x 3 cells, 5 cm apart, served in one task by position (each within 5 mm).
+# A tray of 4 x 3 cells, 5 cm apart, served in one task by position (each within 5 mm), from a
+# point above its centre. The static search screens only `target`s, not region points (the
+# planner meets those), and fails on a block with no target at all (evaluate.screen_batch:
+# max() of an empty sequence): hence the target `above`.
 REGION = """design tray12 {
     payload 50 g
+    target above at (0.30, 0, 0.25) m
     region tray box size (0.15, 0.10, 0) m at (0.30, 0, 0.20) m grid 4 x 3 x 1 within 5 mm
     units 2 to 3
-    task serve { visit tray }
+    task serve { visit above, tray }
     rank modules, cycle_time
 }
 """
