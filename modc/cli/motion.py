@@ -136,6 +136,18 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
     raise SystemExit(EXIT_OK)
 
 
+def _seconds(_ctx: click.Context, _param: click.Parameter, value: float) -> float:
+    """A click callback: finite seconds, at least 0.1 (FloatRange lets nan and inf through)."""
+    import math
+
+    if not (math.isfinite(value) and value >= 0.1):
+        raise click.BadParameter(f"{value!r} is not a number of seconds from 0.1 on")
+    return value
+
+
+EXIT_INTERRUPTED = 130  # Ctrl-C, as a shell reports a process SIGINT ended
+
+
 @app.command("plan")
 @argument("file", help=".mod file (or its YAML form)")
 @click.option("--to", help="target to move tool0 to (a `target` of the robot)")
@@ -145,7 +157,9 @@ def play_cmd(file: str, traj: str, record: str | None, robot: str | None, headle
 @click.option("--seed", type=click.IntRange(min=0), default=0,
               help="seed of IK starts, RRT-Connect and shortcuts: same file and seed, same motion")
 @click.option("--start", help="pose to start from (default: home)")
-@click.option("--timeout", type=click.FloatRange(min=0.1), default=20.0, help="seconds of path search at most")
+@click.option("--timeout", type=float, default=20.0, callback=_seconds,
+              help="seconds of path search at most (per segment with --task)")
+@click.option("-q", "--quiet", is_flag=True, help="no progress display (--task)")
 @library_option
 def plan_cmd(
     file: str,
@@ -156,10 +170,11 @@ def plan_cmd(
     seed: int,
     start: str | None,
     timeout: float,
+    quiet: bool,
     library: str | None,
 ) -> None:
     """Plan a collision-free motion from the home pose (or --start) to a named target (exit 1 if none);
-    with --task, plan and time a whole task from the home pose."""
+    with --task, plan and time a whole task from the home pose (progress on stderr, -q: none)."""
     from ..plan import PlanError, plan
 
     if (to is None) == (task is None):
@@ -168,17 +183,24 @@ def plan_cmd(
     try:
         if task is not None:
             from ..plan.task import plan_task
+            from .plan_progress import progress
 
             if start is not None:
                 _err("modc plan: --start does not apply to --task (a task starts from the home pose)")
                 raise SystemExit(EXIT_USAGE)
-            result: Any = plan_task(file, task, robot=robot, seed=seed, library=library, timeout=timeout)
+            mode = "off" if quiet else "live" if sys.stderr.isatty() else "plain"
+            with progress(mode, task) as hook:
+                result: Any = plan_task(file, task, robot=robot, seed=seed, library=library, timeout=timeout,
+                                        progress=hook)
         else:
             assert to is not None
             result = plan(file, to, robot=robot, seed=seed, start=start, library=library, timeout=timeout)
     except PlanError as e:
         _print_diagnostics(e.diagnostics, e.sources)
         raise SystemExit(e.exit_code) from None
+    except KeyboardInterrupt:
+        _err("modc plan: interrupted; nothing planned")
+        raise SystemExit(EXIT_INTERRUPTED) from None
     if json_out:
         sys.stdout.write(result.dumps())
     else:

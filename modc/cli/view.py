@@ -28,9 +28,11 @@ def _open_browser(url: str) -> bool:
 def view_cmd(file: str, port: int, no_browser: bool, traj: str | None, robot: str | None, library: str | None) -> None:
     """Live 3D view in the browser: the arm in its cell with its targets, a slider per joint, the
     named poses, tool0 and each joint's gravity torque against its actuator, trajectory playback.
+    A ranking.json lists its designs and plays each design's task (its .traj.json).
     Saving the file updates the page; an error shows its diagnostics and keeps the last good arm.
     Ctrl-C stops it."""
-    from ..view.page import Page, Ranking, Source, ViewError, read_trajectory
+    from ..view.page import Page, Source, ViewError, read_trajectory
+    from ..view.ranking import Ranking, RankingPage
     from ..view.server import ServeError, run, start, stop_server
 
     # Ctrl-C before the address is printed is click's "Aborted!" (exit 1); after it, a clean stop (exit 0).
@@ -38,7 +40,7 @@ def view_cmd(file: str, port: int, no_browser: bool, traj: str | None, robot: st
         if file.endswith(".json"):
             if traj is not None:
                 raise ViewError("--traj plays on one file, not on a ranking")
-            page = Page.for_ranking(Ranking(file), library=library)
+            page: Page = RankingPage(Ranking(file), library=library)
         else:
             source = Source(file, robot=robot, library=library, traj=read_trajectory(traj) if traj else None)
             source.load(strict=True)

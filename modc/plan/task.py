@@ -22,6 +22,7 @@ task's segments (the approach from home is reported, and in the trajectory, but 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,6 +37,8 @@ STRAIGHT_STEP = 0.002  # m between IK waypoints along a straight path
 STRAIGHT_ANGLE_STEP = math.radians(1.0)  # and at most this much rotation of tool0
 MAX_JOINT_STEP = 0.1  # rad: more between neighbouring waypoints is a jump (the IK changed branch)
 START = "task start"  # the name the pose each segment starts from is given (in plan_robot's messages)
+# progress(k, n, kind, a, b): segment k of n (0: the approach from home) starts (modc plan's display)
+Progress = Callable[[int, int, str, str, str], None]
 
 
 @dataclass(frozen=True)
@@ -112,7 +115,7 @@ class TaskPlan:
 
 
 def plan_task(path, task: str, robot: str | None = None, seed: int = 0, library: str | None = None,
-              timeout: float | None = None) -> TaskPlan:
+              timeout: float | None = None, progress: Progress | None = None) -> TaskPlan:
     """Read a .mod (or YAML) file and plan and time the robot's task or path `task`. Raises PlanError."""
     from . import checked_or_raise
 
@@ -127,7 +130,7 @@ def plan_task(path, task: str, robot: str | None = None, seed: int = 0, library:
     except RobotChoiceError as e:
         raise PlanError([e.diagnostic], {}, EXIT_USAGE) from None
     return plan_task_robot(chosen, task, seed=seed, sources=checked.sources, with_robot_name=len(robots) > 1,
-                           timeout=timeout)
+                           timeout=timeout, progress=progress)
 
 
 def _find(robot, name: str):
@@ -143,8 +146,9 @@ def _unknown(robots, task: str, sources) -> PlanError:
 
 
 def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_name: bool = False,
-                    timeout: float | None = None) -> TaskPlan:
-    """Plan and time one checked robot's task or path. Raises PlanError."""
+                    timeout: float | None = None, progress: Progress | None = None) -> TaskPlan:
+    """Plan and time one checked robot's task or path. Raises PlanError. progress(k, n, kind, a,
+    b) is called as segment k of n (0: the approach) starts, and (n, n, "done", "", "") at the end."""
     from . import start_pose
     from .collision import CollisionChecker
     from .retime import Limits, TimingError, join
@@ -166,6 +170,8 @@ def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_na
     for number, (what, a, b) in enumerate(steps):
         if what != "approach" and a == b:
             continue
+        if progress is not None:
+            progress(number, len(steps), what, a, b)
         try:
             if what == "straight":
                 path, timed = job.straight(number, a, b, q)
@@ -179,6 +185,8 @@ def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_na
         t0 += timed.duration
         q = np.array(path[-1], float)
     whole = join(pieces, limits, q)
+    if progress is not None:
+        progress(len(steps), len(steps), "done", "", "")
     t_rows = tuple(round(float(t), 9) for t in whole.t)
     q_rows = tuple(tuple(round(float(v), 12) + 0.0 for v in row) for row in whole.q)
     return TaskPlan(robot.name, task, kind, tuple(f"joint_{i}" for i in range(1, robot.dof + 1)), t_rows, q_rows,

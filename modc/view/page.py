@@ -9,9 +9,9 @@ re-check of the file whenever it changes on disk (an error keeps the last good a
 """
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from .. import trajectory
 from ..compiler import COMPILE_ANALYSES, InputError, check_file
@@ -19,6 +19,9 @@ from ..diagnostics import Diagnostic, codes
 from ..diagnostics.render import render_text
 from ..model.select import RobotChoiceError, choose_robot
 from .arm import Arm
+
+if TYPE_CHECKING:
+    from .ranking import Ranking
 
 
 class ViewError(ValueError):
@@ -109,42 +112,6 @@ def read_trajectory(path: str) -> trajectory.Trajectory:
     return traj
 
 
-class Ranking:
-    """The designs of a `modc design` ranking.json (docs/conventions.md), best first; their files
-    lie next to ranking.json."""
-
-    def __init__(self, path: str | os.PathLike):
-        self.path = Path(path)
-        from ..files import InputProblem, read_json
-
-        try:  # under the limits of every input: a regular file, bounded, UTF-8, not nested deeply
-            doc = read_json(self.path)
-        except OSError as e:
-            raise ViewError(f"cannot read {self.path}: {e.strerror or e}") from None
-        except InputProblem as e:
-            raise ViewError(f"{self.path}: {e}") from None
-        designs = doc.get("designs") if isinstance(doc, dict) else None
-        if not isinstance(designs, list) or not designs:
-            raise ViewError(f'{self.path}: expected {{"designs": [{{"rank": …, "file": …}}, …]}}, at least one design')
-        for k, d in enumerate(designs):
-            if not (isinstance(d, dict) and isinstance(d.get("file"), str) and isinstance(d.get("rank"), int)):
-                raise ViewError(f'{self.path}: designs[{k}]: expected an object with an integer "rank" and a "file"')
-        self.designs = sorted(designs, key=lambda d: d["rank"])
-
-    def file(self, k: int) -> Path:
-        return self.path.parent / self.designs[k]["file"]
-
-    def caption(self, k: int) -> str:
-        d = self.designs[k]
-        parts = [f"design {k + 1} of {len(self.designs)}: rank {d['rank']}"]
-        if isinstance(d.get("chain"), str):
-            parts.append(d["chain"])
-        mass = d.get("mass_kg")
-        if isinstance(mass, (int, float)) and not isinstance(mass, bool) and math.isfinite(mass):
-            parts.append(f"{mass:.3g} kg")
-        return ", ".join(parts) + f" ({d['file']})"
-
-
 class Page:
     """The state behind the page. One source, or a ranking paged through (each design's file
     checked when first shown, then watched while it is on view)."""
@@ -162,8 +129,9 @@ class Page:
 
     @classmethod
     def for_ranking(cls, ranking: Ranking, library: str | None = None) -> Page:
-        return cls([Source(ranking.file(k), library=library) for k in range(len(ranking.designs))],
-                   [ranking.caption(k) for k in range(len(ranking.designs))])
+        from .ranking import RankingPage
+
+        return RankingPage(ranking, library)
 
     @property
     def source(self) -> Source:
@@ -245,3 +213,12 @@ class Page:
         if self.t >= traj.t[-1]:
             self.playing = False
         return True
+
+
+def __getattr__(name: str) -> Any:
+    """Ranking lives in ranking.py, which builds on this module; `from modc.view.page import Ranking` still works."""
+    if name == "Ranking":
+        from .ranking import Ranking
+
+        return Ranking
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -319,12 +319,23 @@ def start(page: Page, host: str = "127.0.0.1", port: int = 8080):
             raise ServeError(f"port {port} on {host} is busy; choose another with --port")
         # no share button: the share link would leave the machine
         server.gui.configure_theme(show_share_button=False, control_width="large")
-        view = View(server, page)
+        view = view_of(server, page)
     except BaseException:  # Ctrl-C while the page is built included: no server left behind
         stop_server(server)
         raise
     view.url = guard.url(server.get_port())
     return server, view
+
+
+def view_of(server, page: Page) -> View:
+    """The View for the page: a ranking's adds the list of designs and the task's segments (ranking_view.py)."""
+    from .ranking import RankingPage
+
+    if isinstance(page, RankingPage):
+        from .ranking_view import RankingView
+
+        return RankingView(server, page)
+    return View(server, page)
 
 
 def stop_server(server) -> None:
