@@ -193,7 +193,8 @@ def target_share(got: dict, target) -> float:
     return share
 
 
-def worst_share(targets: dict[str, dict], cell_targets) -> float:
-    """A design's worst target error as a share of its tolerance."""
-    tol = {t.name: t for t in cell_targets}
-    return max((target_share(got, tol[name]) for name, got in targets.items()), default=0.0)
+def worst_share(targets: dict[str, dict], cell) -> float:
+    """A design's worst target error as a share of its tolerance: targets and region points
+    (`tray[1,0,0]`, the region's tolerance) of the cell (a Robot)."""
+    shares = [target_share(got, t) for name, got in targets.items() if (t := cell.task_target(name)) is not None]
+    return max(shares, default=0.0)

@@ -68,7 +68,23 @@ def _static(problem: Problem, ref: Robot) -> tuple[float | None, float | None, s
 
 
 def evaluate(problem: Problem, seed: int = 0) -> Reference | None:
-    """The block's reference arm on its cell, or None when it names none."""
+    """The block's reference arm on its cell, or None when it names none. Every region point is
+    a target of it, as of the designs (unless `rank coverage`)."""
+    from .tasks import with_points
+
+    problem, names = with_points(problem)
+    out = _evaluate(problem, seed)
+    if out is None or not names:
+        return out
+    fails = []
+    for f in out.fails:
+        for internal, shown in names.items():
+            f = f.replace(f"'{internal}'", f"'{shown}'")
+        fails.append(f)
+    return replace(out, targets={names.get(k, k): v for k, v in out.targets.items()}, fails=tuple(fails))
+
+
+def _evaluate(problem: Problem, seed: int) -> Reference | None:
     ref = problem.reference
     lib = problem.cell.library
     if ref is None or lib is None or not ref.units or any(not u.variant for u in ref.units):

@@ -97,12 +97,12 @@ def _table(o: Outcome) -> str:
     head = "".join(f"<th>{escape(_heading(k, o))}</th>" for k in cols)
     rows = [f"<tr><th>rank</th><th>chain</th>{head}<th>worst target error</th><th>why this rank</th>"
             "<th>alternatives (other H/L variants)</th></tr>"]
-    targets = o.problem.cell.targets
+    cell = o.problem.cell
     for rank, (d, said) in enumerate(zip(o.designs, why(o.designs, o.problem.rank), strict=True), start=1):
-        worst = max(t["position_error_m"] for t in d.verified.targets.values())
+        worst = max((t["position_error_m"] for t in d.verified.targets.values()), default=0.0)
         rows.append(f"<tr><td>{rank}</td><td><code>{escape(d.chain())}</code></td>"
                     + "".join(f"<td>{_cell(k, d)}</td>" for k in cols)
-                    + f"<td>{_share(worst_share(d.verified.targets, targets), worst)}</td><td>{escape(said)}</td>"
+                    + f"<td>{_share(worst_share(d.verified.targets, cell), worst)}</td><td>{escape(said)}</td>"
                     f"<td>{'<br>'.join(f'<code>{escape(x.chain())}</code> ({x.mass:.3f} kg)' for x in d.alternatives)}"
                     "</td></tr>")
     if o.reference is not None:

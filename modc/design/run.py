@@ -192,7 +192,9 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     n = tasks.candidates(problem, top) if tasked else top
 
     def one(p: Problem, units: int | None, k: int) -> Outcome:
-        return _search(p, units, k, seed, executor, progress, deadline)
+        # candidates for planning come from the tiers needed for `top` designs: a further tier
+        # only to have more candidates to time would cost a whole tier's search (6.6 M settings)
+        return _search(p, units, k, seed, executor, progress, deadline, enough=top)
 
     if problem.base_grid is None:
         out = one(screen, max_units, n)
@@ -221,12 +223,13 @@ def longest_reach(problem: Problem, hi: int) -> float:
 
 
 def _search(problem: Problem, max_units: int | None, top: int, seed: int, executor: Executor | None,
-            progress: Callable[..., None] | None, deadline: float | None) -> Outcome:
+            progress: Callable[..., None] | None, deadline: float | None, enough: int | None = None) -> Outcome:
     """The static search: designs ranked by the problem's (static) objectives.
 
     With the default objectives (fewest modules first), chains are searched by number of units,
     and within one number lightest shape first, ROUND shapes at a time: the search stops as soon
-    as `top` kinematically distinct designs are checked that no unsearched shape could beat.
+    as `top` kinematically distinct designs are checked that no unsearched shape could beat, or
+    at the end of a number of units once `enough` (default top) are.
     ROUND does not depend on the number of workers, so neither does where the search stops.
     deadline (time.time()) and search.STOP end it early with what was found."""
     t0 = time.perf_counter()
@@ -311,7 +314,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
         if not early:
             continue
         tally.settle(n, float("inf"))
-        if tally.distinct_count() >= top:
+        if tally.distinct_count() >= (enough or top):
             break
     tally.settle(hi, float("inf"))
     done = {r.shape.label() for r in searched if r.finished}

@@ -69,7 +69,7 @@ def ranking(outcomes: list[Outcome]) -> dict:
                 "rank": rank, "file": file_name(o.problem.name, rank), "design": o.problem.name, "chain": d.chain(),
                 "modules": d.modules, "mass_kg": round(d.mass, 6), "torque_margin": round(d.margin, 6),
                 "targets": d.verified.targets, **task_figures(o, rank, d),
-                "worst_error_share": round(worst_share(d.verified.targets, o.problem.cell.targets), 6),
+                "worst_error_share": round(worst_share(d.verified.targets, o.problem.cell), 6),
                 "why": said,  # in words: what decided this rank against the next (the last: the one before)
                 "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
                                  for a in d.alternatives],
