@@ -88,3 +88,19 @@ def put(kind: str, name: str, data: bytes) -> None:
             raise
     except OSError:
         pass
+
+
+def get_checked(kind: str, name: str) -> bytes | None:
+    """An entry written by put_checked, or None when it is missing or its digest does not match
+    (a damaged or foreign file is rebuilt, never trusted)."""
+    blob = get(kind, name)
+    if blob is None:
+        return None
+    digest, _, payload = blob.partition(b"\n")
+    return payload if hashlib.sha256(payload).hexdigest().encode() == digest else None
+
+
+def put_checked(kind: str, name: str, payload: bytes) -> None:
+    """put(), the payload preceded by its sha256 (get_checked's test)."""
+    put(kind, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
+

@@ -63,4 +63,6 @@ def test_the_page_plays_a_design_task_and_switches_design(chrome, tmp_path):
         _wait(lambda: page.index == 1 and chrome.js(SLIDERS) == 4 and "τnom" in page_text(chrome), 60,
               "design 2's 4 joint sliders")
         assert page.arm.robot.name == "small_2" and page.q == pytest.approx(tuple(Q_A))
-        assert "small_2" in page_text(chrome) and ranking.choice(1) in chrome.js(INPUT_VALUES)
+        # the panel's text follows the server's update: wait for it, as for the sliders above
+        _wait(lambda: "small_2" in page_text(chrome) and ranking.choice(1) in chrome.js(INPUT_VALUES), 60,
+              "design 2's name and list entry in the page")

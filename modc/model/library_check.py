@@ -9,7 +9,6 @@ content, and one that is torn, altered or of another shape is ignored and rewrit
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import typing
 from functools import cache
@@ -152,11 +151,8 @@ def _entry_name(raw: bytes) -> str:
 def _from_cache(name: str) -> L.Library | None:
     from .. import cache as disk
 
-    blob = disk.get(_KIND, name)
-    if blob is None:
-        return None
-    digest, _, payload = blob.partition(b"\n")
-    if hashlib.sha256(payload).hexdigest().encode() != digest:
+    payload = disk.get_checked(_KIND, name)
+    if payload is None:
         return None
     try:
         library = _decode(json.loads(payload))
@@ -169,7 +165,7 @@ def _store(name: str, library: L.Library) -> None:
     from .. import cache as disk
 
     payload = json.dumps(_encode(library), allow_nan=False).encode()
-    disk.put(_KIND, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
+    disk.put_checked(_KIND, name, payload)
 
 
 # An entry is JSON in which a record is {"$record": its class's name, field: value...} and a dict

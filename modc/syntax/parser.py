@@ -70,16 +70,12 @@ _TABLES = "grammar"
 
 
 def _load_tables(name: str, options: dict):
-    import hashlib
     import marshal
 
     from .. import cache
 
-    blob = cache.get(_TABLES, name)
-    if blob is None:
-        return None
-    digest, _, payload = blob.partition(b"\n")
-    if hashlib.sha256(payload).hexdigest().encode() != digest:
+    payload = cache.get_checked(_TABLES, name)
+    if payload is None:
         return None
     from lark import Lark
 
@@ -99,7 +95,6 @@ def _plain(v) -> bool:
 
 
 def _save_tables(name: str, parser) -> None:
-    import hashlib
     import marshal
 
     from lark.grammar import Rule
@@ -116,7 +111,7 @@ def _save_tables(name: str, parser) -> None:
         payload = marshal.dumps((data, memo))
     except ValueError:  # a lark whose tables hold more than plain data: no cache
         return
-    cache.put(_TABLES, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
+    cache.put_checked(_TABLES, name, payload)
 
 
 def grammar_keywords() -> set[str]:
