@@ -188,12 +188,16 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     t0 = time.perf_counter()
     tasked = tasks.has_tasks(problem) or "coverage" in problem.rank
     screen, points = tasks.with_points(problem)  # every region point required: screened as a target
-    screen = screen.model_copy(update={"rank": static(problem.rank)}) if tasked else screen
+    # the static search only picks the candidates to plan and time: fewest modules, then least mass
+    # (the torque margin along the motion is judged by the planning, not by a static tie-break)
+    screen = screen.model_copy(update={"rank": tuple(k for k in static(problem.rank) if k != "margin")
+                                       or ("modules", "mass")}) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
 
     def one(p: Problem, units: int | None, k: int) -> Outcome:
-        # candidates for planning come from the tiers needed for `top` designs: a further tier
-        # only to have more candidates to time would cost a whole tier's search (6.6 M settings)
+        # the extra candidates to time come from the shapes searched until `top` designs are found
+        # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
+        # settings, 369 s on a 4-goal visit cell)
         return _search(p, units, k, seed, executor, progress, deadline, enough=top)
 
     if problem.base_grid is None:
@@ -228,8 +232,8 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
 
     With the default objectives (fewest modules first), chains are searched by number of units,
     and within one number lightest shape first, ROUND shapes at a time: the search stops as soon
-    as `top` kinematically distinct designs are checked that no unsearched shape could beat, or
-    at the end of a number of units once `enough` (default top) are.
+    as `enough` (default `top`) kinematically distinct designs are checked that no unsearched
+    shape could beat; up to `top` are kept.
     ROUND does not depend on the number of workers, so neither does where the search stops.
     deadline (time.time()) and search.STOP end it early with what was found."""
     t0 = time.perf_counter()
@@ -307,7 +311,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
             if stop:
                 out.stopped = stop
                 break
-            if early and tally.done(n, nxt):
+            if early and tally.done(n, nxt, enough):
                 break
         if out.stopped:
             break

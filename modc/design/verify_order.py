@@ -67,15 +67,24 @@ class Verifier:
     def distinct_count(self) -> int:
         return len(self._primary_keys())
 
-    def done(self, n: int, next_mass: float) -> bool:
-        """top distinct designs found that rank before anything of n units not yet searched."""
-        ahead = [k for k in self._primary_keys() if k[0] < n or (k[0] == n and k[1] < next_mass)]
-        return len(ahead) >= self.top
+    def done(self, n: int, next_mass: float, count: int | None = None) -> bool:
+        """count (default top) distinct designs found that rank before anything of n units not
+        yet searched. Without margin in the ranking, a shape as heavy as a design found cannot
+        pass it (they tie on every objective ranked), so ties count as ahead too."""
+        ties = "margin" not in self.problem.rank
+        ahead = [k for k in self._primary_keys()
+                 if k[0] < n or (k[0] == n and (k[1] < next_mass or (ties and k[1] <= next_mass)))]
+        return len(ahead) >= (count or self.top)
 
     def settle(self, n: int, below: float) -> None:
         """Check the pending chains of up to n units lighter than `below`, best first."""
-        ready = sorted((e for e in self.pending if e[1] < n or (e[1] == n and e[2] < below)), key=lambda e: e[0])
-        self.pending = [e for e in self.pending if not (e[1] < n or (e[1] == n and e[2] < below))]
+        ties = "margin" not in self.problem.rank  # as in done(): an equally heavy shape cannot pass
+
+        def due(e) -> bool:
+            return e[1] < n or (e[1] == n and (e[2] < below or (ties and e[2] <= below)))
+
+        ready = sorted((e for e in self.pending if due(e)), key=lambda e: e[0])
+        self.pending = [e for e in self.pending if not due(e)]
         for k, _n, _mass, shape, found, variants in ready:
             better = self._primary_keys()[: self.top]
             if len(better) >= self.top and k[:2] > better[-1][:2]:
