@@ -13,6 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import test_design_task  # tests/: the task cell the design tests search
 
 from modc.view.page import ViewError
 from modc.view.ranking import Ranking, RankingPage
@@ -192,17 +193,7 @@ def test_the_command_refuses_a_ranking_that_leads_out(ranking):
 def test_a_real_design_run_plays_in_the_page(tmp_path):
     """`modc design` on a small cell with a task: its ranking.json opens, every design plays its own file's motion."""
     cell = tmp_path / "cell.mod"
-    cell.write_text("""design small {
-    payload 100 g
-    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    units 3
-    modules H1, L3
-    task serve { visit a, b }
-    rank modules, cycle_time
-}
-""", encoding="utf-8")
+    cell.write_text(test_design_task.TASKED, encoding="utf-8")
     env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
     r = subprocess.run([sys.executable, "-m", "modc", "design", str(cell), "-o", str(tmp_path / "out"), "-q",
                         "--no-render", "--top", "2"], capture_output=True, text=True, env=env, timeout=900)
