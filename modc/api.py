@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .diagnostics.render import render_text
-from .model import Design, Robot
+from .model import Design, ResolvedRobot
 
 
 class ModcError(Exception):
@@ -34,11 +34,11 @@ def _design(path: str | Path, library: str | None) -> Design:
     return c.design
 
 
-def load_all(path: str | Path, library: str | None = None) -> list[Robot]:
-    return list(_design(path, library).robots)
+def load_all(path: str | Path, library: str | None = None) -> list[ResolvedRobot]:
+    return list(_design(path, library).resolved_robots())
 
 
-def load(path: str | Path, robot: str | None = None, library: str | None = None) -> Robot:
+def load(path: str | Path, robot: str | None = None, library: str | None = None) -> ResolvedRobot:
     """The robot called `robot`, or the file's only one; ModcError (robot-unknown) otherwise."""
     from .model.select import RobotChoiceError, choose_robot
 
@@ -48,7 +48,7 @@ def load(path: str | Path, robot: str | None = None, library: str | None = None)
         raise ModcError([e.diagnostic], {}) from None
 
 
-def chain(robot: Robot):
+def chain(robot: ResolvedRobot):
     from .kinematics import Chain
 
     return Chain(robot)

@@ -11,7 +11,6 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import tempfile
 from pathlib import Path
 
 READ_LIMIT = 256 << 20  # bytes: a cache entry larger than this is not one modc wrote
@@ -76,16 +75,9 @@ def put(kind: str, name: str, data: bytes) -> None:
     if where is None or not _PART.fullmatch(name):
         return
     try:
-        # a fresh temporary file (O_EXCL: never a planted link), then one rename, which replaces a
-        # link named like the entry and never what it points to
-        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=where)
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(data)
-            os.replace(tmp, where / name)
-        except BaseException:
-            os.unlink(tmp)
-            raise
+        from .outputs import replace_file
+
+        replace_file(where / name, data)  # replaces a link named like the entry, never what it points to
     except OSError:
         pass
 

@@ -43,7 +43,7 @@ def convert_table(text: str, path: str, name: str | None = None, fit_links: bool
     design = run_all(Design(path=path, robots=(robot,)), ctx)
     if ctx.has_errors:
         return "", ctx.diagnostics, False
-    r = design.robots[0]
+    r = design.resolved_robots()[0]
     table = compare(r)
     if as_json:
         return json.dumps({"sequence": r.sequence, "joints": table}, indent=2) + "\n", ctx.diagnostics, True

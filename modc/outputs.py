@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
 from .diagnostics import Span, codes
@@ -154,6 +154,37 @@ def write_tree(files: Mapping[str, str | bytes], out: PathLike, force: bool = Fa
         replace_tree(files, target, force, keep=lambda p: any(holds(p, src) for src in inputs))
     except ForeignOutput as e:
         _refuse_foreign(out, e.entries)
+
+
+def replace_file(path: PathLike, data: bytes, *, mode: int | None = None,
+                 before_rename: Callable[[], None] | None = None, durable: bool = False) -> None:
+    """Replace one file's contents atomically: data goes to a fresh temporary file in the same
+    directory (mkstemp: created exclusively, never a planted link), which one rename puts in
+    place, so a reader sees the old file or the whole new one, and a link named like the file
+    is replaced, never what it points to. mode: the new file's permission bits (default
+    mkstemp's 0600); durable: fsync before the rename; before_rename runs just before it and
+    may raise to keep the old file (fmt's compare-and-swap). The temporary file never stays."""
+    import tempfile  # not at import: `modc lint` loads this module and writes nothing
+
+    directory, name = os.path.split(os.fspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".tmp", dir=directory or ".")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            if durable:
+                f.flush()
+                os.fsync(f.fileno())
+        if mode is not None:
+            os.chmod(tmp, mode)
+        if before_rename is not None:
+            before_rename()
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
 
 
 # --- the caches --------------------------------------------------------------------------------

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeGuard
 
+from .formatting import json_number as _num
+
 RANGE_TOL = 1e-9  # rad: q on a joint limit, written with rounding, is still inside
 
 
@@ -72,11 +74,6 @@ class Trajectory:
         lines.append(",\n".join(pts))
         lines += ["  ]", "}"]
         return "\n".join(lines) + "\n"
-
-
-def _num(x: float) -> str:
-    v = round(float(x), 12)
-    return "0.0" if v == 0 else repr(v)
 
 
 def _number(x: object) -> TypeGuard[float]:

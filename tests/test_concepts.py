@@ -32,6 +32,17 @@ def test_every_user_takes_the_formatting_from_its_home():
         assert not hasattr(module, "_deg")
 
 
+def test_source_numbers_and_trajectory_numbers_have_their_home_too():
+    from modc import trajectory
+    from modc.model import write
+
+    assert write._num is formatting.fixed and trajectory._num is formatting.json_number
+    assert formatting.fixed(-1e-12) == "0" and formatting.fixed(45.0000000001) == "45"
+    assert formatting.fixed(0.1234567, 6) == "0.123457" and formatting.fixed(12.5) == "12.5"
+    assert formatting.json_number(-1e-13) == "0.0" and formatting.json_number(0.1 + 0.2) == "0.3"
+    assert formatting.json_number(2) == "2.0"
+
+
 def test_gravity_and_time_step_have_one_value():
     from modc.backends import mjcf
     from modc.physical import multibody
@@ -99,7 +110,9 @@ def _exp(v: np.ndarray) -> np.ndarray:
 def test_rotation_error_has_one_home_that_the_copies_equal():
     from modc.design.batch import rotation_error as batched_copy
     from modc.kinematics import rotation_error, rotation_vector
-    from modc.plan.ik import rotation_vector as ik_copy
+    from modc.plan import ik
+
+    assert ik.rotation_error is rotation_error and not hasattr(ik, "rotation_vector")  # the IK calls the home
 
     rng = np.random.default_rng(11)
     vs = [*rng.normal(size=(50, 3)), np.zeros(3), np.array([np.pi, 0, 0]), np.array([0, 1, 1]) / np.sqrt(2) * np.pi,
@@ -109,7 +122,6 @@ def test_rotation_error_has_one_home_that_the_copies_equal():
     got = rotation_vector(Rs)
     for v, R, g in zip(vs, Rs, got, strict=True):
         assert np.allclose(g, rotation_vector(R), atol=1e-12)  # one matrix or a batch: the same answer
-        assert np.allclose(g, ik_copy(R), atol=1e-9)
         if np.linalg.norm(v) < np.pi - 1e-3:  # at 180°, v and -v are the same turn
             assert np.allclose(g, v, atol=1e-7)
         else:
@@ -141,3 +153,27 @@ def test_sim_skips_the_pairs_plan_and_the_srdf_skip_from_the_matrix_in_memory(tm
     assert allowed_pairs(None, robot) == skipped
     assert allowed_pairs(tmp_path, robot) == srdf_disabled_pairs(tmp_path / "config" / f"{robot.file_stem}.srdf")
     assert allowed_pairs(tmp_path, robot) == skipped
+
+
+def test_a_targets_tolerance_is_read_from_the_target():
+    """What counts as reaching a target: Target.tolerance (plan's goals, the IK's acceptance)."""
+    from modc.model.robot import Target
+
+    plain = Target(name="a", xyz=(0.3, 0, 0.2), position_tolerance=0.002)
+    assert plain.tolerance == (0.002, math.inf) and not plain.oriented
+    assert Target(name="b", xyz=(0.3, 0, 0.2), rpy=(0, 0, 0)).tolerance == (0.005, math.radians(2.0))
+    pointing = Target(name="c", xyz=(0.3, 0, 0.2), pointing=(0, 0, -1), orientation_tolerance=0.1)
+    assert pointing.oriented and pointing.tolerance == (0.005, 0.1)
+
+
+def test_the_design_searchs_ik_seeds_are_the_planners():
+    """design/reach.py keeps an array form of plan.ik.seeds (the search's batched IK starts
+    from zero); the same seeds, in the same order, for the same rng seed."""
+    from modc.design import reach
+    from modc.plan import ik
+
+    lower, upper = np.array([-2.0, -1.0, 0.5]), np.array([2.0, 1.5, 2.5])
+    for seed in (0, 7):
+        ours = np.array(ik.seeds(np.zeros(3), lower, upper, 12, seed))
+        assert np.array_equal(reach.seeds(3, 12, lower, upper, seed), ours)
+    assert np.array_equal(ours[0], [0.0, 0.0, 0.5])  # the zero pose, clipped to the limits

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -71,10 +72,9 @@ def test_analyses_start_from_that_home(limited):
     r = c.design.robots[0]
     from modc.plan import start_pose
     from modc.sim.render import pose_of
-    from modc.sim.smoke import pose_list
 
     assert start_pose(r, None)[:2] == ("home", r.home())
-    assert pose_list(r)[0] == ("home", r.home())
+    assert r.named_poses()[0] == ("home", r.home())
     assert pose_of(r, None) == r.home()
 
 
@@ -90,3 +90,16 @@ def test_declared_home_wins_and_must_fit():
 def test_without_limits_home_stays_zero():
     r = checked_ok("robot farm { chain H1 - L4(port=45deg) - L1 }").design.robots[0]
     assert r.home() == (0.0, 0.0, 0.0)
+
+
+def test_home_then_the_named_poses_is_one_list():
+    """The SRDF's group states, the MJCF keyframes, the smoke test and the viewer all take
+    ResolvedRobot.named_poses: home first (declared anywhere in the file), then the others in order."""
+    c = checked_ok(LIMITED.replace("}", "    pose a (0, 10, 0) deg\n    pose home (0, 20, 0) deg\n"
+                                        "    pose b (0, 30, 0) deg\n}"))
+    r = c.design.resolved_robots()[0]
+    assert [n for n, _ in r.named_poses()] == ["home", "a", "b"]
+    assert r.named_poses()[0][1] == r.home() == pytest.approx((0.0, math.radians(20.0), 0.0))
+
+    srdf = build(c, only=["srdf"])[f"config/{r.file_stem}.srdf"]
+    assert re.findall(r'group_state name="([^"]+)"', srdf) == ["home", "a", "b"]

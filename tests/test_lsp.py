@@ -831,3 +831,32 @@ def test_parameters_are_the_lowerings():
     assert language.UNIT_PARAMS == tuple(lower.UNIT_PARAMS) and language.DH_PARAMS == tuple(lower.DH_PARAMS)
     assert set(language.PARAM_TEXT) == set(lower.UNIT_PARAMS) | set(lower.DH_PARAMS)
     assert all(kind in language.KIND_MEASURES for kind, _ in language.PARAMS.values())
+
+
+@pytest.mark.parametrize("text", [
+    "robot a {\n    chain H1 - L1\n    library nosuchlib\n    limit joint_1 (-90, 90) deg\n}\n",  # no library
+    "robot a {\n    chain H1 - Q7\n    limit joint_2 (-90, 90) deg\n}\n",  # a unit the library lacks
+])
+def test_hover_on_a_joint_of_an_unresolved_robot(text):
+    """The joint's range needs the resolved library and the unit's variant; without them the
+    hover says which unit it is (it used to fail: an assertion, a KeyError)."""
+    an = Analysis(text, "/x/a.mod")
+    h = hover(an, text.index("joint_") + 2)
+    assert h is not None and "the joint of unit" in h.contents.value and "range" not in h.contents.value
+
+
+def test_the_library_is_the_checked_robots_not_looked_up_again(monkeypatch):
+    """The LSP takes a robot's library from the checked model (resolve_library found it once);
+    only a block that does not lower yet reads its `library` statement; a library that did not
+    load gives the default (no second lookup of the same name)."""
+    from modc.lsp import document
+
+    text = "robot a {\n    chain H1 - L1\n    library mark2-strict\n}\n"
+    an = Analysis(text, "/x/a.mod")
+    r = an.model_robot("a")
+    calls: list[str] = []
+    monkeypatch.setattr(document, "load_library", lambda ref, where=None: calls.append(ref))
+    assert an.library_for("a") is r.library and r.library.name == "mark2-strict" and calls == []
+    bad = Analysis("robot b {\n    chain H1 - L1\n    library nosuchlib\n}\n", "/x/b.mod")
+    assert bad.model_robot("b") is not None
+    assert bad.library_for("b").name == "mark2" and calls == []

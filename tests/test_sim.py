@@ -79,7 +79,7 @@ def test_every_example_passes_sim(path):
     assert checked.ok
     assert ok, "\n".join(lines)
     for r in checked.design.robots:
-        for name, _ in smoke.pose_list(r):
+        for name, _ in r.named_poses():
             assert any(line.strip().startswith(f"pose {name}: ok") for line in lines), lines
 
 

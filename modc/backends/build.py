@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..diagnostics import Diagnostic
-from ..model import Design, Robot
+from ..model import Design, ResolvedRobot
 from ..physical.assembly import Description, describe
 
 
@@ -26,12 +26,16 @@ class Build:
     package_license: str | None = None
     maintainer: str | None = None
     _descriptions: dict[str, Description] = field(default_factory=dict)
+    robots: tuple[ResolvedRobot, ...] = field(init=False)  # the design's robots, every library resolved
+
+    def __post_init__(self) -> None:
+        self.robots = self.design.resolved_robots()
 
     @property
     def source_name(self) -> str:
         return Path(self.design.path).name
 
-    def description(self, robot: Robot) -> Description:
+    def description(self, robot: ResolvedRobot) -> Description:
         if robot.name not in self._descriptions:
             self._descriptions[robot.name] = describe(robot)
         return self._descriptions[robot.name]

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from .._version import __version__
 from ..kinematics import matrix_rpy
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..physical import collisions
 from ..physical.assembly import Description
 from .build import Build
@@ -33,7 +33,7 @@ def options(build: Build) -> tuple[int, int]:
     return samples, seed
 
 
-def collision_matrix(build: Build, robot: Robot) -> collisions.CollisionMatrix:
+def collision_matrix(build: Build, robot: ResolvedRobot) -> collisions.CollisionMatrix:
     """The robot's self-collision matrix, computed once per build (every backend shares it)."""
     samples, seed = options(build)
     cache = build.__dict__.setdefault(_CACHE, {})

@@ -9,6 +9,6 @@ from .registry import register
 @register("meshes", "binary STL meshes of the parts: meshes/*.stl")
 def emit(build: Build):
     parts = {}
-    for r in build.design.robots:
+    for r in build.robots:
         parts.update(build.description(r).parts)
     return {f"meshes/{name}.stl": stl_bytes(part) for name, part in sorted(parts.items())}

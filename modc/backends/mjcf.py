@@ -46,7 +46,7 @@ import numpy as np
 
 from .._version import __version__
 from ..kinematics import matrix_rpy, transform
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..physical.assembly import Description
 from ..physical.constants import GRAVITY_VECTOR, TIME_STEP
 from ..physical.parts import Primitive
@@ -78,15 +78,14 @@ def vec(xs) -> str:
     return " ".join(num(x) for x in xs)
 
 
-def derivative_time(robot: Robot) -> float:
+def derivative_time(robot: ResolvedRobot) -> float:
     """s: the library's d/p (the paper's 0.05 / 2). Its i is not modelled: a position servo has
     no integral term (the paper's is 0)."""
-    assert robot.library is not None
     control = robot.library.control
     return control.d / control.p
 
 
-def gains(robot: Robot, torque_peak: float) -> tuple[float, float]:
+def gains(robot: ResolvedRobot, torque_peak: float) -> tuple[float, float]:
     """(kp N·m/rad, kv N·m·s/rad) of one joint's position servo."""
     kp = torque_peak / ERROR_AT_PEAK
     return kp, kp * derivative_time(robot)
@@ -121,7 +120,7 @@ def collision_geom(p: Primitive, T_link_part) -> dict:
     return {"type": "cylinder", "size": vec((radius, height / 2.0)), **placement(T)}
 
 
-def _bodies(desc: Description, robot: Robot) -> list[dict]:
+def _bodies(desc: Description, robot: ResolvedRobot) -> list[dict]:
     """The kinematic tree as nested bodies (children lists), base_link at the root."""
     links = {link.name: link for link in desc.links}
     by_parent: dict[str, list] = {}
@@ -158,7 +157,7 @@ def _assets(desc: Description) -> list[dict]:
     return [seen[k] for k in sorted(seen)]
 
 
-def _servos(robot: Robot, joints) -> tuple[list[dict], list[dict]]:
+def _servos(robot: ResolvedRobot, joints) -> tuple[list[dict], list[dict]]:
     """(servo classes, one per actuator variant; actuators, one per joint). A joint whose peak
     torque differs from its variant's class carries its own gains."""
     classes: dict[str, dict] = {}
@@ -173,7 +172,7 @@ def _servos(robot: Robot, joints) -> tuple[list[dict], list[dict]]:
     return list(classes.values()), actuators
 
 
-def _gains_text(robot: Robot, j) -> dict:
+def _gains_text(robot: ResolvedRobot, j) -> dict:
     kp, kv = gains(robot, j.limits.effort)
     try:
         return {"kp": num(kp), "kv": num(kv), "forcerange": vec((-j.limits.effort, j.limits.effort))}
@@ -183,14 +182,14 @@ def _gains_text(robot: Robot, j) -> dict:
                         f"{ERROR_AT_PEAK:g} rad, kv = kp · d/p)") from None
 
 
-def context(build: Build, robot: Robot) -> dict:
+def context(build: Build, robot: ResolvedRobot) -> dict:
     desc = build.description(robot)
     joints = [j for j in desc.joints if j.kind == "revolute"]
     servo_classes, actuators = _servos(robot, joints)
-    poses = [("home", robot.home())] + [(p.name, p.q) for p in robot.poses if p.name != "home"]
+    poses = robot.named_poses()
     return {
         "name": robot.file_stem, "robot": comment(robot.name), "sequence": comment(robot.sequence),
-        "source": comment(build.source_name), "library": comment(robot.library.name if robot.library else ""),
+        "source": comment(build.source_name), "library": comment(robot.library.name),
         "version": __version__, "timestep": num(TIME_STEP), "gravity": vec(GRAVITY_VECTOR),
         "armature": num(ARMATURE), "visual_group": VISUAL_GROUP, "collision_group": COLLISION_GROUP,
         "materials": [{"name": k, "rgba": vec(v)} for k, v in MATERIALS.items()],
@@ -202,21 +201,21 @@ def context(build: Build, robot: Robot) -> dict:
     }
 
 
-def mjcf_text(build: Build, robot: Robot) -> str:
+def mjcf_text(build: Build, robot: ResolvedRobot) -> str:
     return render("mjcf/robot.xml.j2", _finite(robot, lambda: context(build, robot)))
 
 
-def scene_name(robot: Robot) -> str:
+def scene_name(robot: ResolvedRobot) -> str:
     return f"{SCENE_PREFIX}{robot.file_stem}.xml"
 
 
-def scene_text(build: Build, robot: Robot) -> str:
+def scene_text(build: Build, robot: ResolvedRobot) -> str:
     from .mjcf_scene import scene_context
 
     return render("mjcf/scene.xml.j2", _finite(robot, lambda: scene_context(build, robot)))
 
 
-def _finite(robot: Robot, make):
+def _finite(robot: ResolvedRobot, make):
     """make(), or a not-finite diagnostic (at the robot's `library` statement, where the number
     comes from, else at the robot) when a number of the model is infinite or not a number."""
     from ..diagnostics import NOWHERE, codes
@@ -235,7 +234,7 @@ def _finite(robot: Robot, make):
           heavy=True)
 def emit(build: Build):
     files = {}
-    for r in build.design.robots:
+    for r in build.robots:
         files[f"mjcf/{r.file_stem}.xml"] = mjcf_text(build, r)
         files[f"mjcf/{scene_name(r)}"] = scene_text(build, r)
     return files

@@ -23,7 +23,7 @@ import numpy as np
 
 from .._version import __version__
 from ..kinematics import matrix_rpy, rpy_matrix, transform
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
 from . import Build
 from .mjcf import TARGET_PREFIX, num, placement, vec
@@ -38,7 +38,7 @@ FLOOR_MARGIN = 1e-3  # m under the lowest point when the scene reaches below z =
 
 
 
-def _cell(robot: Robot, T_world_base) -> tuple[list[dict], list[dict]]:
+def _cell(robot: ResolvedRobot, T_world_base) -> tuple[list[dict], list[dict]]:
     """Obstacles (world geoms) and targets (world sites), given in base_link, placed in the world."""
     geoms = []
     for ob in robot.obstacles:
@@ -56,11 +56,11 @@ def _cell(robot: Robot, T_world_base) -> tuple[list[dict], list[dict]]:
     return geoms, sites
 
 
-def _keyframe_points(robot: Robot, T_world_base):
+def _keyframe_points(robot: ResolvedRobot, T_world_base):
     """World points bounding the arm in every keyframe, the obstacles and the targets."""
     from ..physical.cell import extent_points  # points in pairs: a centre widened by its radius either way
 
-    poses = [robot.home()] + [p.q for p in robot.poses if p.name != "home"]
+    poses = [q for _, q in robot.named_poses()]
     return np.concatenate([extent_points(robot, q, T_world_base) for q in poses])
 
 
@@ -81,7 +81,7 @@ def _camera(points) -> dict:
             "distance": float(np.linalg.norm(eye - target))}
 
 
-def scene_context(build: Build, robot: Robot) -> dict:
+def scene_context(build: Build, robot: ResolvedRobot) -> dict:
     from ..physical import cell as scene
 
     T_world_base = transform(robot.base.xyz, robot.base.rpy)

@@ -48,7 +48,7 @@ def emit(build: Build):
     doc = {
         "generator": f"modc {__version__}",
         "source": build.source_name,
-        "robots": [robot_report(build, r) for r in build.design.robots],
+        "robots": [robot_report(build, r) for r in build.robots],
         "diagnostics": [d.to_json() for d in build.diagnostics],
         "outputs": outputs,
     }

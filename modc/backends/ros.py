@@ -238,7 +238,7 @@ def context(build: Build, robot, target: Target) -> dict:
         "maintainer": target.maintainer[0],
         "maintainer_email": target.maintainer[1],
         "placeholder_note": _placeholder_note(target),
-        "robots": ", ".join(f"{r.name} = {r.sequence}" for r in build.design.robots),
+        "robots": ", ".join(f"{r.name} = {r.sequence}" for r in build.robots),
         "depends": exec_depends(target),
         # mjcf/ when that backend is in this build (it runs before this one)
         "directories": [
@@ -351,7 +351,7 @@ def robot_outputs(build: Build, robot, target: Target) -> dict[str, str]:
 
 
 def emit_package(build: Build) -> dict[str, str]:
-    robots = build.design.robots
+    robots = build.robots
     if not robots:
         return {}
     target = resolve(build)

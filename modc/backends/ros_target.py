@@ -162,7 +162,7 @@ def resolve(build) -> Target:
     if iface not in COMMAND_INTERFACES:
         raise RosOptionError(f"unknown ros2_control command interface '{iface}' "
                              f"(choose from {', '.join(COMMAND_INTERFACES)})")
-    robots = build.design.robots
+    robots = build.robots
     package = build.ros_package or package_name(robots[0].name if robots else "modc")
     if not valid_package_name(package):
         raise RosOptionError(f"'{names.shown(package, 80)}' is not a valid ROS package name "

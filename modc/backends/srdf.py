@@ -21,7 +21,7 @@ returned by warnings(build) for the driver to report.
 from __future__ import annotations
 
 from .._version import __version__
-from ..model import Robot, Transform
+from ..model import ResolvedRobot, Transform
 from ..physical import collisions
 from .build import Build
 from .common import BASE_LINK, GROUP, TIP_LINK, TOOL_GROUP, collision_matrix, options
@@ -36,7 +36,7 @@ __all__ = ["BASE_LINK", "GROUP", "TIP_LINK", "TOOL_GROUP", "collision_matrix", "
 FRAME_LINKS = ("tool0", "payload")  # frames without geometry by design: no warning for them
 
 
-def robot_warnings(robot: Robot, matrix: collisions.CollisionMatrix) -> list[str]:
+def robot_warnings(robot: ResolvedRobot, matrix: collisions.CollisionMatrix) -> list[str]:
     out = []
     bare = [link for link in matrix.links_without_geometry if link not in FRAME_LINKS]
     if bare:
@@ -50,24 +50,23 @@ def robot_warnings(robot: Robot, matrix: collisions.CollisionMatrix) -> list[str
 
 def warnings(build: Build) -> list[str]:
     """Warnings about every robot of the build, one line each (computes the matrices if needed)."""
-    return [w for r in build.design.robots for w in robot_warnings(r, collision_matrix(build, r))]
+    return [w for r in build.robots for w in robot_warnings(r, collision_matrix(build, r))]
 
 
-def has_tool(robot: Robot) -> bool:
+def has_tool(robot: ResolvedRobot) -> bool:
     return robot.tool != Transform() or robot.payload is not None
 
 
-def context(build: Build, robot: Robot) -> dict:
+def context(build: Build, robot: ResolvedRobot) -> dict:
     desc = build.description(robot)
     matrix = collision_matrix(build, robot)
     joints = [j.name for j in desc.joints if j.kind != "fixed"]
-    states = [("home", robot.home())] + [(p.name, p.q) for p in robot.poses if p.name != "home"]
+    states = robot.named_poses()
     tool = None
     if has_tool(robot):
         parent = next(j.parent for j in desc.joints if j.child == TIP_LINK)
         links = [TIP_LINK] + [j.child for j in desc.joints if j.parent == TIP_LINK]
         tool = {"group": TOOL_GROUP, "links": links, "parent_link": parent}
-    assert robot.library is not None  # resolved before any backend runs
     return {
         "name": robot.file_stem, "robot": robot.name, "sequence": robot.sequence, "source": comment(build.source_name),
         "library": comment(robot.library.name), "version": __version__,
@@ -80,10 +79,10 @@ def context(build: Build, robot: Robot) -> dict:
     }
 
 
-def srdf_text(build: Build, robot: Robot) -> str:
+def srdf_text(build: Build, robot: ResolvedRobot) -> str:
     return render("srdf.xml.j2", context(build, robot))
 
 
 @register("srdf", "MoveIt SRDF per robot (groups, poses, self-collision matrix): config/mod<n>_<name>.srdf", heavy=True)
 def emit(build: Build):
-    return {f"config/{r.file_stem}.srdf": srdf_text(build, r) for r in build.design.robots}
+    return {f"config/{r.file_stem}.srdf": srdf_text(build, r) for r in build.robots}

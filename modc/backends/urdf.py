@@ -15,4 +15,4 @@ def urdf_text(build: Build, robot, mesh_prefix: str = "../meshes/") -> str:
 
 @register("urdf", "URDF per robot: urdf/mod<n>_<name>.urdf")
 def emit(build: Build):
-    return {f"urdf/{r.file_stem}.urdf": urdf_text(build, r) for r in build.design.robots}
+    return {f"urdf/{r.file_stem}.urdf": urdf_text(build, r) for r in build.robots}

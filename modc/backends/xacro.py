@@ -30,7 +30,7 @@ from markupsafe import Markup
 
 from .._version import __version__
 from ..kinematics import A_J, matrix_rpy
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..model.library import Library
 from ..physical.inertia import Inertial, combine, part_inertial
 from ..physical.parts import Part, Primitive, unit_parts
@@ -205,7 +205,7 @@ def unit_data(lib: Library, variant: str, kind: int) -> dict:
     expected = {"twist_unit": "base", "input_casing": "twist1", "actuator": "twist1", "output_casing": "link"}
     if {r: d["body"] for r, d in placed.items()} != expected or (link_module is not None) != t.link:
         raise AssertionError(f"unit {variant}{kind}: parts changed ({sorted(placed)}); update modc/backends/xacro.py")
-    lo, hi = math.radians(v.lower_deg), math.radians(v.upper_deg)
+    lo, hi = v.joint_range
     data: dict[str, Any] = {"effort": v.actuator.torque_peak, "velocity": v.actuator.velocity, "lower": lo, "upper": hi}
     for b in BODIES:
         data[b] = _inertial(combine(bodies[b]))
@@ -297,25 +297,23 @@ def modules_text(entries: list[LibraryEntry], source: str) -> str:
 # robots
 
 
-def macro_name(robot: Robot) -> str:
+def macro_name(robot: ResolvedRobot) -> str:
     return _ident(robot.file_stem)
 
 
-def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) -> dict:
+def robot_context(build: Build, robot: ResolvedRobot, entry: LibraryEntry, source: str) -> dict:
     desc = build.description(robot)
     lib = robot.library
-    assert lib is not None  # resolved before any backend runs
     units = []
     parent = "base_link"
     for i, u in enumerate(robot.units):
         n = i + 1
         t = lib.units[u.kind]
-        v = lib.variants[u.variant]
         params = [("pivot", _deg(u.pivot))]
         if t.link:
             params += [("port", _deg(u.port)), ("link", num(robot.link_length(u)))]
         lo, hi = robot.joint_range(n)
-        if (lo, hi) != (math.radians(v.lower_deg), math.radians(v.upper_deg)):  # narrowed by `limit`
+        if (lo, hi) != robot.hardware_range(n):  # narrowed by `limit`
             params += [("lower", num(lo)), ("upper", num(hi))]
         units.append({"n": n, "name": u.name, "macro": f"{entry.ident}_unit{u.kind}", "variant": _key(u.variant),
                       "parent": parent, "params": params})
@@ -345,7 +343,7 @@ def robot_context(build: Build, robot: Robot, entry: LibraryEntry, source: str) 
 
 
 def xacro_files(build: Build) -> dict[str, str]:
-    robots = build.design.robots
+    robots = build.robots
     if not robots:
         return {}
     source = build.source_name

@@ -17,16 +17,15 @@ from __future__ import annotations
 from itertools import combinations
 
 from .._version import __version__
-from ..model import Robot
+from ..model import ResolvedRobot
 from .build import Build
 from .common import collision_matrix
 from .templates import comment, render
 
 
-def body_of(robot: Robot) -> dict[str, str]:
+def body_of(robot: ResolvedRobot) -> dict[str, str]:
     """Macro-form link with geometry -> the URDF link whose geometry contains it (xacro.LINKS)."""
     lib = robot.library
-    assert lib is not None, "a checked robot has its library"
     out: dict[str, str] = {}
     for n, unit in enumerate(robot.units, start=1):
         carrier = "base_link" if n == 1 else f"link_{n - 1}"  # the input side rides on the previous link
@@ -38,7 +37,7 @@ def body_of(robot: Robot) -> dict[str, str]:
     return out
 
 
-def disabled_pairs(build: Build, robot: Robot) -> list[tuple[str, str, str]]:
+def disabled_pairs(build: Build, robot: ResolvedRobot) -> list[tuple[str, str, str]]:
     """(link1, link2, reason) over the macro form's links with geometry, in macro-link order."""
     urdf_reasons = {frozenset((p.link1, p.link2)): p.reason for p in collision_matrix(build, robot).disabled}
     bodies = body_of(robot)
@@ -51,7 +50,7 @@ def disabled_pairs(build: Build, robot: Robot) -> list[tuple[str, str, str]]:
     return out
 
 
-def macro_srdf_text(build: Build, robot: Robot, macro: str, source: str) -> str:
+def macro_srdf_text(build: Build, robot: ResolvedRobot, macro: str, source: str) -> str:
     return render("xacro/robot_macro.srdf.xacro.j2", {
         "version": __version__, "source": comment(source), "robot": robot.name, "sequence": robot.sequence,
         "name": robot.file_stem, "macro": f"{macro}_srdf",

@@ -181,7 +181,7 @@ def dh_cmd(file: str, json_out: bool, library: str | None) -> None:
     if not checked.ok:
         _print_diagnostics(checked.diagnostics, checked.sources)
         raise SystemExit(EXIT_ERRORS)
-    robots = checked.design.robots
+    robots = checked.design.resolved_robots()
     if json_out:
         doc = {"robots": [{"name": r.name, "sequence": r.sequence, "joints": compare(r)} for r in robots]}
         print(json.dumps(doc, indent=2))

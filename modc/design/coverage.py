@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Robot
+from ..model import ResolvedRobot, Robot
 
 
-def reached(robot: Robot, seed: int) -> tuple[set[str], int]:
+def reached(robot: ResolvedRobot, seed: int) -> tuple[set[str], int]:
     """The names of the region points the robot reaches clear of the cell, and how many there are."""
     from ..kinematics import rpy_matrix
     from ..plan import IK_BATCHES, IK_SEEDS_PER_JOINT, start_pose
@@ -39,7 +39,7 @@ def reached(robot: Robot, seed: int) -> tuple[set[str], int]:
     return out, len(points)
 
 
-def served(robot: Robot, points: set[str]) -> Robot:
+def served(robot: ResolvedRobot, points: set[str]) -> ResolvedRobot:
     """The robot with its tasks visiting only the region points in `points` (targets stay)."""
     names = {p.name for r in robot.regions for p in r.points()}
     tasks = tuple(t.model_copy(update={"visits": tuple(v for v in t.visits if v not in names or v in points)})

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import Pose, Problem, Robot, UnitSpec
+from ..model import Pose, Problem, ResolvedRobot, Robot, UnitSpec
 from . import reach
 from .batch import Geometry, forward, geometry
 from .screen import Obstacles, collides, segment_radii
@@ -156,7 +156,7 @@ class Candidate:
 
 @dataclass(frozen=True)
 class Verified:
-    robot: Robot  # checked, with one pose per target
+    robot: ResolvedRobot  # checked, with one pose per target
     mass: float  # kg, the arm without payload
     margin: float  # smallest share of peak torque left over the joints
     targets: dict[str, dict]  # name -> {"q", "position_error_m", "orientation_error_deg"}
@@ -188,7 +188,7 @@ def verify(problem: Problem, cand: Candidate) -> Verified | str:
     if not checked.ok:
         d = next(d for d in checked.diagnostics if d.is_error)
         return f"{d.code}: {d.message}"
-    robot = checked.design.robots[0]
+    robot = checked.design.resolved_robots()[0]
     checker = CollisionChecker(robot, margin=VERIFY_MARGIN)
     if checker.static_contacts():
         return "base_link touches the cell"

@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from ..model import Problem, Robot, Transform
+from ..model import Problem, Robot, Transform, resolved
 from .rank import Design, order
 
 if TYPE_CHECKING:
@@ -60,7 +60,10 @@ def _turn(R: np.ndarray, d) -> Vec | None:
     return (float(v[0]), float(v[1]), float(v[2]))
 
 
-def cell_at(cell: Robot, pose: Transform) -> Robot:
+_R = TypeVar("_R", bound=Robot)
+
+
+def cell_at(cell: _R, pose: Transform) -> _R:
     """The cell written in the frame of a base at `pose` (cell frame), with `base at` the pose.
 
     Regions are axis-aligned boxes: a yawed base keeps them only at yaw 0 (modc.model.lower_task
@@ -107,7 +110,7 @@ def base_blocked(problem: Problem, pose: Transform) -> bool:
     assert lib is not None
     if not problem.cell.obstacles:
         return False
-    cell = cell_at(problem.cell, pose)
+    cell = cell_at(resolved(problem.cell, lib), pose)
     for v in lib.variants:
         for k in lib.units:
             if not space.allowed(problem, v, k):

@@ -61,7 +61,7 @@ def _static(problem: Problem, ref: Robot) -> tuple[float | None, float | None, s
     if not checked.ok:
         d = next(d for d in checked.diagnostics if d.is_error)
         return None, None, f"{d.code}: {d.message}"
-    robot = checked.design.robots[0]
+    robot = checked.design.resolved_robots()[0]
     payload = robot.payload.mass if robot.payload else 0.0
     margin = min(j.margin for j in robot.torque) if robot.torque else 1.0
     return library_mass(robot) - payload, float(margin), None

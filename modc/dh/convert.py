@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 from ..diagnostics import Diagnostic, codes
 from ..formatting import angle
-from ..model import Robot, Transform, UnitSpec
+from ..model import Robot, Transform, UnitSpec, resolved
 from ..model.library import Library
 
 TOL_A = 1e-6  # m: below this an a is zero
@@ -112,7 +112,7 @@ def choose_variants(robot: Robot, lib: Library, units: tuple[UnitSpec, ...], too
     best: tuple[float, list[str]] | None = None
     for k in feasible:
         variants = [heavy] * k + [light] * (n - k)
-        trial = robot.model_copy(update={"units": with_variants(units, variants), "tool": tool, "library": lib})
+        trial = resolved(robot, lib, units=with_variants(units, variants), tool=tool)
         worst = Statics(trial).worst(samples=64)
         nominal = [lib.variants[v].actuator.torque_nominal for v in variants]
         margin = min((t_nom - t) / t_nom for t_nom, t in zip(nominal, worst, strict=True))

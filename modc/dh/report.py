@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 
 from ..kinematics import Chain
-from ..model import Robot
+from ..model import ResolvedRobot
 from .extract import realised_dh
 
 
@@ -12,7 +12,7 @@ def _row(a: float, alpha: float, d: float) -> dict:
     return {"a": round(a, 12) + 0.0, "alpha": round(alpha, 12) + 0.0, "d": round(d, 12) + 0.0}
 
 
-def compare(robot: Robot) -> list[dict]:
+def compare(robot: ResolvedRobot) -> list[dict]:
     """Per joint: realised (a, alpha, d), and the requested row when the robot came from a DH table."""
     requested = list(robot.dh) if robot.dh else None
     prefer = [r.alpha for r in requested] if requested else None
@@ -28,7 +28,7 @@ def compare(robot: Robot) -> list[dict]:
     return out
 
 
-def text_table(robot: Robot) -> str:
+def text_table(robot: ResolvedRobot) -> str:
     rows = compare(robot)
     has_req = any("requested" in r for r in rows)
     head = f"{'joint':<8}{'a (m)':>10}{'alpha (deg)':>13}{'d (m)':>10}"

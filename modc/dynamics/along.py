@@ -41,7 +41,6 @@ def peaks(dyn: Dynamics, traj) -> list[JointPeak]:
     tau = np.abs(torques(dyn, traj.t, traj.q))
     out = []
     lib = robot.library
-    assert lib is not None
     for i, name in enumerate(names):
         k = int(np.argmax(tau[:, i]))
         act = lib.variants[robot.units[i].variant].actuator

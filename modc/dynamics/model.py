@@ -12,13 +12,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..diagnostics.span import NOWHERE
-from ..model import Payload, Robot
+from ..model import Payload, ResolvedRobot
 from ..physical.multibody import gravity
 
 PayloadOverride = tuple[float, tuple[float, float, float]]  # (kg, centre of mass in tool0, m)
 
 
-def with_payload(robot: Robot, payload: PayloadOverride | None) -> Robot:
+def with_payload(robot: ResolvedRobot, payload: PayloadOverride | None) -> ResolvedRobot:
     """The robot carrying another payload (None: the file's own)."""
     if payload is None:
         return robot
@@ -27,7 +27,7 @@ def with_payload(robot: Robot, payload: PayloadOverride | None) -> Robot:
 
 
 class Dynamics:
-    def __init__(self, robot: Robot, payload: PayloadOverride | None = None):
+    def __init__(self, robot: ResolvedRobot, payload: PayloadOverride | None = None):
         import pinocchio as pin
 
         from ..physical import multibody

@@ -102,7 +102,7 @@ def worst_case(dyn: Dynamics, samples: int = 512, refine: int = 4, seed: int = 0
             val, q = _ascend(dyn, i, Q[k].copy())
             if val > best_val:
                 best_val, best_q = val, q
-        assert best_q is not None and lib is not None
+        assert best_q is not None
         best_val, best_q = _canonical(dyn, i, best_val, best_q)
         act = lib.variants[robot.units[i].variant].actuator
         out.append(JointWorst(f"joint_{i + 1}", robot.units[i].name, float(best_val), tuple(float(x) for x in best_q),

@@ -28,6 +28,7 @@ from lark import Token, Tree
 from lsprotocol import types
 
 from ..compiler import YAML_SUFFIXES, Checked, check_text
+from ..model import ResolvedRobot, Robot
 from ..model.library import Library
 from ..model.library import default as default_library
 from ..model.library import load as load_library
@@ -278,7 +279,7 @@ class Analysis:
         return str(block.name) if block is not None and block.name is not None else None
 
     @cached_property
-    def model_robots(self) -> tuple:
+    def model_robots(self) -> tuple[Robot, ...]:
         """The checked robots; none if the check itself fails (a compiler bug, which the
         server reports as a diagnostic): the token view still serves every feature."""
         try:
@@ -286,7 +287,7 @@ class Analysis:
         except Exception:
             return ()
 
-    def model_robot(self, name: str | None):
+    def model_robot(self, name: str | None) -> Robot | None:
         if name is None:
             return None
         return next((r for r in self.model_robots if r.name == name), None)
@@ -300,12 +301,13 @@ class Analysis:
             return None
 
     def library_for(self, robot: str | None) -> Library:
-        """The robot's module library: the checked model's, else its `library` statement's,
-        else the default."""
+        """The robot's module library: the checked model's (resolved once, by the compiler's
+        resolve_library pass); for a block the file does not lower yet (half typed), its
+        `library` statement's; else the default (also for a library that did not load)."""
         r = self.model_robot(robot)
-        if r is not None and r.library is not None:
+        if isinstance(r, ResolvedRobot):
             return r.library
-        block = next(iter(self.blocks_named(robot)), None)
+        block = next(iter(self.blocks_named(robot)), None) if r is None else None
         if block is not None:
             for st in block.find("library"):
                 ref = tokens_of(st)

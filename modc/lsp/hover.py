@@ -9,6 +9,7 @@ import math
 from lsprotocol import types
 
 from ..diagnostics import REGISTRY
+from ..model import ResolvedRobot
 from ..model.library import Library
 from .document import Analysis, Tok, joint_number
 from .language import MEASURES, PARAMS, REFERS, UNIT_PARAMS, keyword_doc, name_takers
@@ -131,7 +132,9 @@ def _library_markdown(an: Analysis, ref: str) -> str | None:
 
 def _joint_markdown(an: Analysis, robot: str | None, n: int) -> str | None:
     r = an.model_robot(robot)
-    if r is None or not 1 <= n <= r.dof:
+    # the range needs the library and the unit's variant: a robot whose library did not load, or
+    # a unit the library does not know, gets the plain text
+    if not isinstance(r, ResolvedRobot) or not 1 <= n <= r.dof or not r.units[n - 1].variant:
         units = an.units_of(robot) if robot else []
         if 1 <= n <= len(units):
             return f"**joint_{n}**: the joint of unit {n} ({units[n - 1][0]})"

@@ -1,6 +1,20 @@
 """The model: the module library (data) and the checked robot model (SI units)."""
 from .library import Library, LibraryError
-from .robot import Design, DHRow, JointLimit, Obstacle, Payload, Pose, Problem, Robot, Target, Transform, UnitSpec
+from .robot import (
+    Design,
+    DHRow,
+    JointLimit,
+    Obstacle,
+    Payload,
+    Pose,
+    Problem,
+    ResolvedRobot,
+    Robot,
+    Target,
+    Transform,
+    UnitSpec,
+    resolved,
+)
 
 __all__ = [
     "Library",
@@ -12,8 +26,10 @@ __all__ = [
     "Payload",
     "Pose",
     "Problem",
+    "ResolvedRobot",
     "Robot",
     "Target",
     "Transform",
     "UnitSpec",
+    "resolved",
 ]

@@ -141,6 +141,14 @@ class Variant(Record):
         if not self.lower_deg < self.upper_deg:
             raise ValueError("lower_deg must be below upper_deg")
 
+    @property
+    def joint_range(self) -> tuple[float, float]:
+        """The joint's hardware position limits in radians (the file gives degrees): the one
+        conversion every check, backend and analysis reads (ResolvedRobot.joint_range narrows it)."""
+        import math
+
+        return (math.radians(self.lower_deg), math.radians(self.upper_deg))
+
 
 class UnitType(Record):
     """One of the paper's four modular units (section 3.1, eqs. 7-10)."""

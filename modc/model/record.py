@@ -51,6 +51,10 @@ class Record:
             if name not in fields:
                 fields.append(name)
             value = cls.__dict__.get(name, _MISSING)
+            if value is _MISSING:  # redeclared without a default (a narrower type): required, as in dataclasses
+                defaults.pop(name, None)
+                factories.pop(name, None)
+                continue
             if isinstance(value, Field):
                 delattr(cls, name)
                 if value.hidden:

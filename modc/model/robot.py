@@ -4,6 +4,7 @@ Backends read only this (and the library it points to), never the syntax.
 """
 from __future__ import annotations
 
+import math
 from typing import ClassVar, Literal
 
 from ..diagnostics import NOWHERE, Span
@@ -113,6 +114,17 @@ class Target(Value):
     orientation_tolerance: float = ORIENTATION_TOLERANCE
     span: Span = hidden(NOWHERE)
     pointing: Vec3 | None = None  # unit vector in base_link: tool0's x axis (the approach) only; never with rpy
+
+    @property
+    def oriented(self) -> bool:
+        """Whether the target asks for an orientation (a full rpy, or the approach direction)."""
+        return self.rpy is not None or self.pointing is not None
+
+    @property
+    def tolerance(self) -> tuple[float, float]:
+        """(m, rad): how near tool0 must come to count as on the target, the bounds plan.ik.solve
+        accepts a run within; a position-only target has no bound on the orientation."""
+        return (self.position_tolerance, self.orientation_tolerance if self.oriented else math.inf)
 
 
 MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; beyond this, a typo
@@ -250,13 +262,6 @@ class Robot(Value):
         """docs/conventions.md: the URDF for the Kinova bring-up is named mod<n>_<name>."""
         return f"mod{self.dof}_{self.name}"
 
-    def link_length(self, u: UnitSpec) -> float:
-        assert self.library is not None
-        t = self.library.units[u.kind]
-        if not t.link:
-            return 0.0
-        return t.x23 if u.link is None else u.link
-
     def task_target(self, name: str) -> Target | None:
         """A target, or a region's point (`tray[1,0,0]`), by name."""
         t = next((t for t in self.targets if t.name == name), None)
@@ -275,12 +280,40 @@ class Robot(Value):
     def pose(self, name: str) -> Pose | None:
         return next((p for p in self.poses if p.name == name), None)
 
+
+class ResolvedRobot(Robot):
+    """A robot whose library is resolved: what every pass after resolve_library, every backend
+    and every analysis reads. Made only by `resolved` (the resolve_library and check_problems
+    passes), so `library` is never None and the type checker proves it where it is read."""
+
+    library: Library
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.library, Library):
+            raise InvalidModel("a resolved robot has its module library")
+
+    def hardware_range(self, i: int) -> tuple[float, float]:
+        """Joint i's (1-based) range in the library, rad, before any `limit` narrows it."""
+        return self.library.variants[self.units[i - 1].variant].joint_range
+
+    def link_length(self, u: UnitSpec) -> float:
+        t = self.library.units[u.kind]
+        if not t.link:
+            return 0.0
+        return t.x23 if u.link is None else u.link
+
     def home(self) -> tuple[float, ...]:
         """The one home pose (rad) of every backend and analysis: the pose declared `home`, else
         MoveIt's default joint values (default_q). check_poses reports a declared home outside
         the limits (pose-out-of-limits), so a checked robot's home is always inside them."""
         p = self.pose("home")
         return tuple(p.q) if p is not None else self.default_q()
+
+    def named_poses(self) -> list[tuple[str, tuple[float, ...]]]:
+        """(name, q) of home (as home()) first, then every other declared pose in file order: the
+        SRDF's group states, the MJCF keyframes, the smoke test's poses and the viewer's list."""
+        return [("home", self.home())] + [(p.name, tuple(p.q)) for p in self.poses if p.name != "home"]
 
     def default_q(self) -> tuple[float, ...]:
         """MoveIt's default joint values (RobotState::setToDefaultValues, which the Setup
@@ -290,17 +323,25 @@ class Robot(Value):
 
     def joint_range(self, i: int) -> tuple[float, float]:
         """Position limits of joint i (1-based), rad: the library's range, narrowed by `limit`."""
-        import math
-
-        assert self.library is not None
-        v = self.library.variants[self.units[i - 1].variant]
-        lo, hi = math.radians(v.lower_deg), math.radians(v.upper_deg)
-        hw = (lo, hi)
+        hw = self.hardware_range(i)
+        lo, hi = hw
         for lim in self.limits:
             if lim.joint == f"joint_{i}" and lim.lower < lim.upper:
                 lo, hi = max(lo, lim.lower), min(hi, lim.upper)
         # an inverted or disjoint limit is reported by check_poses; analyses keep the hardware range
         return (lo, hi) if lo < hi else hw
+
+
+def resolved(robot: Robot, library: Library, **update: object) -> ResolvedRobot:
+    """The robot with its library (and fields in update replaced), unchecked as model_copy."""
+    new = object.__new__(ResolvedRobot)
+    new.__dict__.update(robot.__dict__)
+    for k, v in update.items():
+        if k not in new.__dict__:
+            raise TypeError(f"Robot has no field {k!r}")
+        new.__dict__[k] = v
+    new.__dict__["library"] = library
+    return new
 
 
 RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest torque margin
@@ -338,3 +379,11 @@ class Design(Value):
     path: str
     robots: tuple[Robot, ...] = ()
     problems: tuple[Problem, ...] = ()  # `design` blocks
+
+    def resolved_robots(self) -> tuple[ResolvedRobot, ...]:
+        """The robots of a design whose checks passed (a build's, an analysis's): every one
+        resolved. InvalidModel for a robot whose library was never resolved."""
+        for r in self.robots:
+            if not isinstance(r, ResolvedRobot):
+                raise InvalidModel(f"robot {r.name}: its library is not resolved (check the design first)")
+        return self.robots  # type: ignore[return-value]  # each one checked just above

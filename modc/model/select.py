@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..diagnostics import Diagnostic, Span, codes
-from .robot import Design, Robot
+from .robot import Design, ResolvedRobot
 
 COMMAND_LINE = Span.point("<command line>")
 
@@ -23,12 +23,13 @@ def _fail(detail: str, known: str, where: Span) -> RobotChoiceError:
     return RobotChoiceError(codes.ROBOT_UNKNOWN.at(where, detail=detail, known=known))
 
 
-def choose_robot(design: Design, name: str | None = None, among: Sequence[Robot] | None = None, why: str = "",
-                 say: str = "--robot NAME", where: Span = COMMAND_LINE) -> Robot:
+def choose_robot(design: Design, name: str | None = None, among: Sequence[ResolvedRobot] | None = None, why: str = "",
+                 say: str = "--robot NAME", where: Span = COMMAND_LINE) -> ResolvedRobot:
     """The robot called `name`; without a name, the only one of `among` (default: every robot of
     the file; `why` says what they have in common, e.g. "have a target 'plant'"); `say` tells the
-    user how to name one. Raises RobotChoiceError."""
-    robots = list(design.robots)
+    user how to name one. Raises RobotChoiceError. The design's checks passed (its robots are
+    resolved: InvalidModel otherwise)."""
+    robots = list(design.resolved_robots())
     if name is not None:
         found = next((r for r in robots if r.name == name), None)
         if found is None:

@@ -4,12 +4,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from ..formatting import fixed as _num
 from .robot import Robot
-
-
-def _num(x: float, digits: int = 9) -> str:
-    s = f"{round(x, digits):.{digits}f}".rstrip("0").rstrip(".")
-    return "0" if s in ("-0", "") else s
 
 
 def angle(x: float) -> str:

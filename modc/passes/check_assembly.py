@@ -5,15 +5,17 @@ import itertools
 from collections import Counter
 
 from ..diagnostics import codes
-from ..model import Design
+from ..model import Design, ResolvedRobot
 from .context import Context
 
 
 def run(design: Design, ctx: Context) -> Design:
     for r in design.robots:
+        if not isinstance(r, ResolvedRobot):  # resolve_library has reported it
+            continue
         lib = r.library
         units = [u for u in r.units if u.variant]
-        if lib is None or not units or len(units) != len(r.units) or len(units) > lib.rules.max_dof:
+        if not units or len(units) != len(r.units) or len(units) > lib.rules.max_dof:
             continue  # unknown units or an oversized chain were reported already; rules would only echo them
         rules = lib.rules
         first, last = units[0], units[-1]

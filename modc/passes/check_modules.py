@@ -7,7 +7,7 @@ from __future__ import annotations
 import difflib
 
 from ..diagnostics import codes
-from ..model import Design
+from ..model import Design, ResolvedRobot
 from .context import Context
 
 
@@ -17,9 +17,9 @@ def _fmt_len(x: float) -> str:
 
 def run(design: Design, ctx: Context) -> Design:
     for r in design.robots:
-        lib = r.library
-        if lib is None:
+        if not isinstance(r, ResolvedRobot):  # resolve_library has reported it
             continue
+        lib = r.library
         for u in r.units:
             if not u.variant:
                 close = difflib.get_close_matches(u.name.upper(), lib.unit_names(), n=1, cutoff=0.5)

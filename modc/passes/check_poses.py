@@ -1,18 +1,15 @@
 """Joint-limit overrides name real joints and are ordered; named poses fit the arm and its limits."""
 from __future__ import annotations
 
-import math
-
 from ..diagnostics import codes
 from ..formatting import angle
-from ..model import Design
+from ..model import Design, ResolvedRobot
 from .context import Context
 
 
 def run(design: Design, ctx: Context) -> Design:
     for r in design.robots:
-        lib = r.library
-        if lib is None or not r.units or any(not u.variant for u in r.units):
+        if not isinstance(r, ResolvedRobot) or not r.units or any(not u.variant for u in r.units):
             continue
         joints = {f"joint_{i}": i for i in range(1, r.dof + 1)}
         for lim in r.limits:
@@ -24,8 +21,7 @@ def run(design: Design, ctx: Context) -> Design:
                     codes.LIMIT_ORDER.at(lim.span, joint=lim.joint, low=angle(lim.lower), high=angle(lim.upper)), r
                 )
                 continue
-            v = lib.variants[r.units[joints[lim.joint] - 1].variant]
-            hlo, hhi = math.radians(v.lower_deg), math.radians(v.upper_deg)
+            hlo, hhi = r.hardware_range(joints[lim.joint])
             bounds = {"joint": lim.joint, "low": angle(lim.lower), "high": angle(lim.upper), "hlow": angle(hlo),
                       "hhigh": angle(hhi)}
             if lim.upper <= hlo or lim.lower >= hhi:

@@ -10,7 +10,7 @@ import difflib
 from pathlib import Path
 
 from ..diagnostics import codes
-from ..model import Design, Problem, Robot
+from ..model import Design, Problem, ResolvedRobot, Robot, resolved
 from ..model import library as lib
 from .context import Context
 
@@ -60,7 +60,7 @@ def _check(p: Problem, library, ctx: Context) -> None:
             break
 
 
-def _reference(ref: Robot, cell: Robot, library, ctx: Context) -> Robot:
+def _reference(ref: Robot, cell: ResolvedRobot, library, ctx: Context) -> ResolvedRobot:
     """`compare with chain …`: its units tagged and checked as a robot block's chain is (the
     library's modules, the assembly rules, the twists), diagnostics at the units as written."""
     from . import check_assembly, check_modules, check_twists
@@ -83,12 +83,13 @@ def run(design: Design, ctx: Context) -> Design:
         library = _library(p, ctx)
         if library is not None:
             _check(p, library, ctx)
-            update: dict = {"library": library}
+            update: dict = {}
             if ctx.library_override:  # the designs written must name the library they were found with
                 path = ctx.library_override not in lib.BUILTIN
                 update |= {"library_ref": ctx.library_override, "library_dir": str(Path.cwd()) if path else None}
-            p = p.model_copy(update={"cell": p.cell.model_copy(update=update)})
+            cell = resolved(p.cell, library, **update)
+            p = p.model_copy(update={"cell": cell})
             if p.reference is not None:
-                p = p.model_copy(update={"reference": _reference(p.reference, p.cell, library, ctx)})
+                p = p.model_copy(update={"reference": _reference(p.reference, cell, library, ctx)})
         problems.append(p)
     return design.model_copy(update={"problems": tuple(problems)})

@@ -18,9 +18,10 @@ here in plain Python: `modc lint` runs this pass and imports no numpy.
 from __future__ import annotations
 
 import math
+from typing import TypeGuard
 
 from ..diagnostics import codes
-from ..model import Design, Robot
+from ..model import Design, ResolvedRobot, Robot
 from .context import Context
 
 _Mat = tuple[tuple[float, float, float], ...]
@@ -66,10 +67,9 @@ def _dist(a: _Vec, b: _Vec) -> float:
     return math.dist(a, b)
 
 
-def chain_points(robot: Robot) -> list[_Vec]:
+def chain_points(robot: ResolvedRobot) -> list[_Vec]:
     """Joint origins 1 … n and tool0 in base_link at q = 0 (the frames of modc.kinematics.Chain)."""
     lib = robot.library
-    assert lib is not None
     R: _Mat = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     p: _Vec = (0.0, 0.0, 0.0)
     points: list[_Vec] = []
@@ -86,7 +86,7 @@ def chain_points(robot: Robot) -> list[_Vec]:
     return points
 
 
-def reach_shell(robot: Robot) -> tuple[_Vec, float, float, float]:
+def reach_shell(robot: ResolvedRobot) -> tuple[_Vec, float, float, float]:
     """(O, r_min, r_max, longest): joint_1's origin in base_link, the bounds on |tool0 - O| (m)
     and the longest fixed segment of the chain."""
     pts = chain_points(robot)
@@ -105,10 +105,10 @@ def _m(x: float, other: float) -> str:
     return f"{x:.6f}"
 
 
-def _checkable(robot: Robot) -> bool:
-    lib = robot.library
-    if lib is None or not robot.units or not robot.targets:
+def _checkable(robot: Robot) -> TypeGuard[ResolvedRobot]:
+    if not isinstance(robot, ResolvedRobot) or not robot.units or not robot.targets:
         return False
+    lib = robot.library
     if any(not u.variant or u.kind not in lib.units for u in robot.units):
         return False
     numbers = [robot.link_length(u) for u in robot.units] + [*robot.tool.xyz]

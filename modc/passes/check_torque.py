@@ -23,10 +23,9 @@ def run(design: Design, ctx: Context) -> Design:
         raise RuntimeError("the torque analysis was asked for but ctx.torque_analysis is not set")
 
     robots = []
-    for r in design.robots:
+    for r in design.resolved_robots():  # no errors so far: resolve_library found every library
         result = analyse(r, ctx.payload_override)
         lib = r.library
-        assert lib is not None  # no errors: resolve_library found it
         eps_ok = all(sum(u.variant == v for u in r.units) <= lib.variants[v].actuator.epsilon for v in lib.variants)
         eps = " (the chain obeys the paper's ε rule, but the physics says no)" if eps_ok else ""
         for i, j in enumerate(result):

@@ -5,7 +5,7 @@ import math
 
 from ..diagnostics import codes
 from ..formatting import degrees
-from ..model import Design
+from ..model import Design, ResolvedRobot
 from ..model.library import TwistSet
 from .context import Context
 
@@ -18,9 +18,9 @@ def _reason(ts: TwistSet, deg: float) -> str:
 
 def run(design: Design, ctx: Context) -> Design:
     for r in design.robots:
-        lib = r.library
-        if lib is None:
+        if not isinstance(r, ResolvedRobot):  # resolve_library has reported it
             continue
+        lib = r.library
         for u in r.units:
             for param, ts in (("pivot", lib.twists.pivot), ("port", lib.twists.port)):
                 if param not in u.param_spans:

@@ -4,20 +4,20 @@ from __future__ import annotations
 import math
 
 from ..diagnostics import codes
-from ..model import Design
+from ..model import Design, ResolvedRobot
 from .context import Context
 
 
 def run(design: Design, ctx: Context) -> Design:
     robots = []
     for r in design.robots:
-        lib = r.library
-        if r.dh is None or lib is None or not r.dh:
+        if r.dh is None or not isinstance(r, ResolvedRobot) or not r.dh:
             robots.append(r)
             continue
         from ..dh.convert import convert
         from ..dh.report import compare
 
+        lib = r.library
         max_dof = lib.rules.max_dof
         if len(r.dh) > max_dof:  # converting (and rounding) thousands of rows would only bury this
             limits = ", ".join(f"{v}: {lib.variants[v].actuator.epsilon}" for v in lib.variants)

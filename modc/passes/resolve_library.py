@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..model import Design
+from ..model import Design, resolved
 from ..model import library as lib
 from .context import Context
 
@@ -29,5 +29,5 @@ def run(design: Design, ctx: Context) -> Design:
         for u in r.units:
             vk = library.split(u.name)
             units.append(u.model_copy(update={"variant": vk[0], "kind": vk[1]}) if vk else u)
-        robots.append(r.model_copy(update={"library": library, "units": tuple(units)}))
+        robots.append(resolved(r, library, units=tuple(units)))
     return design.model_copy(update={"robots": tuple(robots)})

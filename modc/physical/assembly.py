@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..kinematics import A_J, A_t1, A_t2, transform
-from ..model import Robot, Transform
+from ..model import ResolvedRobot, Transform
 from .inertia import Inertial, combine_groups, local_inertial, sphere
 from .parts import Part, unit_mass, unit_parts
 
@@ -170,10 +170,9 @@ def _link_inertials(units: list[_Unit], frames: list[np.ndarray]) -> list[Inerti
     return combine_groups(m, C, inertia, starts)
 
 
-def describe(robot: Robot) -> Description:
+def describe(robot: ResolvedRobot) -> Description:
     """The assembled arm as links and joints (kinematics: modc.kinematics, docs/conventions.md)."""
     lib = robot.library
-    assert lib is not None
     n = robot.dof
     links = [Link("base_link")] + [Link(f"link_{i}") for i in range(1, n + 1)]
     joints: list[Joint] = []
@@ -226,10 +225,9 @@ def kdl_root(desc: Description) -> Description:
     return Description(desc.name, links, [*desc.joints, joint], desc.file_stem)
 
 
-def library_mass(robot: Robot) -> float:
+def library_mass(robot: ResolvedRobot) -> float:
     """What the library says the arm weighs (with payload): the check on describe()'s inertials."""
     lib = robot.library
-    assert lib is not None
     m = sum(unit_mass(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units)
     return m + (robot.payload.mass if robot.payload else 0.0)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from ..model import Robot
+    from ..model import ResolvedRobot
 
 TARGET_RADIUS = 0.012  # m, the visual-only sphere marking a target
 OBSTACLE_RGBA = (0.62, 0.70, 0.78, 1.0)
@@ -15,7 +15,7 @@ TARGET_RGBA = (0.86, 0.12, 0.22, 1.0)
 MODULE_RADIUS = 0.06  # m: a joint module reaches about this far from its frames
 
 
-def extent_points(robot: Robot, q=None, T_world_base=None):
+def extent_points(robot: ResolvedRobot, q=None, T_world_base=None):
     """Points (world) that bound what a picture of the robot shows at q: every frame of the
     chain widened by a module's radius, each obstacle's bounding sphere, each target."""
     import numpy as np

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ..model import Robot
+from ..model import ResolvedRobot
 from . import multibody
 from .assembly import Description, describe
 from .collisions import SPHERE_MARGIN, adjacent_pairs, default_configuration
@@ -46,7 +46,7 @@ class Evaluation:
 class Candidate:
     """One arm: its pinocchio model now, its collision model on the first collision query."""
 
-    def __init__(self, robot: Robot, desc: Description | None = None):
+    def __init__(self, robot: ResolvedRobot, desc: Description | None = None):
         import pinocchio as pin
 
         self.pin = pin
@@ -190,7 +190,7 @@ def _obstacle_radius(o) -> float:
     return float(np.hypot(s[0], s[1] / 2))  # cylinder: radius, length
 
 
-def evaluate(robot: Robot, q) -> Evaluation:
+def evaluate(robot: ResolvedRobot, q) -> Evaluation:
     """Tool pose, gravity torques and collision of one arm at one pose, from scratch."""
     arm = Candidate(robot)
     return Evaluation(arm.tool(q), arm.gravity(q), arm.collides(q))

@@ -15,13 +15,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..kinematics import Chain
-from ..model import Robot
+from ..model import ResolvedRobot
 from .assembly import describe
 from .multibody import gravity
 
 
 class Statics:
-    def __init__(self, robot: Robot):
+    def __init__(self, robot: ResolvedRobot):
         self.robot = robot
         self.chain = Chain(robot)
         self.g = gravity(robot)

@@ -261,8 +261,7 @@ def _goals(job: _Job, checker, q_start):
         job.seed,
         batches=IK_BATCHES,
         enough=free,
-        tolerance=(tgt.position_tolerance,
-                   tgt.orientation_tolerance if tgt.rpy is not None or tgt.pointing is not None else np.inf),
+        tolerance=tgt.tolerance,
     )
     if not solutions:  # say why: too far, too close, orientation or limits (advice.py)
         raise advice.unreachable(job, checker, solver, best, q_start)

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..physical.multibody import hull_points, obstacle_geometry
 
 DEFAULT_MARGIN = 0.005  # m kept between the arm and obstacles, and between links, while planning
@@ -65,8 +65,8 @@ def _box_corners(geometry) -> np.ndarray:
 class CollisionChecker:
     """The arm's collision model plus its environment. q is joint_1 … joint_n (rad)."""
 
-    def __init__(self, robot: Robot, files: Mapping[str, str | bytes] | None = None, margin: float = DEFAULT_MARGIN,
-                 matrix=None):
+    def __init__(self, robot: ResolvedRobot, files: Mapping[str, str | bytes] | None = None,
+                 margin: float = DEFAULT_MARGIN, matrix=None):
         import pinocchio as pin
 
         from ..physical import collisions
@@ -105,8 +105,7 @@ class CollisionChecker:
             self.owner.append(o.name)
 
         objects = geo.objects
-        disabled = {frozenset((p.link1, p.link2)) for p in self.matrix.disabled
-                    if p.reason in ("Adjacent", "Default", "Always")}
+        disabled = self.matrix.unchecked()  # the one rule: the SRDF's, modc sim's
         glinks = geo.geometry_links
         self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]
                            if frozenset((a, b)) not in disabled]

@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kinematics import rotation_error
+
 TOLERANCE = 1e-9  # m: a converged run is within this of the target
 MAX_ITERATIONS = 200
 LAMBDA0 = 1e-3
@@ -41,22 +43,6 @@ class Solution:
     q: np.ndarray
     error: float  # m, |p(q) - target|
     seed_index: int
-
-
-def rotation_vector(R: np.ndarray) -> np.ndarray:
-    """The axis times the angle of a rotation matrix (log map), accurate up to 180°."""
-    cos = np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)
-    angle = float(np.arccos(cos))
-    v = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    s = float(np.linalg.norm(v))
-    if s > 1e-9:
-        return v * (angle / s)
-    if cos > 0:
-        return v  # near identity: the skew part is the rotation vector
-    B = (R + np.eye(3)) / 2.0  # near 180°: the axis from the symmetric part
-    k = int(np.argmax(np.diag(B)))
-    axis = B[:, k] / np.linalg.norm(B[:, k])
-    return axis * angle
 
 
 class PositionIK:
@@ -99,7 +85,7 @@ class PositionIK:
             return np.concatenate([e, ROTATION_WEIGHT * self._axis_error(M)])
         if self.rotation is None:
             return e
-        return np.concatenate([e, ROTATION_WEIGHT * rotation_vector(self.rotation @ np.array(M.rotation).T)])
+        return np.concatenate([e, ROTATION_WEIGHT * rotation_error(self.rotation, np.array(M.rotation))])
 
     def errors(self, q, target) -> tuple[float, float]:
         """(position error m, orientation error rad; 0 without an orientation)."""
@@ -109,7 +95,7 @@ class PositionIK:
             return pe, float(np.linalg.norm(self._axis_error(M)))
         if self.rotation is None:
             return pe, 0.0
-        return pe, float(np.linalg.norm(rotation_vector(self.rotation @ np.array(M.rotation).T)))
+        return pe, float(np.linalg.norm(rotation_error(self.rotation, np.array(M.rotation))))
 
     def jacobian(self, q) -> np.ndarray:
         pin = self.pin
@@ -225,7 +211,6 @@ __all__ = [
     "TOLERANCE",
     "PositionIK",
     "Solution",
-    "rotation_vector",
     "seeds",
     "solve",
 ]

@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from .contacts import CONTACT_TOL, CollisionQueries, Contact
-from .smoke import HOLD_TIME, SETTLE_WINDOW, pose_list
+from .smoke import HOLD_TIME, SETTLE_WINDOW
 from .verdict import Failure, Hold, HoldRecorder, Measured, RobotResult, judge_pose
 
 FK_TOL = (1e-9, 1e-9)  # m, rotation-matrix entries
@@ -207,7 +207,7 @@ def simulate_robot(robot, xml: Path, allowed=(), hold_time: float = HOLD_TIME) -
     dt = float(s.model.opt.timestep)
     steps, window = max(1, round(hold_time / dt)), max(1, round(SETTLE_WINDOW / dt))
     chain, dyn = Chain(robot), Dynamics(robot)
-    for pname, q in pose_list(robot):
+    for pname, q in robot.named_poses():
         measured = measure_pose(s, pname, q, allowed, steps, window)
         res.poses.append(judge_pose(robot, measured, chain, dyn, engine=ENGINE, fk_tol=FK_TOL))
     return res

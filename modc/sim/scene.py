@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..physical.cell import MODULE_RADIUS, OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA, extent_points  # noqa: F401  (one home: physical/)
 from ..physical.constants import GRAVITY
 from .contacts import CollisionQueries
@@ -56,11 +56,11 @@ def load_checked(path, library: str | None = None):
     return check_file(path, library)
 
 
-def select_robots(checked, robot: str | None = None) -> list[Robot]:
+def select_robots(checked, robot: str | None = None) -> list[ResolvedRobot]:
     """Every robot of the file, or the one named (RobotChoiceError when there is none)."""
     from ..model.select import choose_robot
 
-    return list(checked.design.robots) if robot is None else [choose_robot(checked.design, robot)]
+    return list(checked.design.resolved_robots()) if robot is None else [choose_robot(checked.design, robot)]
 
 
 # what an engine loads: the backends to run, then the folder and suffix of the per-robot model
@@ -231,7 +231,7 @@ def matrix_pose(T) -> tuple[tuple[float, float, float], tuple[float, float, floa
 LAYOUT_GAP = 0.15  # m between robots laid out side by side
 
 
-def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, np.ndarray]:
+def world_placements(robots: list[ResolvedRobot], qs: dict | None = None) -> dict[str, np.ndarray]:
     """robot name -> T_world_base. Each robot sits at its `base`; when two robots of one file
     share a placement (both at the default origin, say), they are laid out along the world's y
     axis instead, LAYOUT_GAP apart at the pose shown (qs: name -> q, default home), so that a
@@ -259,7 +259,7 @@ def world_placements(robots: list[Robot], qs: dict | None = None) -> dict[str, n
 @dataclass
 class Scene(CollisionQueries):
     client: Any  # a PyBullet client (pybullet_utils.bullet_client.BulletClient)
-    robot: Robot
+    robot: ResolvedRobot
     urdf: Path
     body: int
     T_world_base: np.ndarray  # 4x4
@@ -339,7 +339,7 @@ class Scene(CollisionQueries):
             self.client.removeBody(b)
 
 
-def load_robot(client, robot: Robot, urdf: Path, T_world_base=None, *, environment: bool = True,
+def load_robot(client, robot: ResolvedRobot, urdf: Path, T_world_base=None, *, environment: bool = True,
                targets: bool = True) -> Scene:
     """Load the robot's URDF (fixed base at T_world_base, default robot.base), its obstacles as
     static bodies (collision + visual) and its targets as visual-only spheres. The arm is loaded

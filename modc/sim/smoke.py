@@ -91,10 +91,6 @@ def check_urdf_inertials(urdf: Path) -> list[str]:
     return bad
 
 
-def pose_list(robot) -> list[tuple[str, tuple[float, ...]]]:
-    return [("home", robot.home())] + [(p.name, tuple(p.q)) for p in robot.poses if p.name != "home"]
-
-
 def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOLD_TIME,
                    time_step: float = TIME_STEP) -> RobotResult:
     """Load one robot into an empty client and run every check (see the module docstring):
@@ -115,7 +111,7 @@ def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOL
     chain, dyn = Chain(robot), Dynamics(robot)
     steps = max(1, round(hold_time / time_step))
     window = max(1, round(SETTLE_WINDOW / time_step))
-    for pname, q in pose_list(robot):
+    for pname, q in robot.named_poses():
         measured = measure_pose(client, s, pname, q, allowed, steps, window, time_step)
         res.poses.append(judge_pose(robot, measured, chain, dyn, engine="PyBullet"))
     s.remove()

@@ -344,28 +344,19 @@ def rewrite_file(path: str, text: str, expected: bytes | None = None) -> None:
     to is rewritten and the link stays."""
     import os
     import stat
-    import tempfile
 
     from ..files import read_bounded
+    from ..outputs import replace_file
 
     real = os.path.realpath(path)
     mode = stat.S_IMODE(os.stat(real).st_mode)
     if expected is None:
         expected = read_bounded(real, 1 << 30)[0]
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(real) + ".", suffix=".fmt", dir=os.path.dirname(real))
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, mode)
-        now, size = read_bounded(real, len(expected))
-        if size != len(expected) or now != expected:
+    old = expected
+
+    def unchanged() -> None:
+        now, size = read_bounded(real, len(old))
+        if size != len(old) or now != old:
             raise ChangedOnDisk(path)
-        os.replace(tmp, real)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+
+    replace_file(real, text.encode("utf-8"), mode=mode, before_rename=unchanged, durable=True)

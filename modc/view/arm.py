@@ -16,7 +16,7 @@ import numpy as np
 
 from ..diagnostics import Diagnostic
 from ..kinematics import Rz, homogeneous, transform
-from ..model import Robot
+from ..model import ResolvedRobot
 from ..physical.assembly import describe
 from ..physical.cell import OBSTACLE_RGBA, TARGET_RGBA
 from ..physical.meshes import tessellate
@@ -88,7 +88,7 @@ def _shape(link: str, k: int, part: Part, T_link_part: np.ndarray, unit: int) ->
 
 
 class Arm:
-    def __init__(self, robot: Robot):
+    def __init__(self, robot: ResolvedRobot):
         self.robot = robot
         self.description = describe(robot)
         self.dof = robot.dof
@@ -102,8 +102,8 @@ class Arm:
 
     @property
     def poses(self) -> list[tuple[str, tuple[float, ...]]]:
-        """Named poses, home first (Robot.home: the declared one, else MoveIt's default)."""
-        return [("home", self.robot.home())] + [(p.name, tuple(p.q)) for p in self.robot.poses if p.name != "home"]
+        """Named poses, home first (ResolvedRobot.named_poses)."""
+        return self.robot.named_poses()
 
     def shapes(self) -> list[Shape]:
         """Every part's mesh on its link. Link i carries unit i's output parts and unit i+1's
@@ -203,7 +203,6 @@ class Arm:
             self._dynamics = Dynamics(self.robot)  # pinocchio: built on first use, kept for the arm's life
         tau = self._dynamics.gravity(q)
         lib = self.robot.library
-        assert lib is not None
         out = []
         for i, u in enumerate(self.robot.units):
             act = lib.variants[u.variant].actuator
