@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import cache
+from ..model import ResolvedRobot
 from .model import Dynamics, PayloadOverride, gravity, with_payload
 
 ALGORITHM = "1"  # bump when worst_case() could give another result for the same input
@@ -110,7 +111,7 @@ def worst_case(dyn: Dynamics, samples: int = 512, refine: int = 4, seed: int = 0
     return out
 
 
-def analyse(robot, payload_mass: float | None = None) -> list[JointWorst]:
+def analyse(robot: ResolvedRobot, payload_mass: float | None = None) -> list[JointWorst]:
     """The worst case for a checked robot; payload_mass (kg) replaces the file's payload mass,
     keeping its centre of mass (tool0's origin if the file has none). Cached by content."""
     payload: PayloadOverride | None = None
@@ -127,7 +128,7 @@ def analyse(robot, payload_mass: float | None = None) -> list[JointWorst]:
     return result
 
 
-def _key(robot, payload: PayloadOverride | None) -> str:
+def _key(robot: ResolvedRobot, payload: PayloadOverride | None) -> str:
     """Everything worst_case() reads: the described arm, gravity, the actuators, the defaults."""
     from ..physical.assembly import describe
 

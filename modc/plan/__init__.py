@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..diagnostics import codes
+from ..model import ResolvedRobot
 from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
 from ..trajectory import Trajectory
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
@@ -95,7 +96,7 @@ class Plan:
         return "\n".join(out)
 
 
-def start_pose(robot, name: str | None):
+def start_pose(robot: ResolvedRobot, name: str | None):
     """(name, q, span) of the start pose: the pose named `name`, else home (Robot.home); None
     when the robot has no pose `name`."""
     if name is not None:
@@ -152,7 +153,7 @@ def plan(path, target: str, robot: str | None = None, seed: int = 0, start: str 
                       with_robot_name=len(robots) > 1, **options)
 
 
-def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, margin: float | None = None,
+def plan_robot(robot: ResolvedRobot, target: str, seed: int = 0, start: str | None = None, margin: float | None = None,
                timeout: float | None = None, max_checks: int | None = None, files=None, sources=None,
                with_robot_name: bool = False) -> Plan:
     """Plan for one checked robot (modc.model.Robot). files: its URDF and meshes as the compiler
@@ -185,7 +186,7 @@ def plan_robot(robot, target: str, seed: int = 0, start: str | None = None, marg
 class _Job:
     """What one plan_robot call is asked: the robot, its target, where it starts, the seed."""
 
-    robot: Any  # modc.model.Robot
+    robot: ResolvedRobot
     target: Any  # modc.model.Target
     start: str  # name of the start pose
     q_start: tuple[float, ...]
@@ -197,7 +198,7 @@ class _Job:
         return PlanError.of(code, span, self.sources, **fields)
 
 
-def _job(robot, target: str, start: str | None, seed: int, sources: dict) -> _Job:
+def _job(robot: ResolvedRobot, target: str, start: str | None, seed: int, sources: dict) -> _Job:
     """The target and start pose named on the command line (target-unknown, pose-unknown)."""
     tgt = next((t for t in robot.targets if t.name == target), None)
     if tgt is None:
@@ -307,7 +308,7 @@ def _free_goals(job: _Job, checker, solutions, free) -> list:
     return goals
 
 
-def _limits(robot):
+def _limits(robot: ResolvedRobot):
     """(velocity, acceleration) limits per joint, rad/s and rad/s² (timing.py)."""
     import numpy as np
 
@@ -379,7 +380,7 @@ def _timed(job: _Job, checker, solver, path, with_robot_name: bool) -> Plan:
         with_robot_name=with_robot_name)
 
 
-def _velocity(robot, i: int) -> float:
+def _velocity(robot: ResolvedRobot, i: int) -> float:
     """The URDF velocity limit of joint i (1-based): the actuator's rated speed, rad/s."""
     return float(robot.library.variants[robot.units[i - 1].variant].actuator.velocity)
 

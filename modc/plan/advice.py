@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from ..diagnostics import codes
+from ..model import ResolvedRobot
 from ..passes.check_reach import reach_shell
 from . import ik
 from .errors import PlanError
@@ -139,7 +140,7 @@ def _distance(job, solver, best, closest: str) -> PlanError:
     return job.fail(codes.TARGET_UNREACHABLE, tgt.span, target=tgt.name, why=why, hint=hint)
 
 
-def inside_obstacle(robot, xyz) -> str | None:
+def inside_obstacle(robot: ResolvedRobot, xyz) -> str | None:
     """'0.125 m inside box 'crate'' when the target point lies in one of the robot's obstacles
     (the deepest), else None: then no arm pose can put tool0 there without touching it."""
     from ..kinematics import rpy_matrix

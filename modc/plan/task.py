@@ -29,6 +29,8 @@ from typing import Any
 import numpy as np
 
 from ..diagnostics import codes
+from ..model import ResolvedRobot
+from ..model.robot import StraightPath, Task
 from ..model.select import COMMAND_LINE, RobotChoiceError, choose_robot
 from ..trajectory import Trajectory
 from .errors import EXIT_FAILED, EXIT_USAGE, PlanError
@@ -133,8 +135,9 @@ def plan_task(path, task: str, robot: str | None = None, seed: int = 0, library:
                            timeout=timeout, progress=progress)
 
 
-def _find(robot, name: str):
-    return next((t for t in (*robot.tasks, *robot.paths) if t.name == name), None)
+def _find(robot: ResolvedRobot, name: str) -> Task | StraightPath | None:
+    either: list[Task | StraightPath] = [*robot.tasks, *robot.paths]
+    return next((t for t in either if t.name == name), None)
 
 
 def _unknown(robots, task: str, sources) -> PlanError:
@@ -145,7 +148,7 @@ def _unknown(robots, task: str, sources) -> PlanError:
     return PlanError([d], sources, EXIT_USAGE)
 
 
-def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_name: bool = False,
+def plan_task_robot(robot: ResolvedRobot, task: str, seed: int = 0, sources=None, with_robot_name: bool = False,
                     timeout: float | None = None, progress: Progress | None = None) -> TaskPlan:
     """Plan and time one checked robot's task or path. Raises PlanError. progress(k, n, kind, a,
     b) is called as segment k of n (0: the approach) starts, and (n, n, "done", "", "") at the end."""
@@ -157,8 +160,8 @@ def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_na
     item = _find(robot, task)
     if item is None:
         raise _unknown([robot], task, sources)
-    kind = "task" if item in robot.tasks else "path"
-    visits = list(item.visits) if kind == "task" else [item.start, item.end]
+    kind = "task" if isinstance(item, Task) else "path"
+    visits = list(item.visits) if isinstance(item, Task) else [item.start, item.end]
     checker = CollisionChecker(robot)
     limits = Limits.of(robot)
     job = _Job(robot, item, kind, seed, sources, checker, limits, timeout)
@@ -195,7 +198,7 @@ def plan_task_robot(robot, task: str, seed: int = 0, sources=None, with_robot_na
 
 @dataclass(frozen=True)
 class _Job:
-    robot: Any  # modc.model.Robot
+    robot: ResolvedRobot
     item: Any  # its Task or StraightPath
     kind: str
     seed: int

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..model import ResolvedRobot
 from .contacts import CONTACT_TOL, CollisionQueries, Contact
 from .smoke import HOLD_TIME, SETTLE_WINDOW
 from .verdict import Failure, Hold, HoldRecorder, Measured, RobotResult, judge_pose
@@ -117,14 +118,14 @@ class MujocoScene(CollisionQueries):
         return np.linalg.inv(pose(base.xpos, base.xmat)) @ pose(tool.xpos, tool.xmat)
 
 
-def scene_path(robot, xml: Path) -> Path:
+def scene_path(robot: ResolvedRobot, xml: Path) -> Path:
     """The scene file beside the robot's MJCF."""
     from ..backends.mjcf import scene_name
 
     return xml.parent / scene_name(robot)
 
 
-def load(robot, xml: Path) -> MujocoScene:
+def load(robot: ResolvedRobot, xml: Path) -> MujocoScene:
     """Load the robot's MJCF scene (ValueError when MuJoCo rejects it); xml: the robot file."""
     mujoco = import_mujoco()
 
@@ -140,7 +141,7 @@ def load(robot, xml: Path) -> MujocoScene:
     return MujocoScene(m, d, links, parents, geometry_links, [f"joint_{i}" for i in range(1, robot.dof + 1)], obstacles)
 
 
-def load_failures(s: MujocoScene, robot, xml: Path) -> list[Failure]:
+def load_failures(s: MujocoScene, robot: ResolvedRobot, xml: Path) -> list[Failure]:
     import mujoco
 
     who = f"robot {robot.name}"
@@ -191,7 +192,7 @@ def hold(s: MujocoScene, qv, steps: int, window: int) -> Hold:
         m.opt.disableflags = flags
 
 
-def simulate_robot(robot, xml: Path, allowed=(), hold_time: float = HOLD_TIME) -> RobotResult:
+def simulate_robot(robot: ResolvedRobot, xml: Path, allowed=(), hold_time: float = HOLD_TIME) -> RobotResult:
     from ..dynamics.model import Dynamics
     from ..kinematics import Chain
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..model import ResolvedRobot
 from ..physical.camera import FILL, Camera, fit_camera, vec3
 from . import scene
 
@@ -319,7 +320,7 @@ def save_png(img, out: str | Path, colors: int | None = None) -> None:
     img.save(out, format="PNG", optimize=True)
 
 
-def pose_of(robot, pose: str | None) -> tuple[float, ...]:
+def pose_of(robot: ResolvedRobot, pose: str | None) -> tuple[float, ...]:
     if pose is None or pose == "home":
         return robot.home()
     p = robot.pose(pose)

@@ -49,6 +49,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from ..model import ResolvedRobot
 from ..physical.constants import GRAVITY, TIME_STEP
 from . import scene
 from .contacts import srdf_disabled_pairs
@@ -91,7 +92,7 @@ def check_urdf_inertials(urdf: Path) -> list[str]:
     return bad
 
 
-def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOLD_TIME,
+def simulate_robot(client, robot: ResolvedRobot, urdf: Path, allowed=(), hold_time: float = HOLD_TIME,
                    time_step: float = TIME_STEP) -> RobotResult:
     """Load one robot into an empty client and run every check (see the module docstring):
     PyBullet measures each pose (measure_pose), verdict.judge_pose judges it."""
@@ -118,7 +119,7 @@ def simulate_robot(client, robot, urdf: Path, allowed=(), hold_time: float = HOL
     return res
 
 
-def load_failures(client, s, robot, urdf: Path) -> list[Failure]:
+def load_failures(client, s, robot: ResolvedRobot, urdf: Path) -> list[Failure]:
     """What PyBullet printed while loading, links without a usable inertial (in the URDF and
     as PyBullet sees them), and the number of revolute joints."""
     who = f"robot {robot.name}"
@@ -164,7 +165,7 @@ def _hold(client, s, qv, steps: int, window: int, time_step: float) -> Hold:
     return rec.hold(s.q(), s.applied_torques(), [s.limits[j][2] for j in s.joint_names])
 
 
-def allowed_pairs(out_dir: str | Path | None, robot) -> set[frozenset[str]]:
+def allowed_pairs(out_dir: str | Path | None, robot: ResolvedRobot) -> set[frozenset[str]]:
     """The link pairs not checked for self-collision: the collision matrix in memory (the one the
     SRDF backend writes and `modc plan` uses, with the same defaults), or, given a compile
     output (--srdf-from OUT), the pairs its SRDF disables (compiled with other samples, say)."""

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..formatting import angle_text
+from ..model import ResolvedRobot
 
 TRACK_TOL = 1e-2  # rad
 FK_POS_TOL = 1e-6  # m (PyBullet computes in single precision)
@@ -135,7 +136,7 @@ class HoldRecorder:
                     efforts=tuple(float(e) for e in efforts))
 
 
-def judge_pose(robot, m: Measured, chain, dyn, engine: str = "PyBullet",
+def judge_pose(robot: ResolvedRobot, m: Measured, chain, dyn, engine: str = "PyBullet",
                fk_tol: tuple[float, float] = (FK_POS_TOL, FK_ROT_TOL)) -> PoseResult:
     """Every check of one pose: FK against modc.kinematics (chain), collisions, the hold, and
     the holding torques against modc.dynamics (dyn)."""
@@ -176,7 +177,7 @@ def judge_pose(robot, m: Measured, chain, dyn, engine: str = "PyBullet",
     return pr
 
 
-def _hold_failures(robot, pr: PoseResult, h: Hold, qv, dyn, at: str, engine: str) -> list[Failure]:
+def _hold_failures(robot: ResolvedRobot, pr: PoseResult, h: Hold, qv, dyn, at: str, engine: str) -> list[Failure]:
     """Joints that sag, and holding torques that disagree with modc's gravity torques (compared
     only when the whole arm is at rest, where it actually rests)."""
     import numpy as np
