@@ -252,3 +252,29 @@ def test_the_cache_writes_only_inside_its_directory(tmp_path, monkeypatch):
     assert cache.get("torque", "k.json") == b"[1]"
     os.mkfifo(root / "torque" / "fifo.json")  # a planted FIFO never blocks a read
     assert cache.get("torque", "fifo.json") is None
+
+
+def test_one_file_is_replaced_whole_or_not_at_all(tmp_path):
+    """outputs.replace_file, the one temporary-file-then-rename writer (fmt's rewrite, the cache):
+    the new contents and mode in one rename; a link named like the file is replaced, not
+    followed; a refusal just before the rename keeps the old file; no temporary file stays."""
+    from modc.outputs import replace_file
+
+    f = tmp_path / "a.mod"
+    f.write_text("old")
+    replace_file(f, b"new", mode=0o640)
+    assert f.read_bytes() == b"new" and (f.stat().st_mode & 0o777) == 0o640
+
+    def refuse() -> None:
+        raise RuntimeError("changed on disk")
+
+    with pytest.raises(RuntimeError):
+        replace_file(f, b"newer", before_rename=refuse)
+    assert f.read_bytes() == b"new"
+    target = tmp_path / "target"
+    target.write_text("keep")
+    link = tmp_path / "entry"
+    os.symlink(target, link)
+    replace_file(link, b"entry", durable=True)
+    assert target.read_text() == "keep" and not link.is_symlink() and link.read_bytes() == b"entry"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.mod", "entry", "target"]
