@@ -860,3 +860,14 @@ def test_the_library_is_the_checked_robots_not_looked_up_again(monkeypatch):
     bad = Analysis("robot b {\n    chain H1 - L1\n    library nosuchlib\n}\n", "/x/b.mod")
     assert bad.model_robot("b") is not None
     assert bad.library_for("b").name == "mark2" and calls == []
+
+
+def test_hover_on_the_library_statement_shows_the_checked_robots_library(monkeypatch):
+    from modc.lsp import document
+
+    text = "robot a {\n    chain H1 - L1\n    library mark2-strict\n}\n"
+    an = Analysis(text, "/x/a.mod")
+    assert an.model_robot("a") is not None
+    monkeypatch.setattr(document, "load_library", lambda *a, **k: None)  # no second lookup
+    h = hover(an, text.index("mark2-strict") + 2)
+    assert h is not None and "**library mark2-strict**" in h.contents.value

@@ -88,7 +88,7 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
     elif text in PARAMS and nxt is not None and nxt.text in ("=", ":"):
         md = param_markdown(text, lib)
     elif prev is not None and prev.text == "library":
-        md = _library_markdown(an, text)
+        md = _library_markdown(an, text, robot)
     elif tok.kind == "code" and text in REGISTRY:
         md = code_markdown(text)
     elif (n := joint_number(text)) is not None:
@@ -123,8 +123,13 @@ def _decl_markdown(an: Analysis, name: str, robot: str | None, kind: str) -> str
     return f"**{kind} {name}**"
 
 
-def _library_markdown(an: Analysis, ref: str) -> str | None:
-    lib = an.library_ref(ref)
+def _library_markdown(an: Analysis, ref: str, robot: str | None) -> str | None:
+    r = an.model_robot(robot)
+    lib: Library | None
+    if isinstance(r, ResolvedRobot) and r.library_ref == ref.strip('"'):
+        lib = r.library  # the robot's own statement: the library the check resolved
+    else:
+        lib = an.library_ref(ref)  # another block's (a design block's cell): loaded here
     if lib is None:
         return None
     return f"**library {lib.name}** — {lib.description}\n\nunits: {', '.join(lib.unit_names())}; source: {lib.source}"
