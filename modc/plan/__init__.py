@@ -160,8 +160,8 @@ def plan_robot(robot: ResolvedRobot, target: str, seed: int = 0, start: str | No
     emits them ({relative path: content}); generated when omitted. Raises PlanError."""
     import numpy as np
 
+    from ..physical.checker import DEFAULT_MARGIN, CollisionChecker
     from . import planner
-    from .collision import DEFAULT_MARGIN, CollisionChecker
 
     t_begin = time.perf_counter()
     if seed < 0:

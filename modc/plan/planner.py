@@ -7,7 +7,7 @@ checker (every checked pair more than the margin apart). Motions: the search use
 discrete motion validator at SEARCH_COARSENESS times the certified step (a point of the arm
 moves up to 2 x margin between checked states), which is fast; then every edge of the path
 found is certified (no point of the arm moves more than margin / 2 between two checked states;
-see modc.plan.collision) and an edge that fails is re-planned by RRT-Connect at the certified
+see modc.physical.checker) and an edge that fails is re-planned by RRT-Connect at the certified
 resolution. The direct motion start -> goal is tried first.
 
 Determinism: OMPL's RNG is seeded (RNG.setSeed(seed + 1), OMPL seeds being > 0) before the
@@ -28,7 +28,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .collision import CollisionChecker
+from ..physical.checker import CollisionChecker
 
 SHORTCUT_TRIES = 60
 SEARCH_COARSENESS = 4.0  # RRT-Connect checks motions 4x coarser than certified; edges are certified after

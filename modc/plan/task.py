@@ -152,8 +152,8 @@ def plan_task_robot(robot: ResolvedRobot, task: str, seed: int = 0, sources=None
                     timeout: float | None = None, progress: Progress | None = None) -> TaskPlan:
     """Plan and time one checked robot's task or path. Raises PlanError. progress(k, n, kind, a,
     b) is called as segment k of n (0: the approach) starts, and (n, n, "done", "", "") at the end."""
+    from ..physical.checker import CollisionChecker
     from . import start_pose
-    from .collision import CollisionChecker
     from .retime import Limits, TimingError, join
 
     sources = sources or {}
@@ -203,7 +203,7 @@ class _Job:
     kind: str
     seed: int
     sources: dict
-    checker: Any  # modc.plan.collision.CollisionChecker
+    checker: Any  # modc.physical.checker.CollisionChecker
     limits: Any  # modc.plan.retime.Limits
     timeout: float | None
 

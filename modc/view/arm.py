@@ -24,7 +24,7 @@ from ..physical.parts import Part
 
 if TYPE_CHECKING:
     from ..dynamics.model import Dynamics
-    from ..plan.collision import CollisionChecker, Contact
+    from ..physical.checker import CollisionChecker, Contact
 
 
 def rgb255(rgba) -> tuple[int, int, int]:
@@ -163,9 +163,9 @@ class Arm:
 
     def contacts(self, q) -> list[Contact]:
         """What touches at q, by the compiler's collision model: the URDF's collision meshes, the
-        SRDF's disabled pairs, the file's obstacles (modc.plan.collision, as `modc plan` checks)."""
+        SRDF's disabled pairs, the file's obstacles (modc.physical.checker, as `modc plan` checks)."""
         if self._checker is None:
-            from ..plan.collision import CollisionChecker
+            from ..physical.checker import CollisionChecker
 
             self._checker = CollisionChecker(self.robot)  # built on first use, kept for the arm's life
             self._static = self._checker.static_contacts()

@@ -60,7 +60,7 @@ class View:
         self.labels: dict = {}  # target name -> its label's handle
         self._sliders: list = []
         self.camera: Camera | None = None  # the framing camera of the arm on view
-        self.contacts: list = []  # what touches at the pose shown (plan.collision.Contact)
+        self.contacts: list = []  # what touches at the pose shown (physical.checker.Contact)
         self.named: dict[int, str] = {}  # module index -> "error" | "warning": modules the diagnostics name
         gui = server.gui
         server.scene.set_up_direction("+z")
