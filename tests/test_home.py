@@ -103,3 +103,18 @@ def test_home_then_the_named_poses_is_one_list():
 
     srdf = build(c, only=["srdf"])[f"config/{r.file_stem}.srdf"]
     assert re.findall(r'group_state name="([^"]+)"', srdf) == ["home", "a", "b"]
+
+
+def test_a_picture_of_several_robots_shows_home_then_every_pose_name():
+    """sim.render.file_poses: home first, then each pose name any robot has, in file order; a
+    robot without that pose stays at its home (both read ResolvedRobot.named_poses)."""
+    from modc.sim.render import file_poses
+
+    c = checked_ok("robot a {\n    chain H1 - L1\n    pose x (10, 0) deg\n}\n"
+                   "robot b {\n    chain H1 - L1\n    pose y (0, 20) deg\n    pose x (0, 30) deg\n}\n")
+    a, b = c.design.resolved_robots()
+    frames = file_poses([a, b])
+    assert len(frames) == 3
+    assert frames[0] == {"a": a.home(), "b": b.home()}
+    assert frames[1] == {"a": a.pose("x").q, "b": b.pose("x").q}
+    assert frames[2] == {"a": a.home(), "b": b.pose("y").q}

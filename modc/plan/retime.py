@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model import ResolvedRobot
+
 LIMIT_SHARE = 0.98  # of each speed and torque limit, given to toppra (it checks at grid points only)
 GRID_POINTS = 120  # toppra grid points per timed piece
 SAMPLE_PERIOD = 0.01  # s between samples of a timed piece (energy, torque, the output trajectory)
@@ -42,7 +44,7 @@ class Limits:
     dynamics: object  # modc.dynamics.model.Dynamics (with the robot's payload)
 
     @classmethod
-    def of(cls, robot) -> Limits:
+    def of(cls, robot: ResolvedRobot) -> Limits:
         from ..dynamics.model import Dynamics
 
         acts = [robot.library.variants[u.variant].actuator for u in robot.units]

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import trajectory
+from ..model import ResolvedRobot
 from ..physical.constants import TIME_STEP
 from . import scene
 from .render import Stage
@@ -36,7 +37,7 @@ CHECK_HZ = 50.0
 CAMERA_SAMPLES = 9  # configurations of the motion the camera is fitted to
 
 
-def pick_robot(checked, traj: trajectory.Trajectory, robot: str | None):
+def pick_robot(checked, traj: trajectory.Trajectory, robot: str | None) -> ResolvedRobot:
     """The robot named on the command line, else the trajectory's, else the file's only robot."""
     from ..model.select import choose_robot
 

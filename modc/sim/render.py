@@ -363,16 +363,14 @@ def render(path, out_png, pose: str | None = None, robot: str | None = None, lib
     )
 
 
-def file_poses(robots) -> list[dict]:
+def file_poses(robots: list[ResolvedRobot]) -> list[dict]:
     """Every configuration a picture of these robots may show: home, then each pose name any of
     them has (a robot without it at home), as {robot name: q}."""
-    names = []
-    for r in robots:
-        names += [p.name for p in r.poses if p.name != "home" and p.name not in names]
-    out = [{r.name: r.home() for r in robots}]
-    for n in names:
-        out.append({r.name: (tuple(r.pose(n).q) if r.pose(n) is not None else r.home()) for r in robots})
-    return out
+    each = [dict(r.named_poses()) for r in robots]
+    names = ["home"]
+    for poses in each:
+        names += [n for n in poses if n not in names]
+    return [{r.name: poses.get(n, poses["home"]) for r, poses in zip(robots, each, strict=True)} for n in names]
 
 
 def picture(client, robots, urdfs, qs, width: int = WIDTH, height: int = HEIGHT,
