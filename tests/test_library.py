@@ -213,3 +213,17 @@ def test_twist_sets_have_a_range(tmp_path, field, value, code):
     c = check_text('design c { library "lib.yaml"\n    target t at (0.2, 0.1, 0.2) m\n}\n', str(tmp_path / "a.mod"))
     assert [d.code for d in c.diagnostics] == [code], [(d.code, d.message) for d in c.diagnostics]
     assert "twists.pivot." in c.diagnostics[0].message
+
+
+def test_a_design_blocks_library_is_looked_up_as_a_robots(tmp_path):
+    """check_problems takes the robots' lookup (resolve_library.load_for): a problem inside a
+    design block's library file is pointed at there, with its line quoted, as for a robot (the
+    block's own copy of the lookup pointed at the `library` statement)."""
+    from modc.diagnostics.render import render_text
+
+    (tmp_path / "lib.yaml").write_text(MARK2.replace("torque_peak: 30.5 ", "torque_peak: 1e300", 1))
+    src = 'design d {\n    library "lib.yaml"\n    target t at (0.3, 0, 0.2) m\n    units 2\n}\n'
+    c = check_text(src, str(tmp_path / "a.mod"))
+    assert [d.code for d in c.diagnostics] == ["out-of-range"]
+    assert c.diagnostics[0].span.file == str(tmp_path / "lib.yaml")
+    assert "torque_peak: 1e300" in render_text(c.diagnostics, c.sources)

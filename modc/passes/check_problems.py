@@ -13,18 +13,7 @@ from ..diagnostics import codes
 from ..model import Design, Problem, ResolvedRobot, Robot, resolved
 from ..model import library as lib
 from .context import Context
-
-
-def _library(p: Problem, ctx: Context):
-    r = p.cell
-    ref = ctx.library_override or r.library_ref
-    where = Path(r.library_dir) if r.library_dir and not ctx.library_override else None
-    try:
-        return lib.load(ref, where)
-    except lib.LibraryError as e:
-        span = r.library_span if r.library_ref == ref and r.library_span.file != "<unknown>" else r.name_span
-        ctx.report(e.diagnostic(span, ref))
-        return None
+from .resolve_library import load_for
 
 
 def _check(p: Problem, library, ctx: Context) -> None:
@@ -80,7 +69,7 @@ def _reference(ref: Robot, cell: ResolvedRobot, library, ctx: Context) -> Resolv
 def run(design: Design, ctx: Context) -> Design:
     problems = []
     for p in design.problems:
-        library = _library(p, ctx)
+        library = load_for(p.cell, ctx)  # the robots' lookup, diagnostics included
         if library is not None:
             _check(p, library, ctx)
             update: dict = {}
