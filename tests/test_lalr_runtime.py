@@ -14,21 +14,25 @@ FILES = sorted([*(ROOT / "examples").glob("*.mod"), *(ROOT / "tests").rglob("*.m
 POSITIONS = ("line", "column", "end_line", "end_column", "start_pos", "end_pos")
 
 
-@pytest.fixture(scope="module", params=["built", "loaded"])
+@pytest.fixture(scope="module", params=[("built", 0), ("loaded", 0), ("loaded", lalr.UNION_AFTER), ("loaded", 10**9)])
 def runtime(request):
     """Exported from a freshly built Lark and from one loaded from cached tables, each stored
-    and read back as the cache does (marshal)."""
+    and read back as the cache does (marshal); lexing with each state's union pattern from the
+    first token, after UNION_AFTER tokens, or never (terminal by terminal)."""
     import lark
 
     from modc.resources import data_dir
 
-    if request.param == "built":
+    source_kind, union_after = request.param
+    if source_kind == "built":
         source = lark.Lark((data_dir("grammar") / "modc.lark").read_text(encoding="utf-8"), **parser._OPTIONS)
     else:
         source = parser._lark()
     data = lalr.export(source, "start")
     assert data is not None
-    return lalr.Parser(marshal.loads(marshal.dumps(data)))
+    runtime = lalr.Parser(marshal.loads(marshal.dumps(data)))
+    runtime.union_after = union_after
+    return runtime
 
 
 def _same(ours, theirs, where: str) -> None:
@@ -93,3 +97,28 @@ def test_a_syntax_error_gets_larks_diagnostic_through_the_runtime(tmp_path, monk
     finally:
         parser._runtime.cache_clear()
 
+
+
+@pytest.mark.parametrize("union_after", [0, 10**9])
+def test_overlapping_terminals_are_lexed_in_larks_order(union_after):
+    """Where a state accepts terminals that overlap, the first in Lark's order wins (priority,
+    then length), and a keyword spelled like a name is retyped: as Lark's union pattern does."""
+    import lark
+
+    grammar = """
+        start: item+
+        item: KW | WORD | NUM | "let" WORD | PAIR
+        KW.2: /if|else/
+        WORD: /[a-z]+/
+        NUM: /[0-9]+/
+        PAIR: /[a-z]+=[0-9]+/
+        %ignore " "
+    """
+    source = lark.Lark(grammar, parser="lalr", propagate_positions=True, maybe_placeholders=True)
+    data = lalr.export(source, "start")
+    assert data is not None
+    runtime = lalr.Parser(marshal.loads(marshal.dumps(data)))
+    runtime.union_after = union_after
+    for text in ("iffy else let x lettuce 42 a=1 if", "let let", "elsewhere x=3y"):
+        _same(runtime.parse(text), source.parse(text), text)
+    assert [t.type for t in runtime.parse("iffy").children[0].children] == ["KW"]  # 'if' then 'fy'

@@ -41,6 +41,11 @@ sys.modules[__name__].__class__ = _Package
 def main(argv: list[str] | None = None) -> None:
     """The `modc` command: each command's module is imported only when it runs (app.COMMANDS)."""
     args = list(sys.argv[1:] if argv is None else argv)
+    if args == ["--version"]:  # what the group's --version prints, without loading click
+        from .. import __version__
+
+        print(f"modc {__version__}")
+        raise SystemExit(0)
     if args[:1] == ["lint"]:
         from .lint_run import plain_args, run_plain
 
