@@ -122,3 +122,32 @@ def test_overlapping_terminals_are_lexed_in_larks_order(union_after):
     for text in ("iffy else let x lettuce 42 a=1 if", "let let", "elsewhere x=3y"):
         _same(runtime.parse(text), source.parse(text), text)
     assert [t.type for t in runtime.parse("iffy").children[0].children] == ["KW"]  # 'if' then 'fy'
+
+
+@pytest.mark.parametrize("damage", ["torn", "foreign", "garbage"])
+def test_a_damaged_runtime_entry_is_never_trusted(tmp_path, monkeypatch, damage):
+    import hashlib
+
+    monkeypatch.setenv("MODC_CACHE_DIR", str(tmp_path))
+    monkeypatch.delenv("MODC_NO_CACHE", raising=False)
+    parser._runtime.cache_clear()
+    try:
+        parser._runtime()
+        (entry,) = (tmp_path / "grammar").glob("*.lalr-rt")
+        blob = entry.read_bytes()
+        if damage == "torn":
+            blob = blob[: len(blob) // 2]
+        else:  # a valid digest over data that is not (or not wholly) the runtime's
+            data = {"format": lalr.FORMAT} if damage == "foreign" else {
+                **marshal.loads(blob.partition(b"\n")[2]), "states": {}, "lexers": [], "lexer_of": {}}
+            payload = marshal.dumps(data)
+            blob = hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload
+        entry.write_bytes(blob)
+        parser._runtime.cache_clear()
+        farm = (ROOT / "examples" / "farm.mod").read_text(encoding="utf-8")
+        tree, diags = parser.parse(farm, "farm.mod")
+        assert not diags and tree.robots[0].name.text == "farm"
+        _, diags = parser.parse("robot a {\n  chain H1 - \n}\n", "bad.mod")
+        assert diags and diags[0].span.line == 3
+    finally:
+        parser._runtime.cache_clear()

@@ -212,12 +212,10 @@ def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]
         tree = None
         runtime = _runtime()
         if runtime is not None:
-            from .lalr import ParseError
-
             try:
                 tree = runtime.parse(text)
-            except ParseError:  # a syntax error: Lark's exception makes the diagnostic
-                tree = None
+            except Exception:  # a syntax error (lalr.ParseError), whose diagnostic Lark's exception makes,
+                tree = None  # or data that passed its digest yet is not the runtime's: Lark decides
         if tree is None:
             from lark.exceptions import UnexpectedInput
 
