@@ -72,7 +72,7 @@ class Tree:
 def export(parser: Any, start: str) -> dict | None:
     """The runtime's data for a lark.Lark LALR parser (contextual lexer, no callbacks), or None
     when it uses something this runtime does not do."""
-    from lark.lexer import ContextualLexer, PatternStr, UnlessCallback
+    from lark.lexer import ContextualLexer
     from lark.parse_tree_builder import ChildFilterLALR, ChildFilterLALR_NoPlaceholders, maybe_create_child_filter
     from lark.parsers.lalr_analysis import Shift
 
@@ -110,7 +110,21 @@ def export(parser: Any, start: str) -> dict | None:
                 expand1 = bool(arg.options.expand1 and not arg.alias)
                 rules.append((str(name), str(arg.origin.name), len(arg.expansion), expand1, include, append))
             row[token] = (1, rule_index[arg])
-    contextual: Any = parser.parser.lexer
+    lexing = _export_lexers(parser.parser.lexer)
+    if lexing is None:
+        return None
+    lexers, terminals, lexer_of = lexing
+    return {"format": FORMAT, "states": states, "start": table.start_states[start], "end": table.end_states[start],
+            "rules": rules, "lexers": lexers, "terminals": terminals, "lexer_of": lexer_of,
+            "positions": bool(o.propagate_positions)}
+
+
+def _export_lexers(contextual: Any) -> tuple[list, dict, dict] | None:
+    """Each distinct state lexer of Lark's contextual lexer: its union pattern, its terminals in
+    Lark's order, the keywords its name-like terminals are retyped to, the terminals that may
+    hold a line break and those ignored; every terminal's literal or pattern; each state's lexer."""
+    from lark.lexer import PatternStr, UnlessCallback
+
     lexers: list = []
     terminals: dict[str, tuple[str | None, str]] = {}
     by_id: dict[int, int] = {}
@@ -136,9 +150,7 @@ def export(parser: Any, start: str) -> dict | None:
             lexers.append(([str(m.pattern) for m in scanner._mres], [str(t.name) for t in scanner.terminals], unless,
                            sorted(map(str, basic.newline_types)), sorted(map(str, basic.ignore_types))))
         lexer_of[state] = by_id[id(basic)]
-    return {"format": FORMAT, "states": states, "start": table.start_states[start], "end": table.end_states[start],
-            "rules": rules, "lexers": lexers, "terminals": terminals, "lexer_of": lexer_of,
-            "positions": bool(o.propagate_positions)}
+    return lexers, terminals, lexer_of
 
 
 # A state's lexer tries its terminals one by one, in Lark's order, first match winning (what the
