@@ -144,6 +144,8 @@ def test_a_damaged_tables_entry_is_rebuilt_never_used(cache_dir, damage):
     parser._lark.cache_clear()
     ast_file, diags = parser.parse((ROOT / "examples" / "farm.mod").read_text(encoding="utf-8"), "farm.mod")
     assert not diags and ast_file.robots[0].name.text == "farm"
+    _, diags = parser.parse("robot a {\n", "bad.mod")  # a syntax error is Lark's to describe: its tables again
+    assert diags[0].code == "unclosed-block"
     assert parser._load_tables(entry.name, parser._OPTIONS) is not None  # rewritten whole
 
 

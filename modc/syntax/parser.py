@@ -42,12 +42,19 @@ def _lark():
 
 @cache
 def _runtime():
-    """The lint parse without importing lark (modc.syntax.lalr), its data exported from Lark's
-    parser once and kept in modc's cache; None when there is no cache (Lark parses then)."""
+    """The lint parse without importing lark (modc.syntax.lalr): its data as shipped with modc
+    (modc.syntax.tables), else exported from Lark's parser once and kept in modc's cache; None
+    when neither can be had (Lark parses then)."""
     from .. import cache as store
-    from . import lalr
+    from . import lalr, tables
 
     text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
+    shipped = tables.load(text)
+    if shipped is not None:
+        try:
+            return lalr.Parser(shipped)
+        except Exception:  # not the runtime's data after all: the cache's, below
+            pass
     name = _runtime_name(text)
     if name is None or store.directory(_TABLES) is None:
         return None
@@ -80,24 +87,17 @@ def _export_runtime(name: str):
 
 def _runtime_name(text: str) -> str | None:
     """The runtime data's cache entry: keyed by the grammar, the options, the runtime's format,
-    Python's version and the lark installed (its package's __init__, which holds the version),
-    read without importing lark."""
-    import importlib.util
+    Python's version and the installed lark's version (read without importing lark)."""
     import sys
 
     from ..cache import key
     from .lalr import FORMAT
+    from .tables import lark_version
 
-    spec = importlib.util.find_spec("lark")
-    if spec is None or spec.origin is None:
+    version = lark_version()
+    if version is None:
         return None
-    try:
-        with open(spec.origin, "rb") as f:
-            lark_init = f.read()
-    except OSError:
-        return None
-    return key(text, repr(sorted(_OPTIONS.items())), lark_init, spec.origin, repr(sys.version_info[:2]),
-               str(FORMAT)) + ".lalr-rt"
+    return key(text, repr(sorted(_OPTIONS.items())), version, repr(sys.version_info[:2]), str(FORMAT)) + ".lalr-rt"
 
 
 def cached_lark(text: str, options: dict):
