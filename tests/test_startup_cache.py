@@ -49,7 +49,40 @@ def test_a_lint_with_a_warm_cache_imports_no_pydantic_no_yaml_and_no_other_comma
     code, again = _run(["lint", farm], tmp_path)
     assert code == 0
     assert not {"pydantic", "pydantic_core", "yaml"} & again
-    assert "modc.cli.lint" in again and not {"modc.cli.design_cmd", "modc.cli.motion", "modc.cli.view"} & again
+    # the lint's own runner, no other command's module, and neither click (a plain command line) nor
+    # lark (the grammar's tables run by modc.syntax.lalr) nor anything heavy
+    assert "modc.cli.lint_run" in again and not {"modc.cli.design_cmd", "modc.cli.motion", "modc.cli.view"} & again
+    assert not {"click", "lark", "jinja2", "numpy", "rich", "pygments"} & again, again
+
+
+def test_a_lint_command_line_click_would_read_otherwise_goes_to_click(tmp_path):
+    farm = str(ROOT / "examples" / "farm.mod")
+    for args in (["lint", "-q", farm, "--format=json"], ["lint", farm, "--sarif-root", ".", "-f", "sarif"]):
+        code, modules = _run(args, tmp_path)
+        assert code == 0 and "click" not in modules, args
+    for args in (["lint", "-fjson", farm], ["lint", "--quiet", "--quiet", farm], ["lint", "--", farm],
+                 ["lint", "-f", "yaml", farm], ["lint"], ["lint", "--help"]):
+        code, modules = _run(args, tmp_path)
+        assert "click" in modules, args  # click reads it, as before: its output and exit code are the command's
+        assert code == (2 if args in (["lint", "-f", "yaml", farm], ["lint"]) else 0), args
+
+
+def test_the_plain_lint_command_line_means_what_click_reads_in_it():
+    from modc.cli.lint import lint_cmd
+    from modc.cli.lint_run import plain_args
+
+    for args in (["a.mod"], ["a.mod", "b.mod", "-q"], ["-f", "github", "a.mod"], ["--format=sarif", "a.mod"],
+                 ["--library", "lib.yaml", "a.mod", "--sarif-root=src"], ["--quiet", "dir", "--library=mark2"]):
+        ours = plain_args(args)
+        assert ours is not None, args
+        ctx = lint_cmd.make_context("lint", list(args))
+        theirs = dict(ctx.params, files=list(ctx.params["files"]))
+        assert {**theirs, **ours} == theirs, args  # the same values; the rest are click's defaults
+        defaults = {"format": "text", "library": None, "quiet": False, "sarif_root": "."}
+        assert {**defaults, **ours} == theirs, args
+    for args in ([], ["-q"], ["-h", "a.mod"], ["-qf", "json", "a.mod"], ["--library", "-x", "a.mod"],
+                 ["--quiet=1", "a.mod"], ["-f", "a.mod"], ["--form", "json", "a.mod"], ["-", "a.mod"]):
+        assert plain_args(args) is None, args
 
 
 def test_the_command_line_still_has_every_command():
@@ -66,10 +99,12 @@ def cache_dir(tmp_path, monkeypatch):
     monkeypatch.setenv("MODC_CACHE_DIR", str(tmp_path))
     monkeypatch.delenv("MODC_NO_CACHE", raising=False)
     parser._lark.cache_clear()
+    parser._runtime.cache_clear()
     L._load_path.cache_clear()
     L._builtin.cache_clear()
     yield tmp_path
     parser._lark.cache_clear()
+    parser._runtime.cache_clear()
     L._load_path.cache_clear()
     L._builtin.cache_clear()
 
@@ -109,6 +144,8 @@ def test_a_damaged_tables_entry_is_rebuilt_never_used(cache_dir, damage):
     parser._lark.cache_clear()
     ast_file, diags = parser.parse((ROOT / "examples" / "farm.mod").read_text(encoding="utf-8"), "farm.mod")
     assert not diags and ast_file.robots[0].name.text == "farm"
+    _, diags = parser.parse("robot a {\n", "bad.mod")  # a syntax error is Lark's to describe: its tables again
+    assert diags[0].code == "unclosed-block"
     assert parser._load_tables(entry.name, parser._OPTIONS) is not None  # rewritten whole
 
 

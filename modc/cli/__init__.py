@@ -2,32 +2,56 @@
 `plan`, `view`, `design`, `fmt`, `lsp`, `schema`, `codes`, `backends`.
 
 Exit codes: 0 success, 1 diagnostics with errors (or a failed check), 2 usage or I/O error. Heavy
-libraries (numpy, jinja2, trimesh, pinocchio, pybullet…) are imported inside commands, never at start-up.
+libraries (numpy, jinja2, trimesh, pinocchio, pybullet…) are imported inside commands, never at start-up;
+a plain `modc lint` command line does not even import click (modc.cli.lint_run).
 """
 from __future__ import annotations
 
 import sys
+import types
 from typing import TYPE_CHECKING
-
-from . import app as _app_module
 
 if TYPE_CHECKING:
     from .app import app
 
 __all__ = ["app", "main"]
-# `modc.cli.app` is the click group (with every command registered), as it always was, not the
-# module that the import above bound here: see __getattr__.
-del app  # noqa: F821
 
 
-def __getattr__(name: str):
-    if name == "app":
-        _app_module.load_commands()
-        globals()["app"] = _app_module.app
-        return _app_module.app
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+class _Package(types.ModuleType):
+    """`modc.cli.app` is the click group (with every command registered), as it always was, not
+    the module modc/cli/app.py, whichever is imported first: the import system's binding of the
+    submodule here is set aside."""
+
+    @property
+    def app(self):
+        from .app import app as group
+        from .app import load_commands
+
+        load_commands()
+        return group
+
+    @app.setter
+    def app(self, _module) -> None:
+        pass
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 def main(argv: list[str] | None = None) -> None:
     """The `modc` command: each command's module is imported only when it runs (app.COMMANDS)."""
-    _app_module.run(list(sys.argv[1:] if argv is None else argv))
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args == ["--version"]:  # what the group's --version prints, without loading click
+        from .. import __version__
+
+        print(f"modc {__version__}")
+        raise SystemExit(0)
+    if args[:1] == ["lint"]:
+        from .lint_run import plain_args, run_plain
+
+        options = plain_args(args[1:])
+        if options is not None:
+            run_plain(options)
+    from .app import run
+
+    run(args)

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import click
 
-from .. import __version__
 from .app import (
     EXIT_ERRORS,
     EXIT_OK,
     EXIT_USAGE,
-    Verbosity,
     _err,
     _expand,
     _print_diagnostics,
@@ -17,11 +15,12 @@ from .app import (
     argument,
     library_option,
 )
+from .lint_run import FORMATS
 
 
 @app.command("lint")
 @argument("files", nargs=-1, required=True, help=".mod files or directories")
-@click.option("-f", "--format", type=click.Choice(["text", "json", "github", "sarif"]), default="text",
+@click.option("-f", "--format", type=click.Choice(list(FORMATS)), default="text",
               help="output format")
 @library_option
 @click.option("-q", "--quiet", is_flag=True, help="print errors only")
@@ -34,36 +33,9 @@ from .app import (
 )
 def lint_cmd(files: tuple[str, ...], format: str, library: str | None, quiet: bool, sarif_root: str) -> None:
     """Check files without writing anything."""
-    from ..compiler import InputError, check_file
-    from ..diagnostics.render import render_github, render_json, render_sarif, summary
+    from .lint_run import run
 
-    Verbosity.quiet = quiet
-    diags, sources, io_error = [], {}, False
-    paths = _expand(files, "modc lint")
-    for path in paths:
-        try:
-            c = check_file(path, library)
-        except InputError as e:
-            diags.append(e.diagnostic)
-            io_error = True
-            continue
-        diags += c.diagnostics
-        sources.update(c.sources)
-    shown = [d for d in diags if not (quiet and not d.is_error)]
-    if format == "json":
-        print(render_json(shown))
-    elif format == "github":
-        if shown:
-            print(render_github(shown))
-    elif format == "sarif":
-        print(render_sarif(shown, __version__, root=sarif_root, sources=sources))
-    else:
-        _print_diagnostics(diags, sources)
-        if not quiet:
-            _err(f"modc lint: {len(paths)} file{'s' * (len(paths) != 1)}, {summary(diags)}")
-    if io_error:
-        raise SystemExit(EXIT_USAGE)
-    raise SystemExit(EXIT_ERRORS if any(d.is_error for d in diags) else EXIT_OK)
+    run(files, format, library, quiet, sarif_root)
 
 
 @app.command("fmt")

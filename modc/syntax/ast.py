@@ -5,59 +5,50 @@ Numbers stay as written (value + unit word) here: units are checked while loweri
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ..diagnostics import Span
+from .node import Node
 
 
-@dataclass(frozen=True, slots=True)
-class Quantity:
+class Quantity(Node):
     value: float
     unit: str | None
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Vector:
+class Vector(Node):
     values: tuple[float, ...]
     unit: str | None
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Name:
+class Name(Node):
     text: str
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Param:
+class Param(Node):
     name: Name
     value: Quantity
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Unit:
+class Unit(Node):
     name: Name  # e.g. H4
     params: tuple[Param, ...]
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Chain:
+class Chain(Node):
     units: tuple[Unit, ...]
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class DHRow:
+class DHRow(Node):
     params: tuple[Param, ...]
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class DH:
+class DH(Node):
     """A standard DH table, to be converted into a chain (paper section 4.2)."""
 
     rows: tuple[DHRow, ...]
@@ -65,15 +56,13 @@ class DH:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Library:
+class Library(Node):
     ref: str  # built-in name or path (relative to the source file)
     is_path: bool
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Placement:
+class Placement(Node):
     """`base …` or `tool …`: a pose given as position and roll-pitch-yaw."""
 
     keyword: str
@@ -82,29 +71,25 @@ class Placement:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Payload:
+class Payload(Node):
     mass: Quantity
     at: Vector | None
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Pose:
+class Pose(Node):
     name: Name
     values: Vector
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Limit:
+class Limit(Node):
     joint: Name
     values: Vector
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Box:
+class Box(Node):
     name: Name
     size: Vector
     at: Vector
@@ -112,16 +97,14 @@ class Box:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Sphere:
+class Sphere(Node):
     name: Name
     radius: Quantity
     at: Vector
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Cylinder:
+class Cylinder(Node):
     name: Name
     radius: Quantity
     length: Quantity
@@ -130,8 +113,7 @@ class Cylinder:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Within:
+class Within(Node):
     """`within 5 mm, 2 deg`: a target's position (and orientation) tolerance."""
 
     position: Quantity
@@ -139,8 +121,7 @@ class Within:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Target:
+class Target(Node):
     name: Name
     at: Vector
     span: Span
@@ -149,14 +130,12 @@ class Target:
     pointing: Vector | None = None  # tool0's x axis (the approach) only, a direction in base_link
 
 
-@dataclass(frozen=True, slots=True)
-class Allow:
+class Allow(Node):
     codes: tuple[Name, ...]
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Units:
+class Units(Node):
     """`units 1 to 3` (design blocks): bounds on the number of units."""
 
     low: Quantity
@@ -164,16 +143,14 @@ class Units:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Modules:
+class Modules(Node):
     """`modules H1, H3, L4` (design blocks): the unit types a chain may use."""
 
     names: tuple[Name, ...]
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Links:
+class Links(Node):
     """`links 150 mm to 300 mm step 50 mm` (design blocks): link-module lengths to try."""
 
     low: Quantity
@@ -182,16 +159,14 @@ class Links:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Rank:
+class Rank(Node):
     """`rank modules, mass, margin` (design blocks): the order of objectives."""
 
     keys: tuple[Name, ...]
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Compare:
+class Compare(Node):
     """`compare with chain H1 - L4(…) - L3` (design blocks): a reference arm, evaluated on the cell
     with the ranking's own checks and shown beside the designs found."""
 
@@ -199,8 +174,7 @@ class Compare:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class PointRef:
+class PointRef(Node):
     """A target or region named in a task or path: `plant`, `tray`, `tray[1,0,0]` (index 0-based)."""
 
     name: Name
@@ -214,8 +188,7 @@ class PointRef:
         return self.name.text + "[" + ",".join(f"{q.value:g}" for q in self.index) + "]"
 
 
-@dataclass(frozen=True, slots=True)
-class Region:
+class Region(Node):
     """`region tray box size (…) m at (…) m grid 3 x 2 x 1 [rpy …] [within …]`: a grid of targets."""
 
     name: Name
@@ -228,8 +201,7 @@ class Region:
     pointing: Vector | None = None  # as a target's
 
 
-@dataclass(frozen=True, slots=True)
-class Task:
+class Task(Node):
     """`task serve { visit plant, tray, plant }`: joint-space motions through the targets in order."""
 
     name: Name
@@ -237,8 +209,7 @@ class Task:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class StraightPath:
+class StraightPath(Node):
     """`path seam from a to b straight`: tool0 along the segment a -> b."""
 
     name: Name
@@ -247,8 +218,7 @@ class StraightPath:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class Range:
+class Range(Node):
     """`yaw 0 to 90 deg step 45 deg`: an evenly stepped range (the low end may share the high's unit)."""
 
     low: Quantity
@@ -257,8 +227,7 @@ class Range:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class BaseWithin:
+class BaseWithin(Node):
     """`base within box size (…) m at (…) m step 50 mm [yaw …]` (design blocks): the base's grid."""
 
     size: Vector
@@ -275,8 +244,7 @@ Statement = (
 )
 
 
-@dataclass(frozen=True, slots=True)
-class Robot:
+class Robot(Node):
     name: Name
     body: tuple[Statement, ...]
     span: Span
@@ -288,8 +256,7 @@ DesignStatement = (
 )
 
 
-@dataclass(frozen=True, slots=True)
-class DesignBlock:
+class DesignBlock(Node):
     """`design NAME { … }`: a cell and its targets, for `modc design` to find chains for."""
 
     name: Name
@@ -297,8 +264,7 @@ class DesignBlock:
     span: Span
 
 
-@dataclass(frozen=True, slots=True)
-class File:
+class File(Node):
     path: str
     robots: tuple[Robot, ...]
     designs: tuple[DesignBlock, ...] = ()

@@ -40,6 +40,66 @@ def _lark():
     return cached_lark(text, _OPTIONS)
 
 
+@cache
+def _runtime():
+    """The lint parse without importing lark (modc.syntax.lalr): its data as shipped with modc
+    (modc.syntax.tables), else exported from Lark's parser once and kept in modc's cache; None
+    when neither can be had (Lark parses then)."""
+    from .. import cache as store
+    from . import lalr, tables
+
+    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
+    shipped = tables.load(text)
+    if shipped is not None:
+        try:
+            return lalr.Parser(shipped)
+        except Exception:  # not the runtime's data after all: the cache's, below
+            pass
+    name = _runtime_name(text)
+    if name is None or store.directory(_TABLES) is None:
+        return None
+    payload = store.get_checked(_TABLES, name)
+    if payload is not None:
+        import marshal
+
+        try:
+            return lalr.Parser(marshal.loads(payload))
+        except Exception:  # an entry of another format, or not ours: export it again
+            pass
+    return _export_runtime(name)
+
+
+def _export_runtime(name: str):
+    import marshal
+
+    from .. import cache as store
+    from . import lalr
+
+    data = lalr.export(_lark(), "start")
+    if data is None:
+        return None
+    try:
+        store.put_checked(_TABLES, name, marshal.dumps(data))
+    except ValueError:
+        return None
+    return lalr.Parser(data)
+
+
+def _runtime_name(text: str) -> str | None:
+    """The runtime data's cache entry: keyed by the grammar, the options, the runtime's format,
+    Python's version and the installed lark's version (read without importing lark)."""
+    import sys
+
+    from ..cache import key
+    from .lalr import FORMAT
+    from .tables import lark_version
+
+    version = lark_version()
+    if version is None:
+        return None
+    return key(text, repr(sorted(_OPTIONS.items())), version, repr(sys.version_info[:2]), str(FORMAT)) + ".lalr-rt"
+
+
 def cached_lark(text: str, options: dict):
     """Lark's LALR parser of the grammar text with these options, its tables from modc's cache
     when they are there (else built and stored)."""
@@ -146,16 +206,23 @@ def parse(text: str, file: str = "<string>") -> tuple[ast.File, list[Diagnostic]
     big = too_large(text, file)
     if big is not None:
         return ast.File(file, ()), [big]
-    from lark.exceptions import UnexpectedInput
-
     from .transform import ToAst
 
-    lark = _lark()
     with collector_paused():
-        try:
-            tree = lark.parse(text, start="start")
-        except UnexpectedInput as e:
-            return ast.File(file, ()), [_diagnose(e, text, file)]
+        tree = None
+        runtime = _runtime()
+        if runtime is not None:
+            try:
+                tree = runtime.parse(text)
+            except Exception:  # a syntax error (lalr.ParseError), whose diagnostic Lark's exception makes,
+                tree = None  # or data that passed its digest yet is not the runtime's: Lark decides
+        if tree is None:
+            from lark.exceptions import UnexpectedInput
+
+            try:
+                tree = _lark().parse(text, start="start")
+            except UnexpectedInput as e:
+                return ast.File(file, ()), [_diagnose(e, text, file)]
         blocks = ToAst(file).transform(tree)
     robots = tuple(b for b in blocks if isinstance(b, ast.Robot))
     designs = tuple(b for b in blocks if isinstance(b, ast.DesignBlock))

@@ -5,10 +5,13 @@ than lark.Transformer + v_args(meta=True), whose per-node wrappers cost a tenth 
 """
 from __future__ import annotations
 
-from lark import Token, Tree
+from typing import TYPE_CHECKING
 
 from ..diagnostics import Span
 from . import ast
+
+if TYPE_CHECKING:
+    from lark import Token
 
 
 def token_span(file: str, t: Token) -> Span:
@@ -27,12 +30,13 @@ class ToAst:
         self.file = file
 
     def transform(self, node):
-        if not isinstance(node, Tree):
+        # a tree of Lark's or of modc.syntax.lalr's (the lint parse), whose leaves are tokens (str) or None
+        if node is None or isinstance(node, str):
             return node
         children = [self.transform(c) for c in node.children]
         method = getattr(self, node.data, None)
         # rules without a method (the YAML form's *_text entry points) stay trees, as in Lark
-        return Tree(node.data, children, node.meta) if method is None else method(node.meta, children)
+        return type(node)(node.data, children, node.meta) if method is None else method(node.meta, children)
 
     def _span(self, meta) -> Span:
         return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column, meta.start_pos, meta.end_pos)

@@ -352,18 +352,18 @@ def _dotted(path: tuple) -> str:
 
 def _respan(node, span: Span):
     """Fragments were parsed out of context: point all their spans at the YAML scalar."""
-    import dataclasses
+    from .node import Node, fields, replace
 
     changes: dict[str, object] = {}
-    for f in dataclasses.fields(node):
-        v = getattr(node, f.name)
+    for name in fields(node):
+        v = getattr(node, name)
         if isinstance(v, Span):
-            changes[f.name] = span
-        elif dataclasses.is_dataclass(v):
-            changes[f.name] = _respan(v, span)
-        elif isinstance(v, tuple) and v and dataclasses.is_dataclass(v[0]):
-            changes[f.name] = tuple(_respan(x, span) for x in v)
-    return dataclasses.replace(node, **changes)
+            changes[name] = span
+        elif isinstance(v, Node):
+            changes[name] = _respan(v, span)
+        elif isinstance(v, tuple) and v and isinstance(v[0], Node):
+            changes[name] = tuple(_respan(x, span) for x in v)
+    return replace(node, **changes)
 
 
 def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
