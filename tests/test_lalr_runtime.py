@@ -8,14 +8,13 @@ import marshal
 import pytest
 from conftest import ROOT
 
-from modc.syntax import lalr, parser, tables
+from modc.syntax import lalr, parser
 
 FILES = sorted([*(ROOT / "examples").glob("*.mod"), *(ROOT / "tests").rglob("*.mod")])
 POSITIONS = ("line", "column", "end_line", "end_column", "start_pos", "end_pos")
 
 
-@pytest.fixture(scope="module", params=[("built", 0), ("loaded", 0), ("loaded", lalr.UNION_AFTER), ("loaded", 10**9),
-                                        ("shipped", lalr.UNION_AFTER)])
+@pytest.fixture(scope="module", params=[("built", 0), ("loaded", 0), ("loaded", lalr.UNION_AFTER), ("loaded", 10**9)])
 def runtime(request):
     """Exported from a freshly built Lark and from one loaded from cached tables, each stored
     and read back as the cache does (marshal); lexing with each state's union pattern from the
@@ -25,12 +24,6 @@ def runtime(request):
     from modc.resources import data_dir
 
     source_kind, union_after = request.param
-    if source_kind == "shipped":  # grammar/modc.lalr.json, as modc.syntax.tables reads it
-        data = tables.load((data_dir("grammar") / "modc.lark").read_text(encoding="utf-8"))
-        assert data is not None
-        runtime = lalr.Parser(data)
-        runtime.union_after = union_after
-        return runtime
     if source_kind == "built":
         source = lark.Lark((data_dir("grammar") / "modc.lark").read_text(encoding="utf-8"), **parser._OPTIONS)
     else:
@@ -89,7 +82,6 @@ def test_the_runtime_gives_larks_tree_or_leaves_the_file_to_lark(runtime):
 
 
 def test_a_syntax_error_gets_larks_diagnostic_through_the_runtime(tmp_path, monkeypatch):
-    monkeypatch.setattr(tables, "load", lambda text: None)  # no shipped tables: the cache's
     monkeypatch.setenv("MODC_CACHE_DIR", str(tmp_path))
     monkeypatch.delenv("MODC_NO_CACHE", raising=False)
     parser._runtime.cache_clear()
@@ -136,7 +128,6 @@ def test_overlapping_terminals_are_lexed_in_larks_order(union_after):
 def test_a_damaged_runtime_entry_is_never_trusted(tmp_path, monkeypatch, damage):
     import hashlib
 
-    monkeypatch.setattr(tables, "load", lambda text: None)  # no shipped tables: the cache's
     monkeypatch.setenv("MODC_CACHE_DIR", str(tmp_path))
     monkeypatch.delenv("MODC_NO_CACHE", raising=False)
     parser._runtime.cache_clear()
@@ -161,38 +152,3 @@ def test_a_damaged_runtime_entry_is_never_trusted(tmp_path, monkeypatch, damage)
     finally:
         parser._runtime.cache_clear()
 
-
-def test_the_shipped_tables_are_this_grammars_made_with_this_lark():
-    """grammar/modc.lalr.json is what `python -m modc.syntax.tables` makes now: remake it after
-    changing the grammar or upgrading lark (until then it is ignored and lint builds the tables)."""
-    import json
-
-    import lark
-
-    from modc.resources import data_dir
-
-    text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
-    with open(data_dir("grammar") / tables.NAME, encoding="utf-8") as f:
-        shipped = json.load(f)
-    assert shipped["stamp"]["lark"] == lark.__version__ == tables.lark_version(), "python -m modc.syntax.tables"
-    # (Lark numbers its states differently from one build to the next: the file is checked by its
-    # stamp here and, through the "shipped" runtime above, by parsing every file as Lark does)
-    assert shipped["stamp"] == tables.make(text)["stamp"], "stale: python -m modc.syntax.tables"
-    assert tables.load(text) is not None
-    assert tables.load(text + "\n// changed") is None  # another grammar: not these tables
-
-
-def test_a_lint_without_any_cache_imports_no_lark(tmp_path):
-    import json
-    import os
-    import subprocess
-    import sys
-
-    probe = ("import json, sys\nfrom modc.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit as e:\n"
-             "    code = e.code\nsys.stderr.write(json.dumps({'exit': code, 'modules': sorted(sys.modules)}))")
-    env = dict(os.environ, MODC_CACHE_DIR=str(tmp_path / "empty"), MODC_NO_CACHE="1")
-    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
-    p = subprocess.run([sys.executable, "-c", probe, "lint", str(ROOT / "examples" / "farm.mod")],
-                       capture_output=True, text=True, env=env, cwd=tmp_path)
-    doc = json.loads(p.stderr.strip().splitlines()[-1])
-    assert doc["exit"] == 0 and "lark" not in doc["modules"] and "click" not in doc["modules"]

@@ -42,19 +42,13 @@ def _lark():
 
 @cache
 def _runtime():
-    """The lint parse without importing lark (modc.syntax.lalr): its data as shipped with modc
-    (modc.syntax.tables), else exported from Lark's parser once and kept in modc's cache; None
-    when neither can be had (Lark parses then)."""
+    """The lint parse without importing lark (modc.syntax.lalr): its data exported from Lark's
+    parser once and kept in modc's cache (so only the first lint on a machine imports lark);
+    None when the cache is off (Lark parses then)."""
     from .. import cache as store
-    from . import lalr, tables
+    from . import lalr
 
     text = (data_dir("grammar") / "modc.lark").read_text(encoding="utf-8")
-    shipped = tables.load(text)
-    if shipped is not None:
-        try:
-            return lalr.Parser(shipped)
-        except Exception:  # not the runtime's data after all: the cache's, below
-            pass
     name = _runtime_name(text)
     if name is None or store.directory(_TABLES) is None:
         return None
@@ -85,6 +79,22 @@ def _export_runtime(name: str):
     return lalr.Parser(data)
 
 
+def lark_version() -> str | None:
+    """The installed lark's version, read from its package without importing it (~35 ms)."""
+    import importlib.util
+    import re
+
+    spec = importlib.util.find_spec("lark")
+    if spec is None or spec.origin is None:
+        return None
+    try:
+        with open(spec.origin, encoding="utf-8") as f:
+            m = re.search(r"""^__version__\s*(?::\s*str\s*)?=\s*["']([^"']+)["']""", f.read(), re.M)
+    except (OSError, UnicodeDecodeError):
+        return None
+    return m.group(1) if m else None
+
+
 def _runtime_name(text: str) -> str | None:
     """The runtime data's cache entry: keyed by the grammar, the options, the runtime's format,
     Python's version and the installed lark's version (read without importing lark)."""
@@ -92,7 +102,6 @@ def _runtime_name(text: str) -> str | None:
 
     from ..cache import key
     from .lalr import FORMAT
-    from .tables import lark_version
 
     version = lark_version()
     if version is None:
