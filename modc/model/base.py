@@ -7,7 +7,7 @@ from collections.abc import Callable
 from typing import Any, ClassVar, TypeVar
 
 from .. import names
-from .record import Record, as_plain, field
+from ..records import Record, as_plain, field
 
 
 class InvalidModel(ValueError):

@@ -12,13 +12,13 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from .. import names
+from ..records import Record
 from . import quantities as Q
 from .library_file import LIBRARY_KEYS, MAX_LIBRARY_BYTES, LibraryError, read_library, where  # noqa: F401 (re-exported)
-from .record import Record
 
 BUILTIN = {"mark2": "mark2.yaml", "mark2-strict": "mark2-strict.yaml"}
 
-# The library's types are frozen records (modc.model.record): a command whose library is in modc's cache
+# The library's types are frozen records (modc.records): a command whose library is in modc's cache
 # (modc.model.library_check) builds them from stored values without importing pydantic. Their
 # annotations are the schema: pydantic reads them, with the Rule and Bounds below, only when a
 # library file is validated.

@@ -16,9 +16,9 @@ from typing import Annotated, Any
 
 from .._version import __version__
 from ..diagnostics.plain_words import plain_words
+from ..records import Record, as_fields, is_record
 from . import library as L
 from .library_file import MAX_LIBRARY_BYTES, LibraryError, read_library, where
-from .record import Record, as_fields, is_record
 
 _KIND = "library"
 FORMAT = "1"  # the entry's layout
@@ -134,7 +134,7 @@ def _types_source() -> bytes:
     """The source of the library's types: an entry written by other types is another key."""
     from pathlib import Path
 
-    from . import record
+    from .. import records as record
 
     try:
         return b"".join(Path(m.__file__ or "").read_bytes() for m in (L, record))

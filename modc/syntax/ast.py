@@ -6,49 +6,49 @@ Numbers stay as written (value + unit word) here: units are checked while loweri
 from __future__ import annotations
 
 from ..diagnostics import Span
-from .node import Node
+from ..records import Record
 
 
-class Quantity(Node):
+class Quantity(Record, kw_only=False):
     value: float
     unit: str | None
     span: Span
 
 
-class Vector(Node):
+class Vector(Record, kw_only=False):
     values: tuple[float, ...]
     unit: str | None
     span: Span
 
 
-class Name(Node):
+class Name(Record, kw_only=False):
     text: str
     span: Span
 
 
-class Param(Node):
+class Param(Record, kw_only=False):
     name: Name
     value: Quantity
     span: Span
 
 
-class Unit(Node):
+class Unit(Record, kw_only=False):
     name: Name  # e.g. H4
     params: tuple[Param, ...]
     span: Span
 
 
-class Chain(Node):
+class Chain(Record, kw_only=False):
     units: tuple[Unit, ...]
     span: Span
 
 
-class DHRow(Node):
+class DHRow(Record, kw_only=False):
     params: tuple[Param, ...]
     span: Span
 
 
-class DH(Node):
+class DH(Record, kw_only=False):
     """A standard DH table, to be converted into a chain (paper section 4.2)."""
 
     rows: tuple[DHRow, ...]
@@ -56,13 +56,13 @@ class DH(Node):
     span: Span
 
 
-class Library(Node):
+class Library(Record, kw_only=False):
     ref: str  # built-in name or path (relative to the source file)
     is_path: bool
     span: Span
 
 
-class Placement(Node):
+class Placement(Record, kw_only=False):
     """`base …` or `tool …`: a pose given as position and roll-pitch-yaw."""
 
     keyword: str
@@ -71,25 +71,25 @@ class Placement(Node):
     span: Span
 
 
-class Payload(Node):
+class Payload(Record, kw_only=False):
     mass: Quantity
     at: Vector | None
     span: Span
 
 
-class Pose(Node):
+class Pose(Record, kw_only=False):
     name: Name
     values: Vector
     span: Span
 
 
-class Limit(Node):
+class Limit(Record, kw_only=False):
     joint: Name
     values: Vector
     span: Span
 
 
-class Box(Node):
+class Box(Record, kw_only=False):
     name: Name
     size: Vector
     at: Vector
@@ -97,14 +97,14 @@ class Box(Node):
     span: Span
 
 
-class Sphere(Node):
+class Sphere(Record, kw_only=False):
     name: Name
     radius: Quantity
     at: Vector
     span: Span
 
 
-class Cylinder(Node):
+class Cylinder(Record, kw_only=False):
     name: Name
     radius: Quantity
     length: Quantity
@@ -113,7 +113,7 @@ class Cylinder(Node):
     span: Span
 
 
-class Within(Node):
+class Within(Record, kw_only=False):
     """`within 5 mm, 2 deg`: a target's position (and orientation) tolerance."""
 
     position: Quantity
@@ -121,7 +121,7 @@ class Within(Node):
     span: Span
 
 
-class Target(Node):
+class Target(Record, kw_only=False):
     name: Name
     at: Vector
     span: Span
@@ -130,12 +130,12 @@ class Target(Node):
     pointing: Vector | None = None  # tool0's x axis (the approach) only, a direction in base_link
 
 
-class Allow(Node):
+class Allow(Record, kw_only=False):
     codes: tuple[Name, ...]
     span: Span
 
 
-class Units(Node):
+class Units(Record, kw_only=False):
     """`units 1 to 3` (design blocks): bounds on the number of units."""
 
     low: Quantity
@@ -143,14 +143,14 @@ class Units(Node):
     span: Span
 
 
-class Modules(Node):
+class Modules(Record, kw_only=False):
     """`modules H1, H3, L4` (design blocks): the unit types a chain may use."""
 
     names: tuple[Name, ...]
     span: Span
 
 
-class Links(Node):
+class Links(Record, kw_only=False):
     """`links 150 mm to 300 mm step 50 mm` (design blocks): link-module lengths to try."""
 
     low: Quantity
@@ -159,14 +159,14 @@ class Links(Node):
     span: Span
 
 
-class Rank(Node):
+class Rank(Record, kw_only=False):
     """`rank modules, mass, margin` (design blocks): the order of objectives."""
 
     keys: tuple[Name, ...]
     span: Span
 
 
-class Compare(Node):
+class Compare(Record, kw_only=False):
     """`compare with chain H1 - L4(…) - L3` (design blocks): a reference arm, evaluated on the cell
     with the ranking's own checks and shown beside the designs found."""
 
@@ -174,7 +174,7 @@ class Compare(Node):
     span: Span
 
 
-class PointRef(Node):
+class PointRef(Record, kw_only=False):
     """A target or region named in a task or path: `plant`, `tray`, `tray[1,0,0]` (index 0-based)."""
 
     name: Name
@@ -188,7 +188,7 @@ class PointRef(Node):
         return self.name.text + "[" + ",".join(f"{q.value:g}" for q in self.index) + "]"
 
 
-class Region(Node):
+class Region(Record, kw_only=False):
     """`region tray box size (…) m at (…) m grid 3 x 2 x 1 [rpy …] [within …]`: a grid of targets."""
 
     name: Name
@@ -201,7 +201,7 @@ class Region(Node):
     pointing: Vector | None = None  # as a target's
 
 
-class Task(Node):
+class Task(Record, kw_only=False):
     """`task serve { visit plant, tray, plant }`: joint-space motions through the targets in order."""
 
     name: Name
@@ -209,7 +209,7 @@ class Task(Node):
     span: Span
 
 
-class StraightPath(Node):
+class StraightPath(Record, kw_only=False):
     """`path seam from a to b straight`: tool0 along the segment a -> b."""
 
     name: Name
@@ -218,7 +218,7 @@ class StraightPath(Node):
     span: Span
 
 
-class Range(Node):
+class Range(Record, kw_only=False):
     """`yaw 0 to 90 deg step 45 deg`: an evenly stepped range (the low end may share the high's unit)."""
 
     low: Quantity
@@ -227,7 +227,7 @@ class Range(Node):
     span: Span
 
 
-class BaseWithin(Node):
+class BaseWithin(Record, kw_only=False):
     """`base within box size (…) m at (…) m step 50 mm [yaw …]` (design blocks): the base's grid."""
 
     size: Vector
@@ -244,7 +244,7 @@ Statement = (
 )
 
 
-class Robot(Node):
+class Robot(Record, kw_only=False):
     name: Name
     body: tuple[Statement, ...]
     span: Span
@@ -256,7 +256,7 @@ DesignStatement = (
 )
 
 
-class DesignBlock(Node):
+class DesignBlock(Record, kw_only=False):
     """`design NAME { … }`: a cell and its targets, for `modc design` to find chains for."""
 
     name: Name
@@ -264,7 +264,7 @@ class DesignBlock(Node):
     span: Span
 
 
-class File(Node):
+class File(Record, kw_only=False):
     path: str
     robots: tuple[Robot, ...]
     designs: tuple[DesignBlock, ...] = ()

@@ -352,16 +352,16 @@ def _dotted(path: tuple) -> str:
 
 def _respan(node, span: Span):
     """Fragments were parsed out of context: point all their spans at the YAML scalar."""
-    from .node import Node, fields, replace
+    from ..records import Record, fields, replace
 
     changes: dict[str, object] = {}
     for name in fields(node):
         v = getattr(node, name)
         if isinstance(v, Span):
             changes[name] = span
-        elif isinstance(v, Node):
+        elif isinstance(v, Record):
             changes[name] = _respan(v, span)
-        elif isinstance(v, tuple) and v and isinstance(v[0], Node):
+        elif isinstance(v, tuple) and v and isinstance(v[0], Record):
             changes[name] = tuple(_respan(x, span) for x in v)
     return replace(node, **changes)
 

@@ -1,10 +1,12 @@
-"""Frozen records: the value types of the checked model and of the module library.
+"""Frozen records: the value types of the AST, the checked model and the module library.
 
-A record is what a frozen, keyword-only dataclass is (fields from the class's annotations,
+A record is what a frozen dataclass is (fields from the class's annotations, in order,
 defaults, equality and hash over the fields, a repr, no assignment after __init__), made without
-dataclasses' code generation: that cost ~0.7 ms a class at import, about 20 ms of every command
-for the model's and the library's 30 classes (benchmarks/bench_startup.py). Type checkers see
-dataclasses (dataclass_transform).
+dataclasses' code generation: that cost ~0.7 ms a class at import, about 40 ms of every command
+for the AST's, the model's and the library's ~60 classes (benchmarks/bench_startup.py). Fields
+are keyword-only, as the model's are, unless the class says `kw_only=False` (the AST's nodes,
+built positionally by the parser). Each class gets one small generated __init__. Type checkers
+see dataclasses (dataclass_transform).
 """
 from __future__ import annotations
 
@@ -41,7 +43,7 @@ class Record:
     _factories: ClassVar[dict[str, Callable[[], Any]]] = {}
     _hidden: ClassVar[frozenset[str]] = frozenset()
 
-    def __init_subclass__(cls, **kwargs: Any) -> None:
+    def __init_subclass__(cls, kw_only: bool = True, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         fields, defaults, factories = list(cls._fields), dict(cls._defaults), dict(cls._factories)
         hidden = set(cls._hidden)
@@ -65,24 +67,15 @@ class Record:
             if value is not _MISSING:
                 defaults[name] = value
         cls._fields, cls._defaults, cls._factories, cls._hidden = tuple(fields), defaults, factories, frozenset(hidden)
-
-    def __init__(self, **values: Any) -> None:
-        d = self.__dict__
-        for name in self._fields:
-            if name in values:
-                d[name] = values.pop(name)
-            elif name in self._defaults:
-                d[name] = self._defaults[name]
-            elif name in self._factories:
-                d[name] = self._factories[name]()
-            else:
-                raise TypeError(f"{type(self).__name__}() missing field '{name}'")
-        if values:
-            raise TypeError(f"{type(self).__name__}() got an unexpected field '{next(iter(values))}'")
-        self.__post_init__()
+        cls.__init__ = _make_init(cls, not kw_only)  # type: ignore[method-assign]
+        if not kw_only:
+            setattr(cls, "__match_args__", cls._fields)  # noqa: B010 - mypy reads __match_args__ as fixed
 
     def __post_init__(self) -> None:
         """Checks and conversions of a new record (assign with object.__setattr__)."""
+
+    def __init__(self, **values: Any) -> None:  # replaced in each subclass by _make_init's
+        raise TypeError("Record is a base class")
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise dataclasses.FrozenInstanceError(f"cannot assign to field '{name}'")
@@ -105,6 +98,45 @@ class Record:
     def __repr__(self) -> str:
         shown = ", ".join(f"{n}={self.__dict__[n]!r}" for n in self._fields if n not in self._hidden)
         return f"{type(self).__name__}({shown})"
+
+
+def _make_init(cls: type[Record], positional: bool) -> Callable[..., None]:
+    """The class's __init__: its fields as parameters (keyword-only unless positional), defaults
+    and factories filled in, then __post_init__."""
+    params, body = [], []
+    scope: dict[str, Any] = {"_MISSING": _MISSING}
+    for n in cls._fields:
+        if n in cls._defaults:
+            scope[f"_d_{n}"] = cls._defaults[n]
+            params.append(f"{n}=_d_{n}")
+        elif n in cls._factories:
+            scope[f"_f_{n}"] = cls._factories[n]
+            params.append(f"{n}=_MISSING")
+        else:
+            params.append(n)
+        body.append(f"    _record_dict[{n!r}] = _f_{n}() if {n} is _MISSING else {n}\n" if n in cls._factories
+                    else f"    _record_dict[{n!r}] = {n}\n")
+    if positional and any(p.count("=") == 0 for p in params[next((i for i, p in enumerate(params) if "=" in p),
+                                                                  len(params)):]):
+        raise TypeError(f"{cls.__name__}: a field without a default follows one with a default")
+    head = ", ".join(params) if positional else ("*, " + ", ".join(params) if params else "")
+    signature = f"def __init__(self{', ' if head else ''}{head}):\n"
+    # (locals start with _record_ or _d_/_f_: a field may be called d, as DH's is)
+    source = f"{signature}    _record_dict = self.__dict__\n{''.join(body)}    self.__post_init__()\n"
+    exec(source, scope)  # noqa: S102 - parameter names are the class's own field names (identifiers)
+    init = scope["__init__"]
+    init.__qualname__ = f"{cls.__qualname__}.__init__"
+    return init
+
+
+def fields(r: Record) -> tuple[str, ...]:
+    """The record's field names, in order."""
+    return r._fields
+
+
+def replace(r: Record, **changes: Any) -> Any:
+    """A copy of the record with some fields changed (dataclasses.replace)."""
+    return type(r)(**{n: changes.get(n, r.__dict__[n]) for n in r._fields})
 
 
 def is_record(tp: Any) -> bool:

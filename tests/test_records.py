@@ -1,4 +1,5 @@
-"""The AST's node base (modc.syntax.node) behaves as the frozen dataclasses it replaced."""
+"""The one record base (modc.records): the AST nodes and the model records behave as the frozen
+dataclasses they replaced."""
 from __future__ import annotations
 
 import copy
@@ -8,8 +9,8 @@ import pickle
 import pytest
 
 from modc.diagnostics import Span
+from modc.records import fields, replace
 from modc.syntax import ast
-from modc.syntax.node import fields, replace
 
 S = Span.point("t.mod")
 
@@ -51,3 +52,21 @@ def test_class_patterns_match():
             assert text == "home"
         case _:
             pytest.fail("no match")
+
+
+def test_a_keyword_record_takes_any_field_name_and_fills_defaults_and_factories():
+    """The model's records are keyword-only; a field may be called as the generated __init__'s
+    own locals might be (DH's `d`), and a factory gives each record its own value."""
+    from modc.records import Record, field
+
+    class Row(Record):
+        d: float
+        a: float = 0.0
+        notes: list = field(default_factory=list)
+
+    r, s = Row(d=0.1), Row(d=0.1)
+    assert (r.d, r.a, r.notes) == (0.1, 0.0, []) and r == s and r.notes is not s.notes
+    with pytest.raises(TypeError):
+        Row(0.1)  # type: ignore[misc]  # keyword-only
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        r.d = 0.2  # type: ignore[misc]
