@@ -11,6 +11,7 @@ from ..kinematics import matrix_rpy
 from ..model import ResolvedRobot
 from ..physical import collisions
 from ..physical.assembly import Description
+from ..physical.parts import MATERIALS
 from .build import Build
 from .format import num, vec
 from .templates import comment
@@ -41,16 +42,6 @@ def collision_matrix(build: Build, robot: ResolvedRobot) -> collisions.Collision
     if key not in cache:
         cache[key] = collisions.cached_matrix(build.description(robot), samples, seed)
     return cache[key]
-
-
-# name -> RGBA; parts pick a material by role
-MATERIALS = {
-    "heavy": (0.20, 0.33, 0.55, 1.0),
-    "light": (0.90, 0.50, 0.15, 1.0),
-    "twist": (0.75, 0.75, 0.75, 1.0),
-    "actuator": (0.12, 0.12, 0.12, 1.0),
-    "link": (0.92, 0.92, 0.88, 1.0),
-}
 
 
 def _origin(T) -> dict:

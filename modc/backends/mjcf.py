@@ -50,11 +50,11 @@ from ..model import ResolvedRobot
 from ..physical.assembly import Description
 from ..physical.constants import GRAVITY_VECTOR, TIME_STEP
 from ..physical.parts import Primitive
-from . import Build, register
 from . import format as fmt
-from .srdf import collision_matrix
+from .build import Build
+from .common import MATERIALS, collision_matrix
+from .registry import register
 from .templates import comment, render
-from .urdf import MATERIALS
 
 ERROR_AT_PEAK = 0.005  # rad of position error at which a servo reaches the actuator's peak torque
 ARMATURE = 1e-3  # kg·m², reflected rotor inertia per joint (numerical regularisation, see above)

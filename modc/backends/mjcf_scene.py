@@ -25,7 +25,7 @@ from .._version import __version__
 from ..kinematics import matrix_rpy, rpy_matrix, transform
 from ..model import ResolvedRobot
 from ..physical.cell import OBSTACLE_RGBA, TARGET_RADIUS, TARGET_RGBA
-from . import Build
+from .build import Build
 from .mjcf import TARGET_PREFIX, num, placement, vec
 from .templates import comment
 

@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 from .build import Build
-from .common import MATERIALS, urdf_context
+from .common import urdf_context
 from .registry import register
 from .templates import render
 
-__all__ = ["MATERIALS", "emit", "urdf_text"]  # MATERIALS: view/ and mjcf read the colours here today
+__all__ = ["emit", "urdf_text"]
 
 
 def urdf_text(build: Build, robot, mesh_prefix: str = "../meshes/") -> str:

@@ -20,6 +20,17 @@ Z_TO_Y = ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0))  # Rx(90°): a z-a
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
+# A part's colour (Part.color) -> RGBA: one home for the URDF's materials, the MJCF and the viewer
+MATERIALS = {
+    "heavy": (0.20, 0.33, 0.55, 1.0),
+    "light": (0.90, 0.50, 0.15, 1.0),
+    "twist": (0.75, 0.75, 0.75, 1.0),
+    "actuator": (0.12, 0.12, 0.12, 1.0),
+    "link": (0.92, 0.92, 0.88, 1.0),
+}
+
+
+
 @dataclass(frozen=True)
 class Primitive:
     shape: str  # "cylinder" (r, h) | "tube" (r_in, r_out, h) | "box" (x, y, z); cylinders along local z

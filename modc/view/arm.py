@@ -46,7 +46,7 @@ OUTPUT_PARTS = ("output_casing", "link_")  # physical.assembly: these ride on th
 
 
 def part_rgb(part: Part) -> tuple[int, int, int]:
-    from ..backends.urdf import MATERIALS
+    from ..physical.parts import MATERIALS
 
     r, g, b, _ = MATERIALS.get(part.color, (0.6, 0.6, 0.6, 1.0))
     return (round(r * 255), round(g * 255), round(b * 255))
