@@ -153,6 +153,15 @@ def _longest(problem: Problem, n: int) -> list[space.Shape]:
     return space.shapes(problem, n)
 
 
+def _edge(problem: Problem, mass: float | None) -> float | None:
+    """The lightest unsearched shape's mass as the search compares designs with it: equal masses
+    summed in another order differ in the last bits, so 1e-9 kg either way - ahead of a design
+    as heavy when margin may still tell them apart, level with it when nothing can."""
+    if mass is None:
+        return None
+    return mass - 1e-9 if "margin" in problem.rank else mass + 1e-9
+
+
 Ceiling = tuple[int, float, bool]  # (modules, kg, ties): only shapes that could rank before this
 
 
@@ -327,7 +336,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
                     # and stop the round once `top` designs rank before every unsearched shape (the
                     # same point whatever the executor: shapes complete in submission order). A
                     # round searched to its end stops the search at `enough` (below).
-                    below = after.get(p.shape.label())
+                    below = _edge(problem, after.get(p.shape.label()))
                     if early and below is not None and (res.found or tally.accepted):
                         tally.settle(n, below)
                         if tally.done(n, below, top):
@@ -343,7 +352,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
                 _absorb(out, res, names, closest, hit, clear, searched)
                 tally.add(n, splits, res)
             stop = _stopping(deadline)
-            nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) and not stop else float("inf")
+            nxt = _edge(problem, rounds[k + 1][0][0]) if k + 1 < len(rounds) and not stop else float("inf")
             if halt:  # the rest of the round unsearched: nothing heavier than it may be checked
                 nxt = halt[0]
                 seen = {r.shape.label() for r in searched}
