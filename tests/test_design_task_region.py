@@ -95,3 +95,38 @@ def test_the_region_is_served_by_a_planned_design():
     visits = [s.end for s in d.plans[0].counted]
     assert visits == [f"tray[{i},{j},0]" for i in range(3) for j in range(2)]
     assert d.cycle_time > 0 and d.coverage == 1.0
+
+
+def test_with_margin_ranked_every_shape_as_light_as_the_design_is_searched(monkeypatch):
+    """A round stops at a shape only once nothing unsearched can beat the design: with margin
+    ranked, a shape as light as the design (even by the last bits of a sum, 1.82 vs
+    1.8199999999999998 kg) may still beat it on torque margin, so it is searched."""
+    from modc.design import run, search
+
+    seen: set = set()
+    real = search.search_part
+
+    def counted(spec, shape, *a, **kw):
+        seen.add(shape)
+        return real(spec, shape, *a, **kw)
+
+    monkeypatch.setattr(search, "search_part", counted)
+    p = problem("""design shelf {
+    payload 100 g
+    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
+    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    target c at (0.10, 0.30, 0.45) m
+    units 3
+}
+""")
+    assert "margin" in p.rank
+    o = run.design(p, top=1)
+    assert len(o.designs) == 1
+    from modc.design.evaluate import Spec
+
+    closest = {t.name: float("inf") for t in p.cell.targets}
+    (_n, _splits, shapes), = run._tiers(p, Spec.of(p), 3, closest)  # the shapes within the reach bound
+    as_light = {s for m, _, s in shapes if m <= o.designs[0].mass + 1e-6}
+    assert len(as_light) > 1 and as_light <= seen
