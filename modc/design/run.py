@@ -153,12 +153,10 @@ def _longest(problem: Problem, n: int) -> list[space.Shape]:
     return space.shapes(problem, n)
 
 
-def _edge(problem: Problem, mass: float | None) -> float | None:
+def _edge(problem: Problem, mass: float) -> float:
     """The lightest unsearched shape's mass as the search compares designs with it: equal masses
     summed in another order differ in the last bits, so 1e-9 kg either way - ahead of a design
     as heavy when margin may still tell them apart, level with it when nothing can."""
-    if mass is None:
-        return None
     return mass - 1e-9 if "margin" in problem.rank else mass + 1e-9
 
 
@@ -336,7 +334,8 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
                     # and stop the round once `top` designs rank before every unsearched shape (the
                     # same point whatever the executor: shapes complete in submission order). A
                     # round searched to its end stops the search at `enough` (below).
-                    below = _edge(problem, after.get(p.shape.label()))
+                    heavier = after.get(p.shape.label())
+                    below = None if heavier is None else _edge(problem, heavier)
                     if early and below is not None and (res.found or tally.accepted):
                         tally.settle(n, below)
                         if tally.done(n, below, top):
