@@ -28,7 +28,9 @@ thread), so other load on the machine does not count; wall figures are time.perf
                whole space on 2 workers.
 5. dask        units of work (five-unit shapes of the three-target cell) on a Dask LocalCluster of 1 and 2
                single-thread worker processes: wall s, and the extrapolation to 64 workers.
-6. anchor      Timor-python 1.1.1 (TUM) in its own venv: per design, assemble a 3-DoF chain
+6. task        benchmarks/bench_task.py's goals (a 4-goal visit task <= 60 s, a 12-point region
+               <= 30 s CPU) and benchmarks/bench_task_base.py's base placement (1 pose vs 25).
+7. anchor      Timor-python 1.1.1 (TUM) in its own venv: per design, assemble a 3-DoF chain
                from geometric_primitive_modules, build its pinocchio robot, IK for three targets
                (each the FK of a random pose); the first (warm-up) design counts in nothing.
 """
@@ -390,6 +392,11 @@ def main() -> None:
     result["reference"] = bench_reference(48 if args.quick else 192)
     result["solve"] = bench_solve()
     result["complete"] = bench_complete()
+    from bench_task import bench_region, bench_visit  # the task goals and base placement, side by side
+    from bench_task_base import bench_base
+
+    result["task"] = {"visit": bench_visit(), "region": bench_region()}
+    result["base_placement"] = bench_base()
     result["anchor"] = bench_timor(Path(args.timor), 10 if args.quick else 40)
     c, r, s, k, lib = (result[x] for x in ("candidate", "reference", "solve", "complete", "library"))
     a = result["anchor"]
@@ -405,6 +412,14 @@ def main() -> None:
              f"{s['evaluated']:,} settings over {s['shapes']} shapes, complete={s['complete']}; best {s['best']}",
              f"complete   nothing feasible, units 1-3: {k['seconds_cpu']:.1f} s CPU, {k['evaluated']:,} settings "
              f"({k['excluded']:,} excluded by bounds), complete={k['complete']}: {k['why_none']}"]
+    for name, t in result["task"].items():
+        lines.append(f"task       {name}: {t['seconds_cpu']:.1f} s CPU (goal {t['goal_cpu_s']:.0f} s; search "
+                     f"{t['static_search_cpu_s']:.1f} s, planning {t['planning_cpu_s']:.1f} s); best {t['best']} "
+                     f"({t['cycle_time_s']} s)")
+    b = result["base_placement"]["top1"]
+    one, many = b["one_pose"], b["poses_25"]
+    lines.append(f"base       1 pose {one['seconds_cpu']:.1f} s, 25 poses {many['seconds_cpu']:.1f} s CPU "
+                 f"({many['bases_searched']} searched): {b['ratio_cpu']:.1f}x (goal <= 5)")
     if "walled_workers2_wall_s" in lib:
         lines.append(f"library    walled cell, units 1-6, --workers 2: {lib['walled_workers2_wall_s']:.1f} s wall "
                      f"(exit {lib['walled_exit']})")

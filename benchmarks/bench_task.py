@@ -14,8 +14,7 @@ warm-up design (one target, no task) runs first and counts in nothing.
 
    visit   a 4-goal `visit` task around a post, units 2 to 3, every module type: goal <= 60 s CPU
    region  a 12-point region (grid 4 x 3 x 1) visited in one task, units 2 to 3: goal <= 30 s CPU
-   points  the same 12 points written as targets (the static search screens targets, not region
-           points): what the region goal costs once regions are screened too
+   points  the same 12 points written as targets: the region costs what its points as targets cost
 """
 from __future__ import annotations
 
@@ -58,9 +57,9 @@ VISIT = """design visit4 {
 """
 
 # A tray of 4 x 3 cells, 5 cm apart, served in one task by position (each within 5 mm), from a
-# point above its centre. The static search screens only `target`s, not region points (the
-# planner meets those), and fails on a block with no target at all (evaluate.screen_batch:
-# max() of an empty sequence): hence the target `above`.
+# point above its centre. Every point is required: the static search screens the 12 points as
+# targets (modc.design.tasks.with_points), each from the candidate's own solution at the nearest
+# point it already reached (evaluate.screen_batch).
 REGION = """design tray12 {
     payload 50 g
     target above at (0.30, 0, 0.25) m

@@ -42,6 +42,8 @@ def _run(text: str, top: int) -> dict:
     return {"seconds_cpu": round(cpu, 3), "seconds_wall": round(wall, 3), "designs": len(o.designs),
             "best": best.chain() if best else None,
             "best_base_m": list(best.verified.robot.base.xyz) if best else None,
+            "best_mass_kg": round(best.mass, 6) if best else None,
+            "best_margin": round(best.margin, 6) if best else None,
             "bases_searched": o.bases_searched, "bases_pruned": o.bases_pruned, "bases_total": o.bases_total}
 
 

@@ -66,24 +66,64 @@ def test_base_poses_beyond_reach_are_skipped_soundly_and_nearest_first():
     assert np.linalg.norm(np.subtract(p.cell.targets[0].xyz, far.xyz)) - 0.005 > longest
 
 
-def test_poses_after_the_top_designs_are_not_searched(monkeypatch):
-    """First fit: poses nearest first, each searched completely, until `top` designs are found."""
+# from the pose nearest the target (x = 0.3 m) it lies 0.35 m straight above the base, where no
+# 2-unit H1/L3 arm reaches (a 3-unit one does); from x = 0.2 m a 2-unit arm reaches it
+FARTHER = """design farther {
+    target a at (0.3, 0, 0.35) m
+    units 2 to 3
+    modules H1, L3
+    base within box size (0.1, 0, 0) m at (0.25, 0, 0) m step 100 mm
+}
+"""
+
+
+def test_the_best_pose_wins_not_the_first_that_fits():
+    """First fit (the nearest pose searched alone) returned a 3-module arm at x = 0.3 m (it fails
+    with the first-fit search): the 2-module arm at x = 0.2 m ranks first."""
     from modc.design import placement, run
 
+    p = problem(FARTHER)
+    kept, _, _ = placement.poses(p, run.longest_reach(p, 3))
+    assert [k.xyz[0] for k in kept] == pytest.approx([0.3, 0.2])  # nearest first
+    fixed = FARTHER.replace("    base within box size (0.1, 0, 0) m at (0.25, 0, 0) m step 100 mm\n",
+                            "    base at (0.3, 0, 0) m\n")
+    assert not run.design(problem(fixed), top=1, max_units=2).designs  # the nearest pose needs 3 units
+    o = run.design(p, top=1)
+    assert len(o.designs) == 1 and o.designs[0].modules == 2
+    assert o.designs[0].verified.robot.base.xyz == pytest.approx((0.2, 0.0, 0.0))
+
+
+def test_each_pose_searches_only_what_could_beat_the_designs_found(monkeypatch):
+    """Fewest modules first over every pose; a pose searched after a design is found gets that
+    design's modules and mass as its ceiling, a greater number of units is not searched once the
+    top designs are found, and the answer is the best of every pose alone."""
+    from modc.design import placement, run
+
+    three = FARTHER.replace("box size (0.1, 0, 0) m at (0.25, 0, 0) m", "box size (0.2, 0, 0) m at (0.2, 0, 0) m")
     calls = []
     real = run._search
 
     def counted(p, *a, **kw):
-        calls.append(p.cell.base.xyz)
+        calls.append((p.cell.base.xyz[0], p.min_units, p.max_units, kw.get("ceiling")))
         return real(p, *a, **kw)
 
     monkeypatch.setattr(run, "_search", counted)
-    wide = SHIFTED.replace("target a at (0.75, 0.05, 0.20) m\n", "").replace("modules H1, L3", "modules H1, L3, L4")
-    o = run.design(problem(wide), top=1)
-    assert len(o.designs) == 1 and o.bases_searched == len(calls) == 1
-    assert calls[0] == placement.poses(problem(wide), run.longest_reach(problem(wide), 3))[0][0].xyz
-    assert o.bases_touching == 0
-    assert o.bases_total == 5 and o.designs[0].verified.robot.base.xyz == calls[0]
+    o = run.design(problem(three), top=1)
+    monkeypatch.setattr(run, "_search", real)
+    assert len(o.designs) == 1 and o.bases_searched == 3
+    best = o.designs[0]
+    assert [c[:3] for c in calls] == [(pytest.approx(x), 2, 2) for x in (0.3, 0.2, 0.1)]  # 2 units, nearest first
+    assert calls[0][3] is None and calls[1][3] is None  # nothing found yet at x = 0.3
+    ceiling = calls[2][3]  # the design found at x = 0.2
+    assert ceiling is not None and ceiling[0] == 2 and ceiling[2]  # margin ranks after mass: ties compete
+    each = []
+    for x in (0.3, 0.2, 0.1):  # every pose alone, with the base as written there (more units cannot beat 2)
+        p = problem(three)
+        pose = next(k for k in p.base_grid.poses() if k.xyz[0] == pytest.approx(x))
+        each += run.design(p.model_copy(update={"cell": placement.cell_at(p.cell, pose), "base_grid": None}),
+                           top=1, max_units=2).designs
+    assert (best.modules, round(best.mass, 9)) == min((d.modules, round(d.mass, 9)) for d in each)
+    assert best.modules == 2 and ceiling[1] >= best.mass - 1e-9
 
 
 def test_a_base_pose_inside_an_obstacle_is_skipped():

@@ -25,6 +25,7 @@ from .screen import Obstacles, collides, segment_radii
 from .space import Shape
 
 SEEDS = 4  # IK starts per target (the zero pose first)
+FEW = 2048  # candidates left for a target: their remaining seeds run in one batch
 VERIFY_MARGIN = 0.001  # m kept from the cell and between links in the chosen poses
 
 
@@ -88,38 +89,52 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     T = len(tg.names)
     lo, hi = np.full(n, spec.lower), np.full(n, spec.upper)
     q0 = reach.seeds(n, SEEDS, lo, hi, seed)
-    q = np.zeros((C, T, SEEDS, n))
-    ep = np.full((C, T, SEEDS), np.inf)
-    ratio = np.full((C, T, SEEDS), np.inf)
-    hit = np.zeros((C, T, SEEDS), bool)
+    S = SEEDS + 1  # slot SEEDS: the warm start (below)
+    q = np.zeros((C, T, S, n))
+    ep = np.full((C, T, S), np.inf)
+    ratio = np.full((C, T, S), np.inf)
+    hit = np.zeros((C, T, S), bool)
     ik_hit = np.zeros((C, T), bool)
     tried = np.zeros((C, T), bool)
     live = np.arange(C)
+    done: list[int] = []
     for t in np.argsort(-np.linalg.norm(tg.xyz, axis=1), kind="stable"):
         if live.size == 0:
             break
         tried[live, t] = True
         # seeds one after the other: a candidate stops at its first run that reaches the target
-        # clear of the cell (whether any seed does is the same as running them all)
+        # clear of the cell (whether any seed does is the same as running them all). First a
+        # warm start: each candidate's own solution at the nearest target it already reached
+        # (a region's points lie centimetres apart: a few LM steps from there); an extra seed
+        # only adds runs, so the screen passes at least what the common seeds pass.
         need = live
-        for s in range(SEEDS):
-            if need.size == 0:
-                break
+        warm = min(done, key=lambda u: float(np.linalg.norm(tg.xyz[u] - tg.xyz[t]))) if done else None
+        done.append(int(t))
+        seeds = ([SEEDS] if warm is not None else []) + list(range(SEEDS))
+        while need.size and seeds:
+            # few candidates left: the rest of the seeds in one call (a call costs its
+            # iterations more than its runs)
+            group = seeds if seeds[0] < SEEDS and need.size <= FEW else seeds[:1]
+            seeds = seeds[len(group):]
             sub = Geometry(g.pre[need], g.post[need], g.t1, g.flange_tool)
-            qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), q0[s:s + 1], lo, hi)
-            r = ept[:, 0, 0] / max(tg.tol_p[t], 1e-12)
-            if tg.oriented[t]:
-                r = np.maximum(r, ert[:, 0, 0] / max(tg.tol_r[t], 1e-12))
-            h = r <= 1.0
-            ik_hit[need, t] |= h
-            if h.any() and len(spec.obstacles.shape):
-                # only the runs that reached their target are worth a collision test
-                c = np.flatnonzero(h)
-                one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
-                _, _, _, pts = forward(one, qt[c, 0, 0][:, None, None, :], points=True)
-                h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
-            q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, 0], ept[:, 0, 0], h, r
-            need = need[~h]
+            start = q[need, warm, hit[need, warm].argmax(-1)][:, None] if group == [SEEDS] else q0[group]
+            qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), start, lo, hi)
+            got = np.zeros(need.size, bool)
+            for j, s in enumerate(group):
+                r = ept[:, 0, j] / max(tg.tol_p[t], 1e-12)
+                if tg.oriented[t]:
+                    r = np.maximum(r, ert[:, 0, j] / max(tg.tol_r[t], 1e-12))
+                h = r <= 1.0
+                ik_hit[need, t] |= h
+                if h.any() and len(spec.obstacles.shape):
+                    # only the runs that reached their target are worth a collision test
+                    c = np.flatnonzero(h)
+                    one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+                    _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
+                    h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+                q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r
+                got |= h
+            need = need[~got]
         live = live[hit[live, t].any(-1)]
     reached = hit.any(-1)  # (C, T)
     feasible = reached.all(-1)

@@ -10,12 +10,12 @@ same world as every other design.
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
 bounds is skipped (sound: no chain could reach it from there), so is one where base_link sinks
-into the cell whatever the first unit (sound: the exact check would reject every design), and poses are searched closest
-cell first (the farthest point of the cell nearest), each completely, until `top` (pose, chain)
-designs are found: the poses after that are not searched (first fit, not the best pose of the grid;
-ranking.json "bases" says how many poses were searched and skipped by reach). So 25 poses cost
-what the poses searched before `top` designs cost, plus one; the ranking keeps one entry per
-chain (its best pose), so it may hold fewer than `top` designs.
+into the cell whatever the first unit (sound: the exact check would reject every design). The
+answer is the best over the grid under the ranking's static objectives, not the first fit:
+with fewest modules ranked first, one number of units at a time is searched over every kept pose
+(closest cell first), each pose only for shapes that could rank before the `top`-th design found
+so far (search()). ranking.json "bases" says how many poses were searched and skipped. The
+ranking keeps one entry per chain (its best pose), so it may hold fewer than `top` designs.
 """
 from __future__ import annotations
 
@@ -142,25 +142,61 @@ def poses(problem: Problem, longest: float) -> tuple[list[Transform], int, int]:
     return [k[2] for k in kept], len(grid.poses()) - len(kept) - touching, touching
 
 
+def _levels(problem: Problem, max_units: int | None) -> list[tuple[int, int]]:
+    """Ranges of units searched one after the other over every pose: one number of units at a
+    time when the ranking puts fewest modules first, else the whole range at once."""
+    lib = problem.cell.library
+    assert lib is not None
+    lo, hi = max(problem.min_units, lib.rules.min_dof), min(max_units or problem.max_units, lib.rules.max_dof)
+    if problem.rank[:2] == ("modules", "mass"):
+        return [(n, n) for n in range(lo, hi + 1)]
+    return [(lo, hi)]
+
+
 def search(problem: Problem, max_units: int | None, top: int, longest: float,
-           one: Callable[[Problem, int | None, int], Outcome]) -> Outcome:
-    """The merged outcome of one(sub_problem, max_units, top) over the kept base poses."""
+           one: Callable[..., Outcome], ties: bool = True) -> Outcome:
+    """The merged outcome of one(sub_problem, max_units, top, ceiling, diagnosing) over the kept
+    base poses: the best (pose, chain) designs of the grid under the ranking's static objectives.
+
+    Fewest modules first, a number of units at a time over every pose (nearest first), and at
+    each pose only the shapes that could rank before the `top`-th design found so far (the
+    ceiling: fewer modules, or as many and lighter; with `ties`, as light too, when a later
+    objective may still tell them apart); a number of units is searched only while fewer than
+    `top` designs are found. So a pose is skipped only where no chain could beat what is found."""
     from .run import Outcome
 
     kept, pruned, touching = poses(problem, longest)
-    outs = []
+    outs: list[Outcome] = []
+    searched: set[int] = set()
     designs: list[Design] = []
-    found = 0  # (pose, chain) designs found
-    for pose in kept:
-        sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None})
-        o = one(sub, max_units, top)
-        outs.append(o)
-        found += len(o.designs)
-        designs = _best_per_chain(designs + list(o.designs), problem.rank)
-        if o.stopped or found >= top:
+    levels = _levels(problem, max_units)
+    by_level = problem.rank[:2] == ("modules", "mass")
+    stopped = None
+    for lo, hi in levels:
+        for i, pose in enumerate(kept):
+            ceiling = None
+            if by_level and len(designs) >= top:
+                d = designs[top - 1]
+                ceiling = (d.modules, d.mass, ties)
+                if d.modules < lo:
+                    break  # every chain of this number of units has more modules than the top designs
+            sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None,
+                                             "min_units": lo, "max_units": hi})
+            o = one(sub, hi, top, ceiling, False)
+            outs.append(o)
+            searched.add(i)
+            designs = _best_per_chain(designs + list(o.designs), problem.rank)
+            stopped = stopped or o.stopped
+            if stopped:
+                break
+        if stopped or (by_level and len(designs) >= top):
             break
+    diagnosis = None
+    if not designs and kept and not stopped:  # why none: the nearest pose's search, told per target
+        diagnosis = one(problem.model_copy(update={"cell": cell_at(problem.cell, kept[0]), "base_grid": None}),
+                        max_units, top)
     out = Outcome(problem, designs[:top])
-    out.bases_searched, out.bases_pruned, out.bases_total = len(outs), pruned, len(kept) + pruned + touching
+    out.bases_searched, out.bases_pruned, out.bases_total = len(searched), pruned, len(kept) + pruned + touching
     out.bases_touching = touching
     names = [t.name for t in problem.cell.targets]
     out.closest = {t: min((o.closest.get(t, math.inf) for o in outs), default=math.inf) for t in names}
@@ -179,8 +215,8 @@ def search(problem: Problem, max_units: int | None, top: int, longest: float,
         out.stopped = out.stopped or o.stopped
         out.unfinished += [s for s in o.unfinished if s not in out.unfinished]
         out.coarse += [s for s in o.coarse if s not in out.coarse]
-        if not out.designs and o.targets and not out.targets:
-            out.targets = o.targets
+    if diagnosis is not None:
+        out.targets = diagnosis.targets
     return out
 
 

@@ -9,7 +9,7 @@ is the same for one process, a local pool or a Dask cluster.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from typing import Any
@@ -111,10 +111,10 @@ def _stopping(deadline: float | None) -> str | None:
     return None
 
 
-def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, deadline: float | None,
-               each: Callable[[Part], None], tick: Callable[[], None]) -> None:
+def _run_parts(executor: Executor | None, spec: Spec, work: Iterable, seed: int, deadline: float | None,
+               each: Callable[[Part], bool], tick: Callable[[], None]) -> None:
     """Every range of work, its Part handed to each() in submission order; stops early (the
-    rest unsearched) on Ctrl-C or at the deadline."""
+    rest unsearched) on Ctrl-C, at the deadline or when each() says so (True)."""
     if executor is None:
         TICK.append(tick)
         try:
@@ -122,7 +122,8 @@ def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, dea
                 if _stopping(deadline):
                     return
                 for p in search_chunk(spec, [w], seed, deadline):
-                    each(p)
+                    if each(p):
+                        return
         finally:
             TICK.remove(tick)
         return
@@ -138,7 +139,8 @@ def _run_parts(executor: Executor | None, spec: Spec, work: list, seed: int, dea
                 except TimeoutError:
                     tick()
             for p in parts:
-                each(p)
+                if each(p):
+                    return
     finally:
         for f in futures:
             f.cancel()
@@ -151,7 +153,26 @@ def _longest(problem: Problem, n: int) -> list[space.Shape]:
     return space.shapes(problem, n)
 
 
-def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float]) -> list:
+def _edge(problem: Problem, mass: float) -> float:
+    """The lightest unsearched shape's mass as the search compares designs with it: equal masses
+    summed in another order differ in the last bits, so 1e-9 kg either way - ahead of a design
+    as heavy when margin may still tell them apart, level with it when nothing can."""
+    return mass - 1e-9 if "margin" in problem.rank else mass + 1e-9
+
+
+Ceiling = tuple[int, float, bool]  # (modules, kg, ties): only shapes that could rank before this
+
+
+def _below(ceiling: Ceiling | None, n: int, mass: float) -> bool:
+    """Could a chain of n units and at least `mass` rank before the ceiling (fewest modules, then
+    least mass; with ties, an equal key too, when a later objective may still tell them apart)?"""
+    if ceiling is None:
+        return True
+    cn, cm, ties = ceiling
+    return n < cn or (n == cn and (mass < cm - 1e-9 or (ties and mass <= cm + 1e-9)))
+
+
+def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float], ceiling: Ceiling | None = None) -> list:
     lib = problem.cell.library
     assert lib is not None
     tiers = []
@@ -168,7 +189,9 @@ def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float]) -> 
                 closest[t.name] = min(closest[t.name], max(g + t.position_tolerance, 0.0))
             if max(gaps, default=-1.0) > 0:  # a target beyond any pose of this shape: no IK needed
                 continue
-            shapes.append((_min_mass(problem, s, splits), s.label(), s))
+            m = _min_mass(problem, s, splits)
+            if _below(ceiling, n, m):
+                shapes.append((m, s.label(), s))
         shapes.sort(key=lambda e: e[:2])
         tiers.append((n, splits, shapes))
     return tiers
@@ -194,11 +217,12 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
                                        or ("modules", "mass")}) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
 
-    def one(p: Problem, units: int | None, k: int) -> Outcome:
+    def one(p: Problem, units: int | None, k: int, ceiling: Ceiling | None = None, diagnosing: bool = True) -> Outcome:
         # the extra candidates to time come from the shapes searched until `top` designs are found
         # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
         # settings, 369 s on a 4-goal visit cell)
-        return _search(p, units, k, seed, executor, progress, deadline, enough=top)
+        return _search(p, units, k, seed, executor, progress, deadline, enough=top, ceiling=ceiling,
+                       diagnosing=diagnosing)
 
     if problem.base_grid is None:
         out = one(screen, max_units, n)
@@ -206,7 +230,9 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
         lib = problem.cell.library
         assert lib is not None
         hi = min(max_units or problem.max_units, lib.rules.max_dof)
-        out = placement.search(screen, max_units, n, longest_reach(problem, hi), one)
+        # designs of equal modules and mass may still differ on a later objective (margin, a task's)
+        ties = any(o not in ("modules", "mass") for o in problem.rank)
+        out = placement.search(screen, max_units, n, longest_reach(problem, hi), one, ties)
     out.problem = problem
     tasks.restore(out, points)
     if tasked:
@@ -227,7 +253,8 @@ def longest_reach(problem: Problem, hi: int) -> float:
 
 
 def _search(problem: Problem, max_units: int | None, top: int, seed: int, executor: Executor | None,
-            progress: Callable[..., None] | None, deadline: float | None, enough: int | None = None) -> Outcome:
+            progress: Callable[..., None] | None, deadline: float | None, enough: int | None = None,
+            ceiling: Ceiling | None = None, diagnosing: bool = True) -> Outcome:
     """The static search: designs ranked by the problem's (static) objectives.
 
     With the default objectives (fewest modules first), chains are searched by number of units,
@@ -235,7 +262,9 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     as `enough` (default `top`) kinematically distinct designs are checked that no unsearched
     shape could beat; up to `top` are kept.
     ROUND does not depend on the number of workers, so neither does where the search stops.
-    deadline (time.time()) and search.STOP end it early with what was found."""
+    deadline (time.time()) and search.STOP end it early with what was found. ceiling: only shapes
+    that could rank before it are searched (base placement: what other poses found); diagnosing:
+    say per target why there is no design (probes of seconds each)."""
     t0 = time.perf_counter()
     spec = Spec.of(problem)
     lib = problem.cell.library
@@ -251,7 +280,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     starts = np.array([(u.x01, 0.0, u.z01) for u in lib.units.values()], float)
     blocked, walls = bounds_blocked(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(problem.cell.tool.xyz)),
                                     float(spec.radii.min()), longest, starts)
-    tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest)
+    tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest, ceiling)
     total_shapes = sum(len(s) for _, _, s in tiers)
     total_settings = sum(estimate(spec, s) for _, _, shapes in tiers for _, _, s in shapes)
     early = problem.rank[:2] == ("modules", "mass")
@@ -277,24 +306,43 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     for n, splits, shapes in tiers:
         rounds = _rounds(shapes) if early else [shapes]
         for k, batch in enumerate(rounds):
-            work = [w for _, _, s in batch for w in parts_of(spec, s)]
+            # lazily in one process: a shape's plan (its family bounds) is worked out only if the
+            # round gets to it
+            work = (w for _, _, s in batch for w in parts_of(spec, s))
             pending: dict[str, list[Part]] = {}
-            expected = {s.label(): len(parts_of(spec, s)) for _, _, s in batch}
+            expected: dict[str, int] = {}
+            # the mass of the shape after each one of the round (shapes are searched in that order)
+            after = {s.label(): batch[j + 1][0] for j, (_, _, s) in enumerate(batch[:-1])}
+            halt: list[float] = []  # the lightest unsearched mass, once the round stops early
 
-            def each(p: Part, n=n, splits=splits, pending=pending, expected=expected) -> None:
+            def each(p: Part, n=n, splits=splits, pending=pending, expected=expected, after=after,
+                     halt=halt) -> bool:
                 out.evaluated += p.screened + p.excluded
                 # progress in the units of total_settings: this part's share of its shape
                 state["settings"] += estimate(spec, p.shape) * max(p.upto - p.lo, p.hi == p.lo) \
                     / max(listed(spec, p.shape), 1)
                 pending.setdefault(p.shape.label(), []).append(p)
-                if len(pending[p.shape.label()]) == expected[p.shape.label()]:
+                expect = expected.setdefault(p.shape.label(), len(parts_of(spec, p.shape)))
+                if len(pending[p.shape.label()]) == expect:
                     res = merge(spec, p.shape, pending.pop(p.shape.label()))
                     _absorb(out, res, names, closest, hit, clear, searched)
                     state["done"] += 1
                     tally.add(n, splits, res)
                     if res.found and not state["best"]:
                         state["best"] = f"shape {res.shape.label()} (unchecked)"
+                    # every shape lighter than the next one is searched: check what it found now,
+                    # and stop the round once `top` designs rank before every unsearched shape (the
+                    # same point whatever the executor: shapes complete in submission order). A
+                    # round searched to its end stops the search at `enough` (below).
+                    heavier = after.get(p.shape.label())
+                    below = None if heavier is None else _edge(problem, heavier)
+                    if early and below is not None and (res.found or tally.accepted):
+                        tally.settle(n, below)
+                        if tally.done(n, below, top):
+                            halt.append(below)
+                            return True
                 report()
+                return False
 
             out.shapes += len(batch)
             _run_parts(executor, spec, work, seed, deadline, each, report)
@@ -303,7 +351,11 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
                 _absorb(out, res, names, closest, hit, clear, searched)
                 tally.add(n, splits, res)
             stop = _stopping(deadline)
-            nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) and not stop else float("inf")
+            nxt = _edge(problem, rounds[k + 1][0][0]) if k + 1 < len(rounds) and not stop else float("inf")
+            if halt:  # the rest of the round unsearched: nothing heavier than it may be checked
+                nxt = halt[0]
+                seen = {r.shape.label() for r in searched}
+                out.shapes -= sum(1 for _, _, s in batch if s.label() not in seen)
             tally.settle(n, nxt)
             if tally.accepted:
                 state["best"] = distinct(tally.accepted, problem.rank)[0].chain()
@@ -330,7 +382,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     out.complete = not out.unfinished and not out.coarse
     out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
     out.designs = [tally.swaps(d) for d in distinct(tally.accepted, problem.rank)[:top]]
-    if not out.designs:
+    if not out.designs and diagnosing:
         out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0
     state["done"] = total_shapes - len(out.unfinished)

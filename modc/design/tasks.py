@@ -11,6 +11,10 @@ from dataclasses import replace
 from .rank import TASK, Design, order
 
 PLAN_FACTOR = 3  # designs the static search returns per design asked for when a task objective ranks
+# and at least this many: arms of equal modules and mass differ by seconds of cycle time (a 12-point
+# tray: 2.2 s to 11.8 s), and planning one costs about 2 s once the search stops at the shape
+# where they are found
+MIN_PLANNED = 6
 
 
 def has_tasks(problem) -> bool:
@@ -20,7 +24,7 @@ def has_tasks(problem) -> bool:
 def candidates(problem, top: int) -> int:
     """How many designs the static search should return: more than `top` when a task objective
     ranks (the static order does not know which arm is fastest)."""
-    return top * PLAN_FACTOR if any(o in TASK for o in problem.rank) else top
+    return max(top * PLAN_FACTOR, MIN_PLANNED) if any(o in TASK for o in problem.rank) else top
 
 
 def task_names(robot) -> list[str]:
