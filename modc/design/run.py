@@ -23,7 +23,7 @@ from .diagnose import diagnose, why_none
 from .evaluate import Spec
 from .rank import Design, distinct, key, static
 from .screen import reach_bound
-from .search import STOP, TICK, Part, ShapeResult, estimate, listed, merge, parts_of, search_chunk
+from .search import STOP, TICK, Part, ShapeResult, estimate, follow, listed, merge, parts_of, search_chunk
 from .verify_order import Verifier
 
 ROUND = 16  # shapes in a tier's first round of search between exact checks; rounds double up to ROUND_MAX
@@ -53,6 +53,7 @@ class Outcome:
     screened: int = 0  # chains that passed the screen
     rejections: list[str] = field(default_factory=list)  # why exact checks failed, in order
     excluded: int = 0  # settings ruled out by a sound bound
+    dominated: int = 0  # of those, settings a dominance bound ruled out of the ranking (search.ShapeResult)
     complete: bool = True  # every setting of every shape in the bounds screened or excluded
     stopped: str | None = None  # "time budget" or "interrupted"
     unfinished: list[str] = field(default_factory=list)  # shapes whose search did not run to the end
@@ -280,14 +281,19 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
             work = [w for _, _, s in batch for w in parts_of(spec, s)]
             pending: dict[str, list[Part]] = {}
             expected = {s.label(): len(parts_of(spec, s)) for _, _, s in batch}
+            later: list = []  # a shape's next level, once its round is whole (search.follow)
 
-            def each(p: Part, n=n, splits=splits, pending=pending, expected=expected) -> None:
+            def each(p: Part, n=n, splits=splits, pending=pending, expected=expected, later=later) -> None:
                 out.evaluated += p.screened + p.excluded
                 # progress in the units of total_settings: this part's share of its shape
                 state["settings"] += estimate(spec, p.shape) * max(p.upto - p.lo, p.hi == p.lo) \
                     / max(listed(spec, p.shape), 1)
                 pending.setdefault(p.shape.label(), []).append(p)
-                if len(pending[p.shape.label()]) == expected[p.shape.label()]:
+                if len(pending[p.shape.label()]) == expected[p.shape.label()] and \
+                        (more := follow(spec, p.shape, pending[p.shape.label()])):
+                    expected[p.shape.label()] += len(more)
+                    later.extend(more)
+                elif len(pending[p.shape.label()]) == expected[p.shape.label()]:
                     res = merge(spec, p.shape, pending.pop(p.shape.label()))
                     _absorb(out, res, names, closest, hit, clear, searched)
                     state["done"] += 1
@@ -298,6 +304,9 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
 
             out.shapes += len(batch)
             _run_parts(executor, spec, work, seed, deadline, each, report)
+            while later and not _stopping(deadline):
+                work, later[:] = list(later), []
+                _run_parts(executor, spec, work, seed, deadline, each, report)
             for ps in pending.values():  # shapes cut short: what their finished ranges found
                 res = merge(spec, ps[0].shape, ps)
                 _absorb(out, res, names, closest, hit, clear, searched)
@@ -340,6 +349,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
 
 def _absorb(out: Outcome, res: ShapeResult, names, closest, hit, clear, searched) -> None:
     out.excluded += res.excluded
+    out.dominated += res.dominated
     out.evaluated += res.evaluated - sum(p.screened + p.excluded for p in res.parts)  # families excluded whole
     searched.append(res)
     for i, name in enumerate(names):
