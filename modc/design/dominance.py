@@ -5,7 +5,7 @@ Within a shape the settings kept (search.KEEP of them) are the smallest by searc
     key(s) = (round(worst(s), 2), c(s), sum |angles|, values),
 
 c(s) the number of nonzero twists. A shape whose live families (modc.design.prefix) hold more
-than search.COMPLETE settings is enumerated *level by level*: level c is every live setting with
+than FIRST settings is enumerated *level by level*: level c is every live setting with
 exactly c nonzero twists (each choice of c axes set to their nonzero values, the others 0),
 levels 0, 1, 2, … in turn, each through the per-setting bounds and the IK screen as usual.
 
@@ -51,10 +51,13 @@ class Levels:
     lengths: tuple[int, ...]
     zero: tuple[int, ...]
     head: int  # axes fixed by a family's number
-    alive: np.ndarray  # live family numbers, sorted
+    alive: np.ndarray | None  # live family numbers, sorted (None: dropped, the counts kept)
     per: int  # settings per family
-    nz_alive: np.ndarray  # nonzero twists among each live family's head axes
+    nz_alive: np.ndarray | None  # nonzero twists among each live family's head axes
     counts: tuple[int, ...]  # live settings per level 0 … len(lengths)
+
+    def light(self) -> Levels:
+        return Levels(self.lengths, self.zero, self.head, None, self.per, None, self.counts)
 
 
 def _poly(lengths, zero) -> list[int]:
@@ -72,7 +75,7 @@ def levels_of(values: tuple[np.ndarray, ...], alive: np.ndarray, per: int) -> Le
     zero = tuple(int(np.flatnonzero(np.abs(a) <= 1e-9)[0]) if np.any(np.abs(a) <= 1e-9) else -1 for a in values)
     head = next(h for h in range(len(lengths) + 1) if math.prod(lengths[h:]) == per)
     alive = np.asarray(alive, np.int64)
-    nz = np.zeros(len(alive), np.int64)
+    nz = np.zeros(len(alive), np.int8)  # a few bytes a family: plans of hundreds of shapes are in memory at once
     if head:
         digits = np.unravel_index(alive, lengths[:head])
         for d, z in zip(digits, zero[:head], strict=True):
@@ -103,6 +106,7 @@ def _tail_numbers(lv: Levels, m: int) -> np.ndarray:
 
 def level_numbers(lv: Levels, c: int) -> np.ndarray:
     """The live settings of level c as the shape's setting numbers, ascending."""
+    assert lv.alive is not None and lv.nz_alive is not None
     out = []
     for p in np.unique(lv.nz_alive).tolist():
         m = c - p

@@ -5,12 +5,11 @@ within the joint limits, then the obstacle screen) or excluded by a sound bound 
 families of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free),
 then setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0
 within tolerance of some target). Exact reductions (modc.design.space) remove settings that
-cannot change tool0. A shape whose families left alive still hold more than COMPLETE settings
-(4 or more units with links, targets in reach) is searched level by level - fewest nonzero
-twists first - and closed by a dominance bound once its kept settings cannot be beaten
-(modc.design.dominance); only if that would list more than COMPLETE settings are the levels
-left searched on a deterministic coarse grid of its twists, and the shape reported as not
-complete.
+cannot change tool0. A shape whose families left alive hold more than dominance.FIRST settings
+is searched level by level - fewest nonzero twists first - and closed by a dominance bound as
+soon as its kept settings cannot be beaten by any setting left (modc.design.dominance); only
+when the levels listed would pass COMPLETE settings are the levels left searched on a
+deterministic coarse grid of its twists, and the shape reported as not complete.
 
 A shape's settings are numbered unit by unit (unit 1's pivot outermost, then its port, unit 2's
 pivot, …); a unit of work is a range of those numbers (WORK settings), so a large shape spreads
@@ -22,12 +21,14 @@ lies, then simplest twists first.
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
 import threading
 import time
 import weakref
 import zlib
-from dataclasses import dataclass, field
+from collections import OrderedDict
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -168,11 +169,22 @@ class Plan:
         return self.axes.full
 
 
-_PLANS: dict[int, tuple[weakref.ref, dict[Shape, Plan]]] = {}
+_PLANS: dict[int, tuple[weakref.ref, dict[Shape, Plan], str]] = {}
+# a worker gets a new Spec object with each unit of work: the last plans by content, so the units
+# of one shape share its family bounds and level lists
+_BY_CONTENT: OrderedDict[tuple[str, Shape], Plan] = OrderedDict()
+
+
+def _digest(spec: Spec) -> str:
+    """What a plan depends on: the problem (its library, tool and targets) and the targets screened."""
+    tg = spec.targets
+    return hashlib.sha256(repr(spec.problem).encode() + tg.xyz.tobytes() + tg.tol_p.tobytes()
+                          + np.asarray(tg.oriented).tobytes()).hexdigest()
 
 
 def plan(spec: Spec, shape: Shape) -> Plan:
-    """The shape's plan (computed once per spec object in this process)."""
+    """The shape's plan (computed once per spec object in this process, and the last few by
+    content)."""
     key = id(spec)
     entry = _PLANS.get(key)
     if entry is None or entry[0]() is not spec:
@@ -180,11 +192,16 @@ def plan(spec: Spec, shape: Shape) -> Plan:
         def forget(_ref: weakref.ref, key: int = key) -> None:
             _PLANS.pop(key, None)
 
-        entry = (weakref.ref(spec, forget), {})
+        entry = (weakref.ref(spec, forget), {}, _digest(spec))
         _PLANS[key] = entry
     cache = entry[1]
     if shape not in cache:
-        cache[shape] = _plan(spec, shape)
+        got = _BY_CONTENT.get((entry[2], shape))
+        if got is None:
+            got = _BY_CONTENT[(entry[2], shape)] = _plan(spec, shape)
+            while len(_BY_CONTENT) > 16:
+                _BY_CONTENT.popitem(last=False)
+        cache[shape] = got
     return cache[shape]
 
 
@@ -267,7 +284,7 @@ def _listed(spec: Spec, shape: Shape, how) -> tuple[Axes, np.ndarray | None]:
         return axes(spec, shape, how), None
     p = plan(spec, shape)
     if how[0] == "levels":
-        lv = p.levels
+        lv = p.levels if p.levels is not None and p.levels.alive is not None else _plan(spec, shape).levels
         assert lv is not None
         return p.axes, dominance.numbers(p, how, lambda: np.concatenate(
             [dominance.level_numbers(lv, c) for c in range(how[1], how[2] + 1)]))
@@ -435,6 +452,8 @@ def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
         finished = all(p.upto >= p.hi for p in parts) and len(parts) == len(p_.ranges)
         complete = p_.complete and finished
     excluded = sum(p.excluded for p in parts) + (p_.excluded if finished else 0) + dominated
+    if p_.levels is not None and finished:  # its families' arrays are not needed any more here
+        _PLANS[id(spec)][1][shape] = replace(p_, levels=p_.levels.light())
     return ShapeResult(shape, tuple(found), screened + excluded, tuple(float(x) for x in closest),
                        0.0 if found else 1.0, screened, excluded, dominated, p_.total, complete, finished,
                        tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), list(parts))
