@@ -166,3 +166,30 @@ def test_four_unit_arms_with_targets_in_reach_are_complete_and_the_same_on_any_e
                                                                     pooled.dominated)
     js = ranking([serial])
     assert js["complete"] and js["coarse_shapes"] == [] and js["dominated"] == serial.dominated
+
+
+def test_rounds_are_decided_only_when_whole_and_in_their_fixed_chain():
+    """dominance.decide: the next level while the kept list can be beaten, the dominated levels
+    once it cannot, the coarse rest past the budget, nothing while a round is not whole."""
+    from modc.design import dominance
+    from modc.design.search import Found
+
+    values = tuple(np.array([-1.0, 0.0, 1.0, 2.0]) for _ in range(4))
+    lv = dominance.levels_of(values, np.arange(4 ** 4), 1)
+    assert lv.counts == (1, 12, 54, 108, 81)
+    first = ("levels", 0, 1)
+    zero = [Found((0.0,), (0.0,), (), 0.0)] * 3
+    length = {first: 13, ("levels", 2, 2): 54, ("levels", 3, 3): 108, ("rest", 2): 7}.__getitem__
+
+    def decide(done, kept, budget=1000):
+        return dominance.decide(lv, first, done, kept if callable(kept) else lambda rounds: kept, length, 3, budget)
+
+    assert decide({first: 13}, zero) == (None, 54 + 108 + 81, True, True)
+    assert decide({first: 13}, zero[:2]) == (("levels", 2, 2), 0, False, False)
+    assert decide({first: 12}, zero) == (None, 0, False, False)  # a unit missing: nothing decided
+    later = {first: 13, ("levels", 2, 2): 54}
+    assert decide(later, lambda rounds: zero[:len(rounds) + 1]) == (None, 108 + 81, True, True)
+    assert decide(later, zero) == (None, 0, False, False)  # the first round closed it: level 2 is not its chain
+    assert decide({first: 13, ("levels", 2, 2): 54}, zero[:2], budget=100) == (("rest", 2), 0, False, False)
+    assert decide({first: 13, ("levels", 2, 2): 54, ("rest", 2): 7}, [], budget=100) == (None, 0, False, True)
+    assert decide({first: 13, ("levels", 3, 3): 108}, zero) == (None, 0, False, False)  # not its chain

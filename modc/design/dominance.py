@@ -35,6 +35,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -167,3 +168,29 @@ def next_level(lv: Levels, done: int, budget: int) -> int | None:
         if lv.counts[c]:
             return c if listed + lv.counts[c] <= budget else -1
     return None
+
+
+def decide(lv: Levels, first: tuple, done: dict, kept: Callable[[list], list], length: Callable[[tuple], int],
+           keep: int, budget: int) -> tuple[tuple | None, int, bool, bool]:
+    """What a shape searched by level needs next, from the rounds done (how -> settings done in
+    whole units; kept(rounds): the kept list over those rounds; length(how): a round's settings):
+    (the next round or None, settings dominated, complete, finished). The rounds run in a fixed
+    chain - the first, then one level at a time, maybe the coarse rest - and a decision is taken
+    only on whole rounds, so it is the same however the units were spread over workers."""
+    if any(n != length(h) for h, n in done.items()):
+        return None, 0, False, False
+    chain: list[tuple] = [first]
+    while chain[-1] in done and chain[-1][0] == "levels":
+        top = chain[-1][2]
+        whole = set(done) == set(chain)
+        if dominates(kept(chain), keep):
+            return None, (sum(lv.counts[top + 1:]) if whole else 0), whole, whole
+        c = next_level(lv, top, budget)
+        if c is None:
+            return None, 0, whole, whole
+        chain.append(("levels", c, c) if c >= 0 else ("rest", top))
+    if chain[-1] in done:  # the coarse grid above the last level ran: finished, not complete
+        return None, 0, False, set(done) == set(chain)
+    if set(done) != set(chain[:-1]):
+        return None, 0, False, False
+    return chain[-1], 0, False, False

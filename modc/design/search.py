@@ -393,34 +393,22 @@ def _length(spec: Spec, shape: Shape, how) -> int:
 
 def _by_level(spec: Spec, shape: Shape, parts: list[Part]) -> tuple[list[Work], int, bool, bool]:
     """A shape searched by level, from the parts so far: (the next round's units of work,
-    settings dominated, complete, finished). Nothing more to do before a round is whole."""
+    settings dominated, complete, finished); see dominance.decide."""
     p = plan(spec, shape)
-    lv = p.levels
-    assert lv is not None
+    assert p.levels is not None and isinstance(p.how, tuple)
     done: dict[bool | tuple, int] = {}
     for q in parts:
         if q.upto < q.hi:
             return [], 0, False, False
         done[q.how] = done.get(q.how, 0) + q.hi
-    if any(n != _length(spec, shape, h) for h, n in done.items()):
-        return [], 0, False, False
-    chain: list[tuple] = [p.how]  # type: ignore[list-item]  # the rounds in their order: the first, then one level at a time, maybe the rest
-    while chain[-1] in done and chain[-1][0] == "levels":
-        top = chain[-1][2]
-        kept = sorted((f for q in parts if q.how in chain for f in q.found), key=order_key)[:KEEP]
-        if dominance.dominates(kept, KEEP):
-            if set(done) != set(chain):
-                return [], 0, False, False
-            return [], sum(lv.counts[top + 1:]), True, True
-        c = dominance.next_level(lv, top, COMPLETE)
-        if c is None:
-            return [], 0, set(done) == set(chain), set(done) == set(chain)
-        chain.append(("levels", c, c) if c >= 0 else ("rest", top))
-    if chain[-1] in done:  # the coarse grid above the last level ran: finished, not complete
-        return [], 0, False, set(done) == set(chain)
-    if set(done) != set(chain[:-1]):
-        return [], 0, False, False
-    how = chain[-1]
+
+    def kept(rounds: list) -> list[Found]:
+        return sorted((f for q in parts if q.how in rounds for f in q.found), key=order_key)[:KEEP]
+
+    how, dominated, complete, finished = dominance.decide(p.levels, p.how, done, kept,
+                                                          lambda h: _length(spec, shape, h), KEEP, COMPLETE)
+    if how is None:
+        return [], dominated, complete, finished
     return [(shape, r, how) for r in _split([(0, _length(spec, shape, how))]) or ((),)], 0, False, False
 
 
