@@ -4,6 +4,7 @@
     python benchmarks/bench_design.py --quick         # smaller samples, no whole-library run
     python benchmarks/bench_design.py --timor ROOT    # ROOT: a venv with timor-python installed (ROOT/bin/python)
     python benchmarks/bench_design.py --json [OUT]
+    python benchmarks/bench_design.py --beyond 4 [5 6]   # only measurement 7, units 1-4 [1-5, 1-6]
 
 CPU figures are time.process_time() of this process pinned to one core (BLAS/OpenMP pools at one
 thread), so other load on the machine does not count; wall figures are time.perf_counter().
@@ -33,6 +34,12 @@ thread), so other load on the machine does not count; wall figures are time.perf
 7. anchor      Timor-python 1.1.1 (TUM) in its own venv: per design, assemble a 3-DoF chain
                from geometric_primitive_modules, build its pinocchio robot, IK for three targets
                (each the FK of a random pose); the first (warm-up) design counts in nothing.
+7. beyond      two targets 0.86 m out, beyond every 3-unit setting (a sound bound), within reach
+               of 4-unit arms (77 shapes of 256 keep live families): run.design (top 3) with
+               units 1-4 in this process (CPU and wall s), and with --beyond 5 / 6 units 1-5 / 1-6
+               through `modc design --workers 2` (wall s); complete or not, shapes on the coarse
+               grid, settings through the IK, excluded by bounds, of those dominated (shapes
+               searched by level, modc.design.dominance). Date and load average recorded.
 """
 from __future__ import annotations
 
@@ -363,6 +370,68 @@ def bench_dask(shapes: int) -> dict | None:
     return out
 
 
+# Two targets 0.86 m out: every 3-unit twist setting falls short (the family bounds exclude them
+# all), 4-unit arms with links reach them (dominance.py: their shapes are searched by level).
+BEYOND = """design beyond3 {
+    payload 100 g
+    target a at (0.714, 0.294, 0.378) m
+    target b at (-0.255, 0.765, 0.298) m
+    units 1 to 4
+}
+"""
+
+
+def bench_beyond(highest: list[int]) -> dict:
+    import tempfile
+
+    from _common import child_env
+
+    out: dict = {"date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "load_average": os.getloadavg()}
+    all_cpus = os.sched_getaffinity(0) | set(range(os.cpu_count() or 1))
+    for hi in highest:
+        text = BEYOND.replace("units 1 to 4", f"units 1 to {hi}")
+        if hi <= 4:
+            from modc.design import run
+
+            t, c = time.perf_counter(), time.process_time()
+            o = run.design(_problem(text), top=3, seed=0)
+            out[f"units_1_{hi}"] = {
+                "seconds_wall": time.perf_counter() - t, "seconds_cpu": time.process_time() - c, "workers": 1,
+                "complete": o.complete, "coarse_shapes": len(o.coarse), "shapes": o.shapes,
+                "through_ik": o.evaluated - o.excluded, "excluded": o.excluded, "dominated": o.dominated,
+                "best": o.designs[0].chain() if o.designs else None}
+            continue
+        with tempfile.TemporaryDirectory() as tmp:
+            src = Path(tmp) / "beyond.mod"
+            src.write_text(text, encoding="utf-8")
+            t = time.perf_counter()
+            p = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(Path(tmp) / "out"),
+                                "--workers", "2", "-q", "--no-render", "--top", "3"], capture_output=True, text=True,
+                               env=child_env(), preexec_fn=lambda: os.sched_setaffinity(0, all_cpus), timeout=7200)
+            wall = time.perf_counter() - t
+            js = Path(tmp) / "out" / "ranking.json"
+            r = json.loads(js.read_text(encoding="utf-8")) if js.is_file() else {}
+        out[f"units_1_{hi}"] = {
+            "seconds_wall": wall, "workers": 2, "exit": p.returncode, "complete": r.get("complete"),
+            "coarse_shapes": len(r.get("coarse_shapes", [])), "through_ik": r.get("evaluated", 0)
+            - r.get("excluded_by_bounds", 0), "excluded": r.get("excluded_by_bounds"), "dominated": r.get("dominated"),
+            "best": r["designs"][0]["chain"] if r.get("designs") else None}
+    return out
+
+
+def _beyond_lines(b: dict) -> list[str]:
+    lines = [f"beyond     run of {b['date_utc']} UTC, load average {', '.join(f'{x:.1f}' for x in b['load_average'])}"]
+    for k, v in b.items():
+        if not k.startswith("units_"):
+            continue
+        cpu = f", {v['seconds_cpu']:.1f} s CPU" if "seconds_cpu" in v else ""
+        lines.append(f"beyond     {k[6:].replace('_', '-')}: {v['seconds_wall']:.1f} s wall{cpu} ({v['workers']} "
+                     f"worker(s)), complete={v['complete']}, {v['coarse_shapes']} coarse shapes; settings "
+                     f"through the IK {v['through_ik']:,}, excluded {v['excluded']:,} (dominated "
+                     f"{v['dominated']:,}); best {v['best']}")
+    return lines
+
+
 def bench_timor(root: Path, designs: int) -> dict | None:
     py = root / "venv" / "bin" / "python"
     if not py.is_file():
@@ -381,8 +450,16 @@ def main() -> None:
     ap.add_argument("--timor", default=os.environ.get("TIMOR_ROOT", "/tmp/timor-offline"),
                     help="a venv with timor-python installed (ROOT/bin/python)")
     ap.add_argument("--json", nargs="?", const="-", default=None)
+    ap.add_argument("--beyond", nargs="+", type=int, metavar="UNITS",
+                    help="only measurement 7: units 1 to each UNITS (4 in this process, 5-6 on --workers 2)")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
+    if args.beyond:
+        b = bench_beyond(args.beyond)
+        print("\n".join(_beyond_lines(b)), file=sys.stderr)
+        if args.json is not None:
+            print(json.dumps(b, indent=2))
+        return
     result: dict = {"machine": platform.processor() or platform.machine(), "python": platform.python_version()}
     # before pinning (the worker processes would inherit one core)
     result["library"] = bench_library(4 if args.quick else 16, whole=not args.quick)

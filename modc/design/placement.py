@@ -210,6 +210,7 @@ def search(problem: Problem, max_units: int | None, top: int, longest: float,
         out.shapes += o.shapes
         out.screened += o.screened
         out.excluded += o.excluded
+        out.dominated += o.dominated
         out.rejections += o.rejections
         out.complete &= o.complete
         out.stopped = out.stopped or o.stopped

@@ -23,7 +23,7 @@ from .diagnose import diagnose, why_none
 from .evaluate import Spec
 from .rank import Design, distinct, key, static
 from .screen import reach_bound
-from .search import STOP, TICK, Part, ShapeResult, estimate, listed, merge, parts_of, search_chunk
+from .search import STOP, TICK, Part, ShapeResult, estimate, follow, listed, merge, parts_of, search_chunk
 from .verify_order import Verifier
 
 ROUND = 16  # shapes in a tier's first round of search between exact checks; rounds double up to ROUND_MAX
@@ -53,6 +53,7 @@ class Outcome:
     screened: int = 0  # chains that passed the screen
     rejections: list[str] = field(default_factory=list)  # why exact checks failed, in order
     excluded: int = 0  # settings ruled out by a sound bound
+    dominated: int = 0  # of those, settings a dominance bound ruled out of the ranking (search.ShapeResult)
     complete: bool = True  # every setting of every shape in the bounds screened or excluded
     stopped: str | None = None  # "time budget" or "interrupted"
     unfinished: list[str] = field(default_factory=list)  # shapes whose search did not run to the end
@@ -314,16 +315,24 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
             # the mass of the shape after each one of the round (shapes are searched in that order)
             after = {s.label(): batch[j + 1][0] for j, (_, _, s) in enumerate(batch[:-1])}
             halt: list[float] = []  # the lightest unsearched mass, once the round stops early
+            later: list = []  # a shape's next level, once its round is whole (search.follow)
+            waiting: set[str] = set()  # shapes with a level still to search: no early stop before them
 
             def each(p: Part, n=n, splits=splits, pending=pending, expected=expected, after=after,
-                     halt=halt) -> bool:
+                     halt=halt, later=later, waiting=waiting) -> bool:
                 out.evaluated += p.screened + p.excluded
                 # progress in the units of total_settings: this part's share of its shape
                 state["settings"] += estimate(spec, p.shape) * max(p.upto - p.lo, p.hi == p.lo) \
                     / max(listed(spec, p.shape), 1)
                 pending.setdefault(p.shape.label(), []).append(p)
-                expect = expected.setdefault(p.shape.label(), len(parts_of(spec, p.shape)))
-                if len(pending[p.shape.label()]) == expect:
+                label = p.shape.label()
+                expect = expected.setdefault(label, len(parts_of(spec, p.shape)))
+                if len(pending[label]) == expect and (more := follow(spec, p.shape, pending[label])):
+                    expected[label] += len(more)
+                    later.extend(more)
+                    waiting.add(label)
+                elif len(pending[label]) == expect:
+                    waiting.discard(label)
                     res = merge(spec, p.shape, pending.pop(p.shape.label()))
                     _absorb(out, res, names, closest, hit, clear, searched)
                     state["done"] += 1
@@ -336,7 +345,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
                     # round searched to its end stops the search at `enough` (below).
                     heavier = after.get(p.shape.label())
                     below = None if heavier is None else _edge(problem, heavier)
-                    if early and below is not None and (res.found or tally.accepted):
+                    if early and below is not None and not waiting and (res.found or tally.accepted):
                         tally.settle(n, below)
                         if tally.done(n, below, top):
                             halt.append(below)
@@ -346,6 +355,9 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
 
             out.shapes += len(batch)
             _run_parts(executor, spec, work, seed, deadline, each, report)
+            while later and not halt and not _stopping(deadline):
+                levels, later[:] = list(later), []
+                _run_parts(executor, spec, levels, seed, deadline, each, report)
             for ps in pending.values():  # shapes cut short: what their finished ranges found
                 res = merge(spec, ps[0].shape, ps)
                 _absorb(out, res, names, closest, hit, clear, searched)
@@ -392,6 +404,7 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
 
 def _absorb(out: Outcome, res: ShapeResult, names, closest, hit, clear, searched) -> None:
     out.excluded += res.excluded
+    out.dominated += res.dominated
     out.evaluated += res.evaluated - sum(p.screened + p.excluded for p in res.parts)  # families excluded whole
     searched.append(res)
     for i, name in enumerate(names):

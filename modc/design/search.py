@@ -5,9 +5,11 @@ within the joint limits, then the obstacle screen) or excluded by a sound bound 
 families of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free),
 then setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0
 within tolerance of some target). Exact reductions (modc.design.space) remove settings that
-cannot change tool0. A shape whose families left alive still hold more than COMPLETE settings
-(4 or more units with links, targets in reach) is searched on a deterministic coarse grid of
-its twists and reported as not complete.
+cannot change tool0. A shape whose families left alive hold more than dominance.FIRST settings
+is searched level by level - fewest nonzero twists first - and closed by a dominance bound as
+soon as its kept settings cannot be beaten by any setting left (modc.design.dominance); only
+when the levels listed would pass COMPLETE settings are the levels left searched on a
+deterministic coarse grid of its twists, and the shape reported as not complete.
 
 A shape's settings are numbered unit by unit (unit 1's pivot outermost, then its port, unit 2's
 pivot, …); a unit of work is a range of those numbers (WORK settings), so a large shape spreads
@@ -19,17 +21,19 @@ lies, then simplest twists first.
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
 import threading
 import time
 import weakref
 import zlib
-from dataclasses import dataclass, field
+from collections import OrderedDict
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..kinematics import transform
-from . import bounds, prefix
+from . import bounds, dominance, prefix
 from .batch import geometry
 from .evaluate import Spec, screen_batch
 from .space import Shape, port_free, twist_values
@@ -67,6 +71,7 @@ class Part:
     closest: tuple[float, ...]  # per target, m (inf: never tried)
     hit: tuple[bool, ...]  # per target: some IK run within tolerance (collisions aside)
     clear: tuple[bool, ...]  # per target: reached without touching the cell
+    how: bool | tuple = True  # which list lo … hi index (see Work)
 
 
 @dataclass
@@ -77,7 +82,8 @@ class ShapeResult:
     closest: tuple[float, ...]
     best_score: float
     screened: int = 0
-    excluded: int = 0
+    excluded: int = 0  # dominated included
+    dominated: int = 0  # settings of levels a dominance bound closed (modc.design.dominance)
     total: int = 0  # settings of the shape (on the coarse grid when not complete)
     complete: bool = True  # every setting screened or excluded
     finished: bool = True  # the search of its settings ran to the end (no budget stop)
@@ -155,17 +161,30 @@ class Plan:
     ranges: tuple[tuple[tuple[int, int], ...], ...]  # units of work: ranges, at most WORK settings each
     total: int  # settings of the shape (of the coarse grid when not complete)
     excluded: int  # settings excluded whole, before any is listed
+    how: bool | tuple = True  # what the ranges index (see Work): a level plan's first round
+    levels: dominance.Levels | None = None  # the live settings by level, for a shape searched by level
 
     @property
     def complete(self) -> bool:
         return self.axes.full
 
 
-_PLANS: dict[int, tuple[weakref.ref, dict[Shape, Plan]]] = {}
+_PLANS: dict[int, tuple[weakref.ref, dict[Shape, Plan], str]] = {}
+# a worker gets a new Spec object with each unit of work: the last plans by content, so the units
+# of one shape share its family bounds and level lists
+_BY_CONTENT: OrderedDict[tuple[str, Shape], Plan] = OrderedDict()
+
+
+def _digest(spec: Spec) -> str:
+    """What a plan depends on: the problem (its library, tool and targets) and the targets screened."""
+    tg = spec.targets
+    return hashlib.sha256(repr(spec.problem).encode() + tg.xyz.tobytes() + tg.tol_p.tobytes()
+                          + np.asarray(tg.oriented).tobytes()).hexdigest()
 
 
 def plan(spec: Spec, shape: Shape) -> Plan:
-    """The shape's plan (computed once per spec object in this process)."""
+    """The shape's plan (computed once per spec object in this process, and the last few by
+    content)."""
     key = id(spec)
     entry = _PLANS.get(key)
     if entry is None or entry[0]() is not spec:
@@ -173,11 +192,16 @@ def plan(spec: Spec, shape: Shape) -> Plan:
         def forget(_ref: weakref.ref, key: int = key) -> None:
             _PLANS.pop(key, None)
 
-        entry = (weakref.ref(spec, forget), {})
+        entry = (weakref.ref(spec, forget), {}, _digest(spec))
         _PLANS[key] = entry
     cache = entry[1]
     if shape not in cache:
-        cache[shape] = _plan(spec, shape)
+        got = _BY_CONTENT.get((entry[2], shape))
+        if got is None:
+            got = _BY_CONTENT[(entry[2], shape)] = _plan(spec, shape)
+            while len(_BY_CONTENT) > 16:
+                _BY_CONTENT.popitem(last=False)
+        cache[shape] = got
     return cache[shape]
 
 
@@ -209,9 +233,14 @@ def _plan(spec: Spec, shape: Shape) -> Plan:
                        transform(tool.xyz, tool.rpy))
     fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p)
     total = full.count
-    if fam.settings <= COMPLETE:
+    if fam.settings <= dominance.FIRST:
         ranges = _split(fam.ranges()) or ((),)
         return Plan(full, ranges, total, total - fam.settings)
+    by_level = dominance.levels_of(full.values, fam.alive, fam.per)
+    first = dominance.first_round(by_level, COMPLETE)
+    if first is not None:
+        size_ = sum(by_level.counts[first[0]:first[1] + 1])
+        return Plan(full, _split([(0, size_)]), total, total - fam.settings, ("levels", *first), by_level)
     coarse = coarse_axes(spec, shape)
     return Plan(coarse, _split([(0, coarse.count)]), coarse.count, 0)
 
@@ -246,6 +275,30 @@ def estimate(spec: Spec, shape: Shape) -> int:
     return full.count if full.count <= COMPLETE else min(full.count, COARSE)
 
 
+def _listed(spec: Spec, shape: Shape, how) -> tuple[Axes, np.ndarray | None]:
+    """The axes a unit of work enumerates and the setting numbers its ranges index (None: the
+    ranges are the numbers). how: True / False - the full axes / the coarse grid; ("levels", lo,
+    hi) - the live settings of levels lo … hi, level by level, ascending within one;
+    ("rest", c) - the coarse grid's settings above level c."""
+    if how is True or how is False:
+        return axes(spec, shape, how), None
+    p = plan(spec, shape)
+    if how[0] == "levels":
+        lv = p.levels if p.levels is not None and p.levels.alive is not None else _plan(spec, shape).levels
+        assert lv is not None
+        return p.axes, dominance.numbers(p, how, lambda: np.concatenate(
+            [dominance.level_numbers(lv, c) for c in range(how[1], how[2] + 1)]))
+    coarse = coarse_axes(spec, shape)
+
+    def rest() -> np.ndarray:
+        every = np.arange(coarse.count, dtype=np.int64)
+        piv, por = _settings_at(coarse, shape.n, every)
+        level = (np.abs(piv) > 1e-9).sum(-1) + (np.abs(por) > 1e-9).sum(-1)
+        return every[level > how[1]]
+
+    return coarse, dominance.numbers(p, how, rest)
+
+
 def _settings(ax: Axes, n: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
     return _settings_at(ax, n, np.arange(lo, hi))
 
@@ -260,14 +313,17 @@ def _settings_at(ax: Axes, n: int, numbers: np.ndarray) -> tuple[np.ndarray, np.
 
 
 def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], seed: int,
-                deadline: float | None = None, full: bool = True) -> Part:
-    """Screen the settings in ranges ([lo, hi) of the shape's numbers, on its full axes or its
-    coarse grid), BLOCK at a time, until done or the deadline (time.time())."""
+                deadline: float | None = None, full: bool | tuple = True) -> Part:
+    """Screen the settings in ranges ([lo, hi) of the shape's numbers on its full axes or its
+    coarse grid, or of a list of them: see _listed), BLOCK at a time, until done or the
+    deadline (time.time())."""
+    ax, listed_ = _listed(spec, shape, full)
     numbers = np.concatenate([np.arange(a, b, dtype=np.int64) for a, b in ranges] or [np.zeros(0, np.int64)])
+    if listed_ is not None:
+        numbers = listed_[numbers]
     lo, hi = 0, len(numbers)
     lib = spec.problem.cell.library
     assert lib is not None
-    ax = axes(spec, shape, full)
     types = [lib.units[k] for k in shape.kinds]
     links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     tool = spec.problem.cell.tool
@@ -305,22 +361,63 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
                                float(s.worst[j])))
         found = sorted(found, key=order_key)[:KEEP]
     return Part(shape, lo, hi, upto, tuple(found), screened, excluded, tuple(float(x) for x in closest),
-                tuple(bool(x) for x in hit), tuple(bool(x) for x in clear))
+                tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), full)
 
 
-Work = tuple[Shape, tuple[tuple[int, int], ...], bool]  # a shape, ranges of its settings, full axes or not
+Work = tuple[Shape, tuple[tuple[int, int], ...], bool | tuple]  # a shape, ranges, what they index (see _listed)
 
 
 def parts_of(spec: Spec, shape: Shape) -> list[Work]:
     """The shape's units of work (its plan's ranges; one empty range when every setting is
     excluded whole, so that the shape still reports)."""
     p = plan(spec, shape)
-    return [(shape, r, p.complete) for r in p.ranges]
+    return [(shape, r, p.how) for r in p.ranges]
 
 
 def listed(spec: Spec, shape: Shape) -> int:
-    """Settings of the shape that units of work go through one by one."""
-    return sum(hi - lo for unit in plan(spec, shape).ranges for lo, hi in unit)
+    """Settings of the shape that units of work go through one by one (for a shape searched by
+    level, at most: its levels up to COMPLETE, then its coarse grid)."""
+    p = plan(spec, shape)
+    if p.levels is not None:
+        live = p.total - p.excluded
+        return live if live <= COMPLETE else COMPLETE + COARSE
+    return sum(hi - lo for unit in p.ranges for lo, hi in unit)
+
+
+def _length(spec: Spec, shape: Shape, how) -> int:
+    p = plan(spec, shape)
+    if how[0] == "levels" and p.levels is not None:
+        return sum(p.levels.counts[how[1]:how[2] + 1])
+    return len(_listed(spec, shape, how)[1])  # type: ignore[arg-type]
+
+
+def _by_level(spec: Spec, shape: Shape, parts: list[Part]) -> tuple[list[Work], int, bool, bool]:
+    """A shape searched by level, from the parts so far: (the next round's units of work,
+    settings dominated, complete, finished); see dominance.decide."""
+    p = plan(spec, shape)
+    assert p.levels is not None and isinstance(p.how, tuple)
+    done: dict[bool | tuple, int] = {}
+    for q in parts:
+        if q.upto < q.hi:
+            return [], 0, False, False
+        done[q.how] = done.get(q.how, 0) + q.hi
+
+    def kept(rounds: list) -> list[Found]:
+        return sorted((f for q in parts if q.how in rounds for f in q.found), key=order_key)[:KEEP]
+
+    how, dominated, complete, finished = dominance.decide(p.levels, p.how, done, kept,
+                                                          lambda h: _length(spec, shape, h), KEEP, COMPLETE)
+    if how is None:
+        return [], dominated, complete, finished
+    return [(shape, r, how) for r in _split([(0, _length(spec, shape, how))]) or ((),)], 0, False, False
+
+
+def follow(spec: Spec, shape: Shape, parts: list[Part]) -> list[Work]:
+    """The units of work a shape needs after these parts (its whole previous round): the next
+    level of a shape searched by level while its kept settings can still be beaten; else none."""
+    if plan(spec, shape).levels is None:
+        return []
+    return _by_level(spec, shape, parts)[0]
 
 
 def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
@@ -335,16 +432,26 @@ def merge(spec: Spec, shape: Shape, parts: list[Part]) -> ShapeResult:
         hit |= np.array(p.hit, bool)
         clear |= np.array(p.clear, bool)
     screened = sum(p.screened for p in parts)
-    finished = all(p.upto >= p.hi for p in parts) and len(parts) == len(p_.ranges)
-    excluded = sum(p.excluded for p in parts) + (p_.excluded if finished else 0)
-    complete = p_.complete and finished
+    dominated = 0
+    if p_.levels is not None:
+        more, dominated, complete, finished = _by_level(spec, shape, parts)
+        finished = finished and not more
+    else:
+        finished = all(p.upto >= p.hi for p in parts) and len(parts) == len(p_.ranges)
+        complete = p_.complete and finished
+    excluded = sum(p.excluded for p in parts) + (p_.excluded if finished else 0) + dominated
+    if p_.levels is not None and finished:  # its families' arrays are not needed any more here
+        _PLANS[id(spec)][1][shape] = replace(p_, levels=p_.levels.light())
     return ShapeResult(shape, tuple(found), screened + excluded, tuple(float(x) for x in closest),
-                       0.0 if found else 1.0, screened, excluded, p_.total, complete, finished,
+                       0.0 if found else 1.0, screened, excluded, dominated, p_.total, complete, finished,
                        tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), list(parts))
 
 
 def search_shape(spec: Spec, shape: Shape, seed: int, deadline: float | None = None) -> ShapeResult:
-    return merge(spec, shape, search_chunk(spec, parts_of(spec, shape), seed, deadline))
+    parts = search_chunk(spec, parts_of(spec, shape), seed, deadline)
+    while more := follow(spec, shape, parts):
+        parts += search_chunk(spec, more, seed, deadline)
+    return merge(spec, shape, parts)
 
 
 def search_chunk(spec: Spec, work: list[Work], seed: int, deadline: float | None = None) -> list[Part]:

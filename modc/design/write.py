@@ -84,6 +84,7 @@ def ranking(outcomes: list[Outcome]) -> dict:
              for o in outcomes if o.bases_searched is not None}
     return {"designs": designs, **({"bases": bases} if bases else {}), "evaluated": sum(o.evaluated for o in outcomes),
             "excluded_by_bounds": sum(o.excluded for o in outcomes),
+            "dominated": sum(o.dominated for o in outcomes),  # of those excluded: out of every shape's top
             "seconds": round(sum(o.seconds for o in outcomes), 3),
             "complete": all(o.complete for o in outcomes),
             "stopped": next((o.stopped for o in outcomes if o.stopped), None),
