@@ -170,7 +170,7 @@ def design_cmd(
     _print_diagnostics(refused, checked.sources)
     if not checked.ok or any(d.is_error for d in refused):
         raise SystemExit(EXIT_ERRORS)
-    problems = checked.design.problems
+    problems = checked.design.resolved_problems()
     if not problems:
         _err(f"modc design: {file} has no `design NAME {{ … }}` block")
         raise SystemExit(EXIT_USAGE)
@@ -188,7 +188,6 @@ def design_cmd(
                 o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar,
                                   deadline=deadline)
             if not o.designs:
-                assert p.cell.library is not None
                 hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
                 units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
                 failed.append(codes.NO_DESIGN.at(p.name_span, units=units, name=p.name, closest=o.why_none()))

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..model import Problem
+from ..model import ResolvedProblem
 from . import space
 from .evaluate import Spec, _sub_targets
 from .screen import reach_bound
@@ -25,10 +25,9 @@ def _length(x: float) -> str:
     return f"{x:.3g} m" if x >= 0.1 else f"{x * 1000:.3g} mm"
 
 
-def _shapes_for(problem: Problem, t: int, hi: int) -> list[space.Shape]:
+def _shapes_for(problem: ResolvedProblem, t: int, hi: int) -> list[space.Shape]:
     """Shapes of the bounds that could reach target t alone (by the reach bound), smallest first."""
     lib = problem.cell.library
-    assert lib is not None
     target = problem.cell.targets[t]
     out = []
     for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
@@ -42,11 +41,10 @@ def _shapes_for(problem: Problem, t: int, hi: int) -> list[space.Shape]:
     return out
 
 
-def _probe(problem: Problem, spec: Spec, t: int, seed: int, until: float, free: bool) -> dict:
+def _probe(problem: ResolvedProblem, spec: Spec, t: int, seed: int, until: float, free: bool) -> dict:
     """Search for target t alone (joints free of their limits with `free`) until it is reached clear
     of the cell or time runs out."""
     lib = problem.cell.library
-    assert lib is not None
     one = dataclasses.replace(spec, targets=_sub_targets(spec.targets, t))
     if free:
         one = dataclasses.replace(one, lower=-math.pi, upper=math.pi)
@@ -66,7 +64,7 @@ def _probe(problem: Problem, spec: Spec, t: int, seed: int, until: float, free: 
     return res
 
 
-def diagnose(problem: Problem, spec: Spec, names, blocked, hit, clear, closest, seed: int,
+def diagnose(problem: ResolvedProblem, spec: Spec, names, blocked, hit, clear, closest, seed: int,
              deadline: float | None, stopped: bool) -> dict[str, dict]:
     out: dict[str, dict] = {}
     for i, name in enumerate(names):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import Pose, Problem, ResolvedRobot, Robot, UnitSpec
+from ..model import Pose, ResolvedProblem, ResolvedRobot, Robot, UnitSpec
 from . import reach
 from .batch import Geometry, forward, geometry
 from .screen import Obstacles, collides, segment_radii
@@ -33,7 +33,7 @@ VERIFY_MARGIN = 0.001  # m kept from the cell and between links in the chosen po
 class Spec:
     """What a worker needs to screen shapes of one problem (picklable)."""
 
-    problem: Problem
+    problem: ResolvedProblem
     targets: reach.Targets
     obstacles: Obstacles
     radii: np.ndarray
@@ -41,9 +41,8 @@ class Spec:
     upper: float
 
     @classmethod
-    def of(cls, problem: Problem) -> Spec:
+    def of(cls, problem: ResolvedProblem) -> Spec:
         lib = problem.cell.library
-        assert lib is not None
         lower = max(np.radians(v.lower_deg) for v in lib.variants.values())
         upper = min(np.radians(v.upper_deg) for v in lib.variants.values())
         return cls(problem, reach.Targets.of(problem.cell.targets), Obstacles.of(problem.cell.obstacles),
@@ -78,7 +77,6 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     first target it cannot reach (most twist settings miss the hardest one), so the rest of the
     work is spent on candidates that may pass."""
     lib = spec.problem.cell.library
-    assert lib is not None
     if g is None:
         types = [lib.units[k] for k in shape.kinds]
         links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
@@ -181,14 +179,14 @@ def pose_name(target: str) -> str:
     return f"at_{target}"
 
 
-def robot_for(problem: Problem, cand: Candidate, poses: dict[str, tuple[float, ...]], name: str) -> Robot:
+def robot_for(problem: ResolvedProblem, cand: Candidate, poses: dict[str, tuple[float, ...]], name: str) -> Robot:
     cell = problem.cell
     return cell.model_copy(update={
         "name": name, "units": cand.units(),
         "poses": tuple(Pose(name=pose_name(t), q=tuple(q)) for t, q in poses.items())})
 
 
-def verify(problem: Problem, cand: Candidate) -> Verified | str:
+def verify(problem: ResolvedProblem, cand: Candidate) -> Verified | str:
     """The exact check of one design; a string says why it fails."""
     from ..compiler import check_text
     from ..kinematics import Chain, rpy_matrix

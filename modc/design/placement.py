@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from ..model import Problem, Robot, Transform, resolved
+from ..model import ResolvedProblem, Robot, Transform, resolved
 from .rank import Design, order
 
 if TYPE_CHECKING:
@@ -98,7 +98,7 @@ def gap(cell: Robot, pose: Transform, longest: float) -> float:
                 for t in points(cell)), default=-1.0)
 
 
-def base_blocked(problem: Problem, pose: Transform) -> bool:
+def base_blocked(problem: ResolvedProblem, pose: Transform) -> bool:
     """Does base_link, at pose, sink into the cell whatever the first unit (every allowed variant
     and type)? The exact check rejects every design there ("base_link touches the cell"), so
     the pose is not worth a search (sound)."""
@@ -107,7 +107,6 @@ def base_blocked(problem: Problem, pose: Transform) -> bool:
     from . import space
 
     lib = problem.cell.library
-    assert lib is not None
     if not problem.cell.obstacles:
         return False
     cell = cell_at(resolved(problem.cell, lib), pose)
@@ -121,7 +120,7 @@ def base_blocked(problem: Problem, pose: Transform) -> bool:
     return True
 
 
-def poses(problem: Problem, longest: float) -> tuple[list[Transform], int, int]:
+def poses(problem: ResolvedProblem, longest: float) -> tuple[list[Transform], int, int]:
     """The grid's poses worth a search, closest cell first, how many the reach bound ruled out
     and how many base_link's contact with the cell did."""
     grid = problem.base_grid
@@ -142,18 +141,17 @@ def poses(problem: Problem, longest: float) -> tuple[list[Transform], int, int]:
     return [k[2] for k in kept], len(grid.poses()) - len(kept) - touching, touching
 
 
-def _levels(problem: Problem, max_units: int | None) -> list[tuple[int, int]]:
+def _levels(problem: ResolvedProblem, max_units: int | None) -> list[tuple[int, int]]:
     """Ranges of units searched one after the other over every pose: one number of units at a
     time when the ranking puts fewest modules first, else the whole range at once."""
     lib = problem.cell.library
-    assert lib is not None
     lo, hi = max(problem.min_units, lib.rules.min_dof), min(max_units or problem.max_units, lib.rules.max_dof)
     if problem.rank[:2] == ("modules", "mass"):
         return [(n, n) for n in range(lo, hi + 1)]
     return [(lo, hi)]
 
 
-def search(problem: Problem, max_units: int | None, top: int, longest: float,
+def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: float,
            one: Callable[..., Outcome], ties: bool = True) -> Outcome:
     """The merged outcome of one(sub_problem, max_units, top, ceiling, diagnosing) over the kept
     base poses: the best (pose, chain) designs of the grid under the ranking's static objectives.

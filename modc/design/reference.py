@@ -10,7 +10,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..model import Problem, Robot
+from ..model import ResolvedProblem, Robot
 from .evaluate import Candidate, Spec, Verified, _sub_targets, screen_batch, verify
 from .rank import target_share
 from .space import Shape
@@ -50,7 +50,7 @@ def chain_text(robot: Robot) -> str:
     return " - ".join(unit_text(robot, i) for i in range(robot.dof))
 
 
-def _static(problem: Problem, ref: Robot) -> tuple[float | None, float | None, str | None]:
+def _static(problem: ResolvedProblem, ref: Robot) -> tuple[float | None, float | None, str | None]:
     """Mass and torque margin of the reference without poses: the compiler's check and torque analysis."""
     from ..compiler import check_text
     from ..model.write import robot_file_text
@@ -67,7 +67,7 @@ def _static(problem: Problem, ref: Robot) -> tuple[float | None, float | None, s
     return library_mass(robot) - payload, float(margin), None
 
 
-def evaluate(problem: Problem, seed: int = 0) -> Reference | None:
+def evaluate(problem: ResolvedProblem, seed: int = 0) -> Reference | None:
     """The block's reference arm on its cell, or None when it names none. Every region point is
     a target of it, as of the designs (unless `rank coverage`)."""
     from .tasks import with_points
@@ -84,7 +84,7 @@ def evaluate(problem: Problem, seed: int = 0) -> Reference | None:
     return replace(out, targets={names.get(k, k): v for k, v in out.targets.items()}, fails=tuple(fails))
 
 
-def _evaluate(problem: Problem, seed: int) -> Reference | None:
+def _evaluate(problem: ResolvedProblem, seed: int) -> Reference | None:
     ref = problem.reference
     lib = problem.cell.library
     if ref is None or lib is None or not ref.units or any(not u.variant for u in ref.units):

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..model import Problem
+from ..model import ResolvedProblem
 from . import space
 from .bounds import blocked as bounds_blocked
 from .diagnose import diagnose, why_none
@@ -44,7 +44,7 @@ class Status:
 
 @dataclass
 class Outcome:
-    problem: Problem
+    problem: ResolvedProblem
     designs: list[Design]
     evaluated: int = 0
     seconds: float = 0.0
@@ -72,11 +72,10 @@ class Outcome:
 _UNIT_MASS: dict[tuple, float] = {}  # (library, variant, kind, link) -> kg: thousands of shapes share a few units
 
 
-def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> float:
+def _mass(problem: ResolvedProblem, shape: space.Shape, variants: tuple[str, ...]) -> float:
     from ..physical.parts import unit_mass
 
     lib = problem.cell.library
-    assert lib is not None
     total = 0.0
     for v, k, x in zip(variants, shape.kinds, shape.links, strict=True):
         link = (x if x is not None else lib.units[k].x23) if lib.units[k].link else 0.0
@@ -87,7 +86,7 @@ def _mass(problem: Problem, shape: space.Shape, variants: tuple[str, ...]) -> fl
     return total
 
 
-def _min_mass(problem: Problem, shape: space.Shape, splits) -> float:
+def _min_mass(problem: ResolvedProblem, shape: space.Shape, splits) -> float:
     masses = [_mass(problem, shape, v) for v in splits
               if all(space.allowed(problem, x, k) for x, k in zip(v, shape.kinds, strict=True))]
     return min(masses, default=float("inf"))
@@ -147,14 +146,14 @@ def _run_parts(executor: Executor | None, spec: Spec, work: Iterable, seed: int,
             f.cancel()
 
 
-def _longest(problem: Problem, n: int) -> list[space.Shape]:
+def _longest(problem: ResolvedProblem, n: int) -> list[space.Shape]:
     """The shapes of n units with the longest links allowed (the reach bound grows with them)."""
     if not space.variant_splits(problem, n):
         return []
     return space.shapes(problem, n)
 
 
-def _edge(problem: Problem, mass: float) -> float:
+def _edge(problem: ResolvedProblem, mass: float) -> float:
     """The lightest unsearched shape's mass as the search compares designs with it: equal masses
     summed in another order differ in the last bits, so 1e-9 kg either way - ahead of a design
     as heavy when margin may still tell them apart, level with it when nothing can."""
@@ -173,9 +172,9 @@ def _below(ceiling: Ceiling | None, n: int, mass: float) -> bool:
     return n < cn or (n == cn and (mass < cm - 1e-9 or (ties and mass <= cm + 1e-9)))
 
 
-def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float], ceiling: Ceiling | None = None) -> list:
+def _tiers(problem: ResolvedProblem, spec: Spec, hi: int, closest: dict[str, float],
+           ceiling: Ceiling | None = None) -> list:
     lib = problem.cell.library
-    assert lib is not None
     tiers = []
     for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
         splits = space.variant_splits(problem, n)
@@ -198,7 +197,7 @@ def _tiers(problem: Problem, spec: Spec, hi: int, closest: dict[str, float], cei
     return tiers
 
 
-def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
+def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
            executor: Executor | None = None, progress: Callable[..., None] | None = None,
            deadline: float | None = None) -> Outcome:
     """Ranked designs for a checked problem (its library resolved).
@@ -218,7 +217,8 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
                                        or ("modules", "mass")}) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
 
-    def one(p: Problem, units: int | None, k: int, ceiling: Ceiling | None = None, diagnosing: bool = True) -> Outcome:
+    def one(p: ResolvedProblem, units: int | None, k: int, ceiling: Ceiling | None = None,
+            diagnosing: bool = True) -> Outcome:
         # the extra candidates to time come from the shapes searched until `top` designs are found
         # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
         # settings, 369 s on a 4-goal visit cell)
@@ -229,7 +229,6 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
         out = one(screen, max_units, n)
     else:
         lib = problem.cell.library
-        assert lib is not None
         hi = min(max_units or problem.max_units, lib.rules.max_dof)
         # designs of equal modules and mass may still differ on a later objective (margin, a task's)
         ties = any(o not in ("modules", "mass") for o in problem.rank)
@@ -243,17 +242,16 @@ def design(problem: Problem, *, max_units: int | None = None, top: int = 5, seed
     return out
 
 
-def longest_reach(problem: Problem, hi: int) -> float:
+def longest_reach(problem: ResolvedProblem, hi: int) -> float:
     """m: the reach bound of the longest arm of at most hi units in the bounds (0 if none)."""
     lib = problem.cell.library
-    assert lib is not None
     return max((reach_bound([lib.units[k] for k in s.kinds], [x or lib.units[k].x23 for k, x in
                             zip(s.kinds, s.links, strict=True)], problem.cell.tool.xyz)
                 for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
                 for s in _longest(problem, n)), default=0.0)
 
 
-def _search(problem: Problem, max_units: int | None, top: int, seed: int, executor: Executor | None,
+def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int, executor: Executor | None,
             progress: Callable[..., None] | None, deadline: float | None, enough: int | None = None,
             ceiling: Ceiling | None = None, diagnosing: bool = True) -> Outcome:
     """The static search: designs ranked by the problem's (static) objectives.
@@ -269,7 +267,6 @@ def _search(problem: Problem, max_units: int | None, top: int, seed: int, execut
     t0 = time.perf_counter()
     spec = Spec.of(problem)
     lib = problem.cell.library
-    assert lib is not None
     out = Outcome(problem, [])
     hi = min(max_units or problem.max_units, lib.rules.max_dof)
     names = [t.name for t in problem.cell.targets]

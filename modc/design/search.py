@@ -130,7 +130,6 @@ class Axes:
 
 def full_axes(spec: Spec, shape: Shape) -> Axes:
     lib = spec.problem.cell.library
-    assert lib is not None
     pivot_set, port_set = twist_values(lib.twists.pivot), twist_values(lib.twists.port)
     free = port_free(spec.problem, shape, lib)
     values: list[np.ndarray] = []
@@ -224,7 +223,6 @@ def _split(ranges: list[tuple[int, int]]) -> tuple[tuple[tuple[int, int], ...], 
 def _plan(spec: Spec, shape: Shape) -> Plan:
     full = full_axes(spec, shape)
     lib = spec.problem.cell.library
-    assert lib is not None
     types = [lib.units[k] for k in shape.kinds]
     links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     tool = spec.problem.cell.tool
@@ -323,7 +321,6 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         numbers = listed_[numbers]
     lo, hi = 0, len(numbers)
     lib = spec.problem.cell.library
-    assert lib is not None
     types = [lib.units[k] for k in shape.kinds]
     links = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     tool = spec.problem.cell.tool

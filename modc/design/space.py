@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import Problem
+from ..model import ResolvedProblem
 
 
 @dataclass(frozen=True)
@@ -48,10 +48,9 @@ def twist_values(ts) -> np.ndarray:
     return np.radians(np.array(deg, float))
 
 
-def variant_splits(problem: Problem, n: int) -> list[tuple[str, ...]]:
+def variant_splits(problem: ResolvedProblem, n: int) -> list[tuple[str, ...]]:
     """Variant sequences the rules allow for n units: first variant, then the may-follow order, eps each."""
     lib = problem.cell.library
-    assert lib is not None
     rules = lib.rules
     out = []
     for seq in itertools.product(sorted(lib.variants), repeat=n):
@@ -65,14 +64,13 @@ def variant_splits(problem: Problem, n: int) -> list[tuple[str, ...]]:
     return out
 
 
-def allowed(problem: Problem, variant: str, kind: int) -> bool:
+def allowed(problem: ResolvedProblem, variant: str, kind: int) -> bool:
     return problem.modules is None or f"{variant}{kind}" in problem.modules
 
 
-def shapes(problem: Problem, n: int) -> list[Shape]:
+def shapes(problem: ResolvedProblem, n: int) -> list[Shape]:
     """Every shape of n units some allowed variant split can build, link lengths expanded."""
     lib = problem.cell.library
-    assert lib is not None
     splits = variant_splits(problem, n)
     kinds_all = sorted(lib.units)
     out = []
@@ -85,7 +83,7 @@ def shapes(problem: Problem, n: int) -> list[Shape]:
     return out
 
 
-def port_free(problem: Problem, shape: Shape, lib) -> list[bool]:
+def port_free(problem: ResolvedProblem, shape: Shape, lib) -> list[bool]:
     """Per position: does its port twist matter (a link unit, and not the last one's irrelevant twist)?"""
     tool = problem.cell.tool
     tool_on_axis = tool.xyz[1] == 0.0 and tool.xyz[2] == 0.0

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import Problem
+from ..model import ResolvedProblem
 from . import space
 from .evaluate import Candidate, verify
 from .rank import Design, identity
@@ -17,7 +17,7 @@ VERIFY_FACTOR = 4  # at most this many exact checks per design asked for, per nu
 
 
 class Verifier:
-    def __init__(self, problem: Problem, top: int, out, mass):
+    def __init__(self, problem: ResolvedProblem, top: int, out, mass):
         self.problem, self.top, self.out, self.mass = problem, top, out, mass
         self.pending: list[tuple] = []
         self.accepted: list[Design] = []
@@ -47,7 +47,6 @@ class Verifier:
         from .evaluate import robot_for
 
         lib = self.problem.cell.library
-        assert lib is not None
         cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
         robot = robot_for(self.problem, cand, {}, self.problem.name)
         tau = static_torques(robot, [sols[0] for sols in f.solutions])

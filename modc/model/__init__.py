@@ -8,12 +8,14 @@ from .robot import (
     Payload,
     Pose,
     Problem,
+    ResolvedProblem,
     ResolvedRobot,
     Robot,
     Target,
     Transform,
     UnitSpec,
     resolved,
+    resolved_problem,
 )
 
 __all__ = [
@@ -26,10 +28,12 @@ __all__ = [
     "Payload",
     "Pose",
     "Problem",
+    "ResolvedProblem",
     "ResolvedRobot",
     "Robot",
     "Target",
     "Transform",
     "UnitSpec",
     "resolved",
+    "resolved_problem",
 ]

@@ -371,6 +371,26 @@ class Problem(Value):
     bound_spans: dict[str, Span] = hidden(default_factory=dict)
 
 
+class ResolvedProblem(Problem):
+    """A `design` block whose cell's library is resolved: what check_problems hands on and every
+    design analysis reads (its cell is a ResolvedRobot, so the library is never None)."""
+
+    cell: ResolvedRobot
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.cell, ResolvedRobot):
+            raise InvalidModel("a resolved design problem has its cell's module library")
+
+
+def resolved_problem(problem: Problem, cell: ResolvedRobot) -> ResolvedProblem:
+    """The problem with its resolved cell, unchecked as model_copy."""
+    new = object.__new__(ResolvedProblem)
+    new.__dict__.update(problem.__dict__)
+    new.__dict__["cell"] = cell
+    return new
+
+
 class Design(Value):
     """Everything one input file defines."""
 
@@ -387,3 +407,11 @@ class Design(Value):
             if not isinstance(r, ResolvedRobot):
                 raise InvalidModel(f"robot {r.name}: its library is not resolved (check the design first)")
         return self.robots  # type: ignore[return-value]  # each one checked just above
+
+    def resolved_problems(self) -> tuple[ResolvedProblem, ...]:
+        """The design blocks of a design whose checks passed: every cell resolved. InvalidModel
+        for a block whose library was never resolved."""
+        for p in self.problems:
+            if not isinstance(p, ResolvedProblem):
+                raise InvalidModel(f"design {p.name}: its library is not resolved (check the design first)")
+        return self.problems  # type: ignore[return-value]  # each one checked just above

@@ -10,7 +10,7 @@ import difflib
 from pathlib import Path
 
 from ..diagnostics import codes
-from ..model import Design, Problem, ResolvedRobot, Robot, resolved
+from ..model import Design, Problem, ResolvedRobot, Robot, resolved, resolved_problem
 from ..model import library as lib
 from .context import Context
 from .resolve_library import load_for
@@ -77,7 +77,7 @@ def run(design: Design, ctx: Context) -> Design:
                 path = ctx.library_override not in lib.BUILTIN
                 update |= {"library_ref": ctx.library_override, "library_dir": str(Path.cwd()) if path else None}
             cell = resolved(p.cell, library, **update)
-            p = p.model_copy(update={"cell": cell})
+            p = resolved_problem(p, cell)
             if p.reference is not None:
                 p = p.model_copy(update={"reference": _reference(p.reference, cell, library, ctx)})
         problems.append(p)
