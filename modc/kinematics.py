@@ -127,6 +127,21 @@ def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:
     return rotation_vector(np.asarray(R_target, float) @ np.swapaxes(np.asarray(R, float), -1, -2))
 
 
+def target_errors(target, T_base_tool: np.ndarray) -> tuple[float, float | None]:
+    """(m, rad) from tool0's pose to a target (modc.model.Target): the position error and, if the
+    target asks for an orientation, the angle to it - the whole frame's for `rpy`, tool0's x axis
+    against the direction for `pointing`; None when it asks for none. Compare with
+    `target.tolerance`: the one test of "reached"."""
+    T = np.asarray(T_base_tool, float)
+    position = float(np.linalg.norm(T[:3, 3] - np.asarray(target.xyz, float)))
+    if target.rpy is not None:
+        return position, float(np.linalg.norm(rotation_error(rpy_matrix(target.rpy), T[:3, :3])))
+    if target.pointing is not None:
+        x, d = T[:3, 0], np.asarray(target.pointing, float)
+        return position, float(np.arctan2(np.linalg.norm(np.cross(x, d)), x @ d))
+    return position, None
+
+
 @dataclass(frozen=True)
 class UnitGeometry:
     """The numbers eqs. (4)-(6) need for one unit, resolved from the library."""

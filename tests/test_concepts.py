@@ -166,6 +166,32 @@ def test_a_targets_tolerance_is_read_from_the_target():
     assert pointing.oriented and pointing.tolerance == (0.005, 0.1)
 
 
+def test_a_targets_errors_have_one_home_that_the_planners_ik_agrees_with():
+    """kinematics.target_errors (the design's exact check) measures what plan.ik's PositionIK
+    does for the same pose: a full orientation, a pointing axis, or position only."""
+    from modc import kinematics as K
+    from modc.model.robot import Target
+    from modc.plan.ik import PositionIK
+
+    rng = np.random.default_rng(3)
+    T = K.transform(rng.uniform(-0.3, 0.3, 3), rng.uniform(-3, 3, 3))
+
+    class Pose:  # what PositionIK reads of pinocchio's placement
+        translation, rotation = T[:3, 3], T[:3, :3]
+
+    for kw in ({"rpy": (0.1, -0.4, 2.0)}, {"pointing": (0.0, 0.6, -0.8)}, {}):
+        t = Target(name="t", xyz=(0.2, -0.1, 0.3), **kw)
+        ik = PositionIK.__new__(PositionIK)
+        ik.rotation = K.rpy_matrix(t.rpy) if t.rpy is not None else None
+        ik.axis = None if t.pointing is None else np.asarray(t.pointing, float)
+        ik.placement = lambda q: Pose  # type: ignore[method-assign]
+        position, angle = K.target_errors(t, T)
+        ref_p, ref_o = ik.errors(None, np.asarray(t.xyz))
+        assert position == pytest.approx(ref_p, abs=1e-12)
+        assert (angle is None) == (not kw) and (angle or 0.0) == pytest.approx(ref_o, abs=1e-9)
+        assert angle is None or 0.0 < angle < math.pi
+
+
 def test_the_design_searchs_ik_seeds_are_the_planners():
     """design/reach.py keeps an array form of plan.ik.seeds (the search's batched IK starts
     from zero); the same seeds, in the same order, for the same rng seed."""

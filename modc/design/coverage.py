@@ -8,17 +8,15 @@ others are dropped from the visits of its robot file, which keeps the regions wh
 design is ranked by the share, larger first (rank.OBJECTIVES)."""
 from __future__ import annotations
 
-import numpy as np
-
 from ..model import ResolvedRobot, Robot
 
 
 def reached(robot: ResolvedRobot, seed: int) -> tuple[set[str], int]:
     """The names of the region points the robot reaches clear of the cell, and how many there are."""
     from ..kinematics import rpy_matrix
+    from ..physical.checker import CollisionChecker
     from ..plan import IK_BATCHES, IK_SEEDS_PER_JOINT, start_pose
     from ..plan import ik as plan_ik
-    from ..plan.collision import CollisionChecker
 
     points = [p for r in robot.regions for p in r.points()]
     if not points:
@@ -30,8 +28,7 @@ def reached(robot: ResolvedRobot, seed: int) -> tuple[set[str], int]:
         rotation = None if t.rpy is None else rpy_matrix(t.rpy)
         solver = plan_ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper,
                                     rotation, t.pointing)
-        oriented = t.rpy is not None or t.pointing is not None
-        tol = (t.position_tolerance, t.orientation_tolerance if oriented else np.inf)
+        tol = t.tolerance
         sols, _best = plan_ik.solve(solver, t.xyz, home, IK_SEEDS_PER_JOINT * robot.dof, seed,
                                     batches=IK_BATCHES, enough=checker.valid, tolerance=tol)
         if any(checker.valid(s.q) for s in sols):

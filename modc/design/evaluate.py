@@ -8,12 +8,13 @@ approximate: it decides what is worth checking.
 verify: the one place a design is accepted. It writes the design as a robot, checks it with the
 compiler's passes and analyses (check_text: assembly rules, twists, poses within limits, the
 torque check with the payload), re-measures every target with modc.kinematics.Chain, and tests
-the chosen joint vectors with modc.plan.collision.CollisionChecker (the emitted meshes against
+the chosen joint vectors with modc.physical.checker.CollisionChecker (the emitted meshes against
 the cell and against themselves beyond the SRDF's disabled pairs). A faster physical model
 (pinocchio/coal built in memory) drops in behind these same calls.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,8 +44,8 @@ class Spec:
     @classmethod
     def of(cls, problem: ResolvedProblem) -> Spec:
         lib = problem.cell.library
-        lower = max(np.radians(v.lower_deg) for v in lib.variants.values())
-        upper = min(np.radians(v.upper_deg) for v in lib.variants.values())
+        lower = max(v.joint_range[0] for v in lib.variants.values())
+        upper = min(v.joint_range[1] for v in lib.variants.values())
         return cls(problem, reach.Targets.of(problem.cell.targets), Obstacles.of(problem.cell.obstacles),
                    segment_radii(lib), float(lower), float(upper))
 
@@ -189,10 +190,10 @@ def robot_for(problem: ResolvedProblem, cand: Candidate, poses: dict[str, tuple[
 def verify(problem: ResolvedProblem, cand: Candidate) -> Verified | str:
     """The exact check of one design; a string says why it fails."""
     from ..compiler import check_text
-    from ..kinematics import Chain, rpy_matrix
+    from ..kinematics import Chain, target_errors
     from ..model.write import robot_file_text
     from ..physical.assembly import library_mass
-    from ..plan.collision import CollisionChecker
+    from ..physical.checker import CollisionChecker
 
     names = [t.name for t in problem.cell.targets]
     first = {t: sols[0] for t, sols in zip(names, cand.solutions, strict=True)}
@@ -214,18 +215,12 @@ def verify(problem: ResolvedProblem, cand: Candidate) -> Verified | str:
             contacts = checker.contacts(np.asarray(sols[0]))
             what = contacts[0].describe() if contacts else "a collision"
             return f"target '{target.name}' is reached only in collision ({what})"
-        T = chain.T_base_tool(np.asarray(q))
-        perr = float(np.linalg.norm(T[:3, 3] - np.asarray(target.xyz)))
-        oerr = None
-        if target.rpy is not None or target.pointing is not None:
-            if target.rpy is not None:
-                E = rpy_matrix(target.rpy) @ T[:3, :3].T
-                oerr = float(np.degrees(np.arccos(np.clip((np.trace(E) - 1) / 2, -1.0, 1.0))))
-            else:  # only tool0's x axis (the approach) is constrained
-                oerr = float(np.degrees(np.arccos(np.clip(T[:3, 0] @ np.asarray(target.pointing), -1.0, 1.0))))
-            if oerr > np.degrees(target.orientation_tolerance) + 1e-9:
-                return f"target '{target.name}' orientation off by {oerr:.2g}°"
-        if perr > target.position_tolerance + 1e-12:
+        perr, angle = target_errors(target, chain.T_base_tool(np.asarray(q)))
+        oerr = None if angle is None else math.degrees(angle)
+        tol_p, tol_o = target.tolerance
+        if angle is not None and angle > tol_o + 1e-9:
+            return f"target '{target.name}' orientation off by {oerr:.2g}°"
+        if perr > tol_p + 1e-12:
             return f"target '{target.name}' missed by {perr * 1000:.2g} mm"
         chosen[target.name] = tuple(float(x) for x in q)
         report[target.name] = {"q": [round(float(x), 9) for x in q], "position_error_m": round(perr, 9),

@@ -103,7 +103,7 @@ def base_blocked(problem: ResolvedProblem, pose: Transform) -> bool:
     and type)? The exact check rejects every design there ("base_link touches the cell"), so
     the pose is not worth a search (sound)."""
     from ..model import UnitSpec
-    from ..plan.collision import CollisionChecker
+    from ..physical.checker import CollisionChecker
     from . import space
 
     lib = problem.cell.library
