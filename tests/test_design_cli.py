@@ -67,8 +67,11 @@ def test_time_budget_keeps_the_best_found(tmp_path):
 
 @pytest.mark.slow
 def test_time_budget_with_nothing_found_exits_1(tmp_path):
+    # a payload no arm holds: whatever the machine's speed, nothing is found before the budget
+    # runs out over the 5,120 shapes (the torque screen rules out each chain the search finds)
     out = tmp_path / "out"
-    p = _run(tmp_path, BIG, "-o", str(out), "--no-render", "--time-budget", "1s", "-q")
+    heavy = BIG.replace("design big {\n", "design big {\n    payload 40 kg\n")
+    p = _run(tmp_path, heavy, "-o", str(out), "--no-render", "--time-budget", "1s", "-q")
     assert p.returncode == 1, p.stderr
     assert "the time budget ran out" in p.stderr and "no design found" in p.stderr
     assert "feasible, best" not in p.stderr  # -q: no progress
