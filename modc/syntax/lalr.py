@@ -323,21 +323,18 @@ def _propagate(meta: Any, children: list) -> None:
     to its last's (containers: nodes inlined into it, which take up text)."""
     first = _first_meta(children)
     if first is not None:
-        if not hasattr(meta, "line"):
-            meta.line = getattr(first, "container_line", first.line)
-            meta.column = getattr(first, "container_column", first.column)
-            meta.start_pos = getattr(first, "container_start_pos", first.start_pos)
-            meta.empty = False
-        meta.container_line = getattr(first, "container_line", first.line)
-        meta.container_column = getattr(first, "container_column", first.column)
-        meta.container_start_pos = getattr(first, "container_start_pos", first.start_pos)
+        _take(meta, first, ("line", "column", "start_pos"))
     last = _first_meta(reversed(children))
     if last is not None:
-        if not hasattr(meta, "end_line"):
-            meta.end_line = getattr(last, "container_end_line", last.end_line)
-            meta.end_column = getattr(last, "container_end_column", last.end_column)
-            meta.end_pos = getattr(last, "container_end_pos", last.end_pos)
-            meta.empty = False
-        meta.container_end_line = getattr(last, "container_end_line", last.end_line)
-        meta.container_end_column = getattr(last, "container_end_column", last.end_column)
-        meta.container_end_pos = getattr(last, "container_end_pos", last.end_pos)
+        _take(meta, last, ("end_line", "end_column", "end_pos"))
+
+
+def _take(meta: Any, child: Any, keys: tuple[str, str, str]) -> None:
+    """One end of the node's span (and of its container's) from a child's."""
+    values = [getattr(child, "container_" + k, getattr(child, k)) for k in keys]
+    if not hasattr(meta, keys[0]):
+        for k, v in zip(keys, values, strict=True):
+            setattr(meta, k, v)
+        meta.empty = False
+    for k, v in zip(keys, values, strict=True):
+        setattr(meta, "container_" + k, v)
