@@ -96,3 +96,19 @@ def put_checked(kind: str, name: str, payload: bytes) -> None:
     """put(), the payload preceded by its sha256 (get_checked's test)."""
     put(kind, name, hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload)
 
+
+
+def prune(kind: str, suffix: str, keep: int) -> None:
+    """Keep the `keep` newest entries of KIND named *suffix; remove the older ones (only regular
+    files modc names so, inside its own directory: never a link, never anything else)."""
+    where = directory(kind, create=False)
+    if where is None:
+        return
+    try:
+        entries = [e for e in os.scandir(where)
+                   if e.name.endswith(suffix) and _PART.fullmatch(e.name) and e.is_file(follow_symlinks=False)]
+        entries.sort(key=lambda e: e.stat(follow_symlinks=False).st_mtime_ns, reverse=True)
+        for e in entries[keep:]:
+            os.unlink(e.path)
+    except OSError:
+        pass

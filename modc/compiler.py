@@ -76,7 +76,7 @@ def check_text(text: str, path: str = "<string>", library: str | None = None, **
     text = normalize_newlines(text)  # the same length: offsets into the original stay right
     tree, diags = parse_text(text, path)
     if "torque" in options.get("analyses", ()) and "torque_analysis" not in options:
-        from .dynamics.worst import analyse  # the passes run it, but only the compiler imports the physics
+        from .dynamics.torque import analyse  # the passes run it, but only the compiler imports the physics
 
         options["torque_analysis"] = analyse
     ctx = Context(diagnostics=diags, library_override=library, **options)
@@ -111,6 +111,60 @@ def build(checked: Checked, only: list[str] | None = None, **options) -> dict[st
         for rel, content in backends[name].emit(b).items():
             b.files[rel] = content
     return dict(sorted(b.files.items()))
+
+
+_BUILDS = "builds"  # modc's cache: whole builds (build_cached)
+KEEP_BUILDS = 16  # the newest builds kept: editing one file and compiling it again and again stays small
+
+
+def build_cached(checked: Checked, only: list[str] | None = None, **options) -> dict[str, str | bytes]:
+    """build(), its files kept in modc's cache under a digest of everything it reads: the checked
+    design (libraries and torque results included), the warnings, the sources, the options, the
+    working directory and modc's own code. A hit (a compile of an unchanged file) imports no
+    numpy, jinja2 or pinocchio; a damaged entry is built again, never trusted."""
+    import marshal
+
+    from . import cache
+
+    name = _build_key(checked, only, options)
+    payload = cache.get_checked(_BUILDS, name)
+    if payload is not None:
+        try:
+            files = marshal.loads(payload)
+        except (ValueError, EOFError, TypeError):
+            files = None
+        if isinstance(files, dict) and all(isinstance(k, str) and isinstance(v, str | bytes) for k, v in files.items()):
+            return files
+    files = build(checked, only, **options)
+    cache.put_checked(_BUILDS, name, marshal.dumps(files))
+    cache.prune(_BUILDS, ".build", KEEP_BUILDS)
+    return files
+
+
+def _build_key(checked: Checked, only: list[str] | None, options: dict) -> str:
+    from . import cache
+    from ._version import __version__
+    from .records import as_plain
+
+    design = checked.design
+    return cache.key(__version__, _code_stamp(), repr(as_plain(design, hidden=False)),
+                     repr([r.torque for r in design.robots]), repr(checked.diagnostics),
+                     repr(sorted(checked.sources.items())), repr(only), repr(sorted(options.items())),
+                     os.getcwd()) + ".build"
+
+
+def _code_stamp() -> str:
+    """modc's own files as installed (name, size, modification time): a changed template or
+    backend is another build."""
+    root = os.path.dirname(os.path.abspath(__file__))
+    stamp = []
+    for folder, dirs, names in os.walk(root):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        for n in sorted(names):
+            if not n.endswith((".pyc", ".pyo")):
+                st = os.stat(os.path.join(folder, n))
+                stamp.append(f"{os.path.relpath(os.path.join(folder, n), root)}:{st.st_size}:{st.st_mtime_ns}")
+    return "\n".join(stamp)
 
 
 def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: bool = False,

@@ -5,8 +5,23 @@ shares with other backends lives in common.py, never in another backend.
 """
 from __future__ import annotations
 
-from .build import Build
+from typing import TYPE_CHECKING, Any
+
 from .registry import BACKENDS, Backend, Files, check_order, register
+
+if TYPE_CHECKING:
+    from .build import Build
+
+
+def __getattr__(name: str) -> Any:
+    # Build (and with it the physical description and numpy) is imported when first used, so that
+    # a compile served from modc's cache (modc.compiler.build_cached) and the ROS option check
+    # (ros_target) load neither
+    if name == "Build":
+        from .build import Build
+
+        return Build
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def load_all() -> dict[str, Backend]:

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from .build import Build
+if TYPE_CHECKING:  # the physical description (numpy) loads with the first backend, not the registry
+    from .build import Build
 
 Files = dict[str, "str | bytes"]
 

@@ -64,7 +64,7 @@ def compile_cmd(
     verbose: bool,
 ) -> None:
     """Check FILE and write URDF, meshes and a report into OUT."""
-    from ..compiler import COMPILE_ANALYSES, InputError, build, check_file, inputs_of
+    from ..compiler import COMPILE_ANALYSES, InputError, build_cached, check_file, inputs_of
     from ..outputs import check_output_dir, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
@@ -103,7 +103,7 @@ def compile_cmd(
     ros_options = _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, command_interface,
                                package_license, maintainer)
     try:
-        files = build(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
+        files = build_cached(checked, selected, collision_samples=collision_samples, seed=seed, **ros_options)
     except InputError as e:  # a backend refuses a value it cannot write (mjcf: not-finite)
         _print_diagnostics([e.diagnostic], checked.sources)
         _err(f"modc: nothing written to {out}")
@@ -125,8 +125,8 @@ def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, com
     """Build fields of the ROS backend. The environment ($ROS_DISTRO, $ROS_VERSION) is read here
     and only here, below the command-line options (docs/ros.md)."""
     import os
+    from types import SimpleNamespace
 
-    from ..backends import Build
     from ..backends.ros_target import RosOptionError, distro_for, resolve
 
     try:
@@ -134,7 +134,7 @@ def _ros_options(checked, selected, ros, ros_distro, ik_solver, ros_package, com
                    "ros_package": ros_package, "command_interface": command_interface,
                    "package_license": package_license, "maintainer": maintainer}
         if selected is None or "ros" in selected:
-            resolve(Build(checked.design, **options))
+            resolve(SimpleNamespace(robots=checked.design.resolved_robots(), **options))  # what a Build holds
     except RosOptionError as e:
         _err(f"modc: {e}")
         raise SystemExit(EXIT_USAGE) from None

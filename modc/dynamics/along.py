@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .model import Dynamics
-from .worst import JointWorst
+from .torque import JointWorst
 
 
 @dataclass(frozen=True)

@@ -6,47 +6,16 @@ with pinocchio's analytic derivatives dg/dq, stopping where the projected gradie
 local maximum on the box). Starting from many well-spread samples makes missing the global
 maximum unlikely; the tests compare with a dense grid.
 
-The result is a pure function of the arm's Description (inertials, joints, limits), gravity, the
-actuators' torques and the search's parameters, so it is cached on disk under their digest
-(modc.cache): a compile whose arm has not changed needs no pinocchio at all.
+The result is a pure function of the checked robot (its arm, base, payload and library) and the
+search's parameters, so modc.dynamics.torque caches it on disk under their digest: a compile
+whose robot has not changed needs neither pinocchio nor numpy for it.
 """
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass
-
 import numpy as np
 
-from .. import cache
-from ..model import ResolvedRobot
-from .model import Dynamics, PayloadOverride, gravity, with_payload
-
-ALGORITHM = "1"  # bump when worst_case() could give another result for the same input
-
-
-@dataclass(frozen=True)
-class JointWorst:
-    name: str
-    variant: str
-    tau: float  # max |g_i(q)|, N·m
-    q: tuple[float, ...]  # the pose where it happens, rad
-    tau_nom: float
-    tau_max: float
-
-    @property
-    def margin(self) -> float:
-        """Share of the peak torque left in the worst pose (negative: overloaded)."""
-        return (self.tau_max - self.tau) / self.tau_max
-
-    def to_json(self) -> dict:
-        """The torque report's per-joint record (docs/conventions.md), rounded so that reports are stable."""
-        return {"name": self.name, "unit": self.variant, "tau_gravity_max": round(self.tau, 6), "tau_nom": self.tau_nom,
-                "tau_max": self.tau_max, "margin": round(self.margin, 6),
-                "pose": [round(float(np.degrees(x)), 1) + 0.0 for x in self.q], "status": self.level}
-
-    @property
-    def level(self) -> str:
-        return "over-peak" if self.tau > self.tau_max else "over-nominal" if self.tau > self.tau_nom else "ok"
+from .model import Dynamics
+from .torque import REFINE, SAMPLES, SEED, JointWorst
 
 
 def _ascend(dyn: Dynamics, i: int, q: np.ndarray, iters: int = 60) -> tuple[float, np.ndarray]:
@@ -88,7 +57,7 @@ def _canonical(dyn: Dynamics, i: int, val: float, q: np.ndarray) -> tuple[float,
     return val, q
 
 
-def worst_case(dyn: Dynamics, samples: int = 512, refine: int = 4, seed: int = 0) -> list[JointWorst]:
+def worst_case(dyn: Dynamics, samples: int = SAMPLES, refine: int = REFINE, seed: int = SEED) -> list[JointWorst]:
     robot = dyn.robot
     lib = robot.library
     n = dyn.nq
@@ -111,30 +80,3 @@ def worst_case(dyn: Dynamics, samples: int = 512, refine: int = 4, seed: int = 0
     return out
 
 
-def analyse(robot: ResolvedRobot, payload_mass: float | None = None) -> list[JointWorst]:
-    """The worst case for a checked robot; payload_mass (kg) replaces the file's payload mass,
-    keeping its centre of mass (tool0's origin if the file has none). Cached by content."""
-    payload: PayloadOverride | None = None
-    if payload_mass is not None:
-        com = robot.payload.com if robot.payload is not None else (0.0, 0.0, 0.0)
-        payload = (payload_mass, com)
-    key = _key(robot, payload)
-    hit = cache.get("torque", key)
-    if hit is not None:
-        return [JointWorst(j[0], j[1], j[2], tuple(j[3]), j[4], j[5]) for j in json.loads(hit)]
-    result = worst_case(Dynamics(robot, payload))
-    cache.put("torque", key, json.dumps([[j.name, j.variant, j.tau, list(j.q), j.tau_nom, j.tau_max]
-                                         for j in result]).encode())
-    return result
-
-
-def _key(robot: ResolvedRobot, payload: PayloadOverride | None) -> str:
-    """Everything worst_case() reads: the described arm, gravity, the actuators, the defaults."""
-    from ..physical.assembly import describe
-
-    lib = robot.library
-    actuators = [(u.name, lib.variants[u.variant].actuator.torque_nominal, lib.variants[u.variant].actuator.torque_peak)
-                 for u in robot.units]
-    defaults = worst_case.__defaults__
-    return cache.key(ALGORITHM, describe(with_payload(robot, payload)).fingerprint(), gravity(robot).tobytes(),
-                     repr(actuators), repr(defaults)) + ".json"

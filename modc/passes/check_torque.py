@@ -1,6 +1,6 @@
 """Can the arm carry itself and its payload? Worst static gravity torque per joint against the
 actuator's nominal (warning) and peak (error) torque. Runs when ctx.analyses has "torque", with the
-search the compiler hands in (ctx.torque_analysis: modc.dynamics.worst.analyse); a pass imports no
+search the compiler hands in (ctx.torque_analysis: modc.dynamics.torque.analyse); a pass imports no
 physics, so `modc lint` stays light and the layers stay one-way."""
 from __future__ import annotations
 

@@ -17,7 +17,7 @@ class Context:
     analyses: frozenset[str] = frozenset()
     torque_severity: str = "error"  # error | warning | off: how an over-peak joint is reported
     payload_override: float | None = None  # `check --payload MASS`, kg at tool0
-    # The worst-case torque search (modc.dynamics.worst.analyse), handed in by the compiler when
+    # The worst-case torque search (modc.dynamics.torque.analyse), handed in by the compiler when
     # analyses has "torque": a pass never imports the physics (pyproject's import contracts).
     torque_analysis: Callable[[Robot, float | None], Sequence[Any]] | None = None
     sources: dict[str, str] = field(default_factory=dict)  # other files diagnostics point into (libraries)

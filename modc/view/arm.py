@@ -195,7 +195,7 @@ class Arm:
 
     def torques(self, q) -> list[JointTorque]:
         """Gravity torque of every joint holding the arm (and payload) still at q."""
-        from ..dynamics.worst import JointWorst
+        from ..dynamics.torque import JointWorst
 
         if self._dynamics is None:
             from ..dynamics.model import Dynamics
