@@ -423,6 +423,52 @@ def test_oriented_straight_path_follows_the_slerp(tmp_path, capsys):
     assert e.value.code == 1 and "path 'turn', segment 1 (a -> b): tool0 cannot stay on the segment" in err
 
 
+POINTING = ("    target a at (0.30, 0, 0.25) m pointing (0.375, 0.7328, -0.5678) within 5 mm, 3 deg\n"
+            "    target b at (0.30, 0.10, 0.25) m pointing (0.1591, 0.8423, -0.515) within 5 mm, 3 deg\n"
+            "    path turn from a to b straight\n")
+
+
+@pytest.mark.slow
+def test_pointing_straight_path_turns_the_approach_axis(tmp_path, capsys):
+    """With `pointing` ends, tool0's x axis follows the great circle between the two directions
+    (within the targets' tolerance at every sample of the timed motion); a direction the arm
+    cannot hold along the segment is refused, not ignored."""
+    import pinocchio as pin
+
+    from modc.plan.collision import CollisionChecker
+    from modc.plan.task import plan_task
+
+    text = EXAMPLE.read_text(encoding="utf-8").replace("    path seam", POINTING + "    path seam")
+    cell = tmp_path / "cell.mod"
+    cell.write_text(text, encoding="utf-8")
+    result = plan_task(cell, "turn")
+    robot = check_file(cell).design.robots[0]
+    checker = CollisionChecker(robot)
+    a, b = robot.task_target("a"), robot.task_target("b")
+    da, db = np.array(a.pointing) / np.linalg.norm(a.pointing), np.array(b.pointing) / np.linalg.norm(b.pointing)
+    theta = math.acos(float(np.clip(da @ db, -1, 1)))
+    seg = result.segments[-1]
+    t, q = _samples(result)
+    pa, pb = np.array(a.xyz), np.array(b.xyz)
+    for row in q[t >= seg.t0 - 1e-9]:
+        pin.forwardKinematics(checker.model, checker.data, row)
+        M = pin.updateFramePlacement(checker.model, checker.data, checker.tool_frame)
+        x = float(np.clip(np.dot(M.translation - pa, pb - pa) / np.dot(pb - pa, pb - pa), 0, 1))
+        d = (math.sin((1 - x) * theta) * da + math.sin(x * theta) * db) / math.sin(theta)  # the great circle
+        axis = np.array(M.rotation)[:, 0]
+        assert math.acos(float(np.clip(axis @ d, -1, 1))) <= math.radians(3) + 1e-9
+        assert np.linalg.norm(M.translation - (pa + x * (pb - pa))) <= 0.005
+    # the same segment asking for a's direction all the way: the 3-joint arm cannot hold it
+    from modc.cli import main
+
+    cell.write_text(text.replace("pointing (0.1591, 0.8423, -0.515)", "pointing (0.375, 0.7328, -0.5678)"),
+                    encoding="utf-8")
+    with pytest.raises(SystemExit) as e:
+        main(["plan", str(cell), "--task", "turn"])
+    err = capsys.readouterr().err
+    assert e.value.code == 1 and "path 'turn', segment 1 (a -> b): tool0 cannot stay on the segment" in err
+
+
 def test_written_robot_file_keeps_the_task():
     """modc.model.write (what `modc design` emits): regions, tasks and paths survive a round trip."""
     from modc.model.write import robot_file_text

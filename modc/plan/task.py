@@ -10,7 +10,9 @@ consecutive pair: each a collision-free joint-space motion within the joint limi
 modc.plan.plan_robot (IK, the collision-free goal closest to where the arm is, RRT-Connect,
 certified edges) from where the previous segment ended. A `path NAME from a to b straight` is
 an approach to a, then tool0 along the segment a -> b: positions linearly interpolated,
-orientation slerped, IK at waypoints STRAIGHT_STEP apart, each seeded from the previous
+orientation slerped (or, when an end asks only for a direction with `pointing`, tool0's x axis
+turned along the great circle between the ends' directions), IK at waypoints STRAIGHT_STEP
+apart, each seeded from the previous
 solution; every waypoint within the targets' tolerances, joints moving at most MAX_JOINT_STEP
 between waypoints (no jump to another IK branch), every motion between waypoints certified
 collision-free.
@@ -251,26 +253,28 @@ class _Job:
         return path, timed
 
     def _frames(self, ta, tb):
-        """(positions, rotations or None) along a -> b at the waypoints."""
-        import pinocchio as pin
-
-        from ..kinematics import rpy_matrix
-
+        """(positions, orientation goals) along a -> b at the waypoints: rotations slerped when both
+        targets give `rpy`, tool0's x axis turned along the great circle when both ask for a
+        direction (`pointing`, or the x axis of an `rpy`), else None."""
         pa, pb = np.asarray(ta.xyz, float), np.asarray(tb.xyz, float)
-        Ra = None if ta.rpy is None else np.asarray(rpy_matrix(ta.rpy), float)
-        Rb = None if tb.rpy is None else np.asarray(rpy_matrix(tb.rpy), float)
-        w = np.asarray(pin.log3(Ra.T @ Rb)) if Ra is not None and Rb is not None else np.zeros(3)
-        n = max(1, math.ceil(max(np.linalg.norm(pb - pa) / STRAIGHT_STEP, np.linalg.norm(w) / STRAIGHT_ANGLE_STEP)))
+        mode = _orientation_mode(ta, tb)
+        turn = 0.0
+        if mode == "rpy":
+            import pinocchio as pin
+
+            from ..kinematics import rpy_matrix
+
+            Ra, Rb = np.asarray(rpy_matrix(ta.rpy), float), np.asarray(rpy_matrix(tb.rpy), float)
+            turn = float(np.linalg.norm(pin.log3(Ra.T @ Rb)))
+        elif mode == "axis":
+            turn = _angle(_axis_of(ta), _axis_of(tb))
+        n = max(1, math.ceil(max(np.linalg.norm(pb - pa) / STRAIGHT_STEP, turn / STRAIGHT_ANGLE_STEP)))
         s = np.linspace(0.0, 1.0, n + 1)
-        positions = [pa + x * (pb - pa) for x in s]
-        if Ra is None or Rb is None:
-            return positions, [Ra if Ra is not None else Rb] * len(s)
-        return positions, [Ra @ np.asarray(pin.exp3(x * w)) for x in s]
+        return [pa + x * (pb - pa) for x in s], [_goal_at(ta, tb, mode, float(x)) for x in s]
 
     def _tolerance(self, ta, tb) -> tuple[float, float]:
-        both = ta.rpy is not None and tb.rpy is not None
         return (min(ta.position_tolerance, tb.position_tolerance),
-                min(ta.orientation_tolerance, tb.orientation_tolerance) if both else math.inf)
+                min(ta.orientation_tolerance, tb.orientation_tolerance) if _orientation_mode(ta, tb) else math.inf)
 
     def _waypoints(self, number: int, ta, tb, q) -> list[np.ndarray]:
         from .ik import PositionIK
@@ -279,9 +283,11 @@ class _Job:
         positions, rotations = self._frames(ta, tb)
         tol_p, tol_o = self._tolerance(ta, tb)
         path = [np.asarray(q, float)]
+        mode = _orientation_mode(ta, tb)
         for k in range(1, len(positions)):
-            x, R = positions[k], rotations[k] if tol_o < math.inf else None
-            solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper, R)
+            x, goal = positions[k], rotations[k]
+            solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper,
+                                goal if mode == "rpy" else None, goal if mode == "axis" else None)
             qn, _ = solver.run(path[-1], x)
             pe, oe = solver.errors(qn, x)
             at = f"{k / (len(positions) - 1):.0%} of the way"
@@ -311,31 +317,90 @@ class _Job:
 
     def _check_timed(self, number: int, ta, tb, qs) -> None:
         """The spline through the waypoints stays within the tolerances of the segment (position,
-        and orientation against the slerp at the same fraction of the way), the joint limits, and
+        and orientation against the goal at the same fraction of the way: the slerp, or the turned
+        approach axis), the joint limits, and
         free of collisions, at every sample."""
-        import pinocchio as pin
 
-        from ..kinematics import rpy_matrix
         from .ik import PositionIK
 
         ch = self.checker
         solver = PositionIK(ch.model, ch.data, ch.tool_frame, ch.lower, ch.upper)
         pa, pb = np.asarray(ta.xyz, float), np.asarray(tb.xyz, float)
         tol_p, tol_o = self._tolerance(ta, tb)
-        Ra = np.asarray(rpy_matrix(ta.rpy), float) if tol_o < math.inf else None
-        w = np.asarray(pin.log3(Ra.T @ np.asarray(rpy_matrix(tb.rpy), float))) if Ra is not None else None
+        mode = _orientation_mode(ta, tb)
         for q in qs:
             M = solver.placement(q)
             p = np.array(M.translation)
             off = distance_to_segment(p, pa, pb) > tol_p
-            if Ra is not None and w is not None and not off:
+            if mode is not None and not off:
                 d = pb - pa
                 x = float(np.clip(np.dot(p - pa, d) / max(float(np.dot(d, d)), 1e-18), 0.0, 1.0))
-                R = Ra @ np.asarray(pin.exp3(x * w))
-                off = float(np.linalg.norm(pin.log3(R.T @ np.array(M.rotation)))) > tol_o
+                off = _orientation_error(_goal_at(ta, tb, mode, x), np.array(M.rotation), mode) > tol_o
             if off or np.any(q < ch.lower - 1e-9) or np.any(q > ch.upper + 1e-9) or ch.contacts(q, 0.0):
                 raise self.fail(number, ta.name, tb.name, "the timed motion leaves the segment's tolerances, a joint "
                                 "limit or the free space between the waypoints", "move the segment away from obstacles")
+
+
+def _axis_of(t) -> np.ndarray | None:
+    """The direction a target asks tool0's x axis to point in: its `pointing`, or its rpy's x axis."""
+    if t.pointing is not None:
+        d = np.asarray(t.pointing, float)
+        return d / np.linalg.norm(d)
+    if t.rpy is not None:
+        from ..kinematics import rpy_matrix
+
+        return np.asarray(rpy_matrix(t.rpy), float)[:, 0]
+    return None
+
+
+def _orientation_mode(ta, tb) -> str | None:
+    """What a straight path holds of tool0's orientation: the whole frame when both ends give rpy,
+    the approach axis when both ask for one at least (pointing), nothing when an end asks none."""
+    if ta.rpy is not None and tb.rpy is not None:
+        return "rpy"
+    if _axis_of(ta) is not None and _axis_of(tb) is not None:
+        return "axis"
+    return None
+
+
+def _angle(u, v) -> float:
+    return float(np.arctan2(np.linalg.norm(np.cross(u, v)), float(np.dot(u, v))))
+
+
+def _goal_at(ta, tb, mode: str | None, x: float) -> np.ndarray | None:
+    """The orientation goal a fraction x of the way from a to b: the slerped rotation (rpy), or
+    the approach axis turned along the great circle from a's to b's (axis)."""
+    if mode == "rpy":
+        import pinocchio as pin
+
+        from ..kinematics import rpy_matrix
+
+        Ra, Rb = np.asarray(rpy_matrix(ta.rpy), float), np.asarray(rpy_matrix(tb.rpy), float)
+        return Ra @ np.asarray(pin.exp3(x * np.asarray(pin.log3(Ra.T @ Rb))))
+    if mode == "axis":
+        u, v = _axis_of(ta), _axis_of(tb)
+        assert u is not None and v is not None
+        theta = _angle(u, v)
+        if theta < 1e-9:
+            return u
+        w = np.cross(u, v)
+        if np.linalg.norm(w) < 1e-12:  # opposite directions: turn about any axis across them
+            w = np.cross(u, (1.0, 0.0, 0.0) if abs(u[0]) < 0.9 else (0.0, 1.0, 0.0))
+        w = w / np.linalg.norm(w)
+        t = x * theta  # Rodrigues: u turned by t about w (w is perpendicular to u)
+        return u * math.cos(t) + np.cross(w, u) * math.sin(t)
+    return None
+
+
+def _orientation_error(goal, R: np.ndarray, mode: str | None) -> float:
+    """rad between tool0's orientation R and the goal (a rotation, or an axis for tool0's x)."""
+    if mode == "rpy":
+        from ..kinematics import rotation_error
+
+        return float(np.linalg.norm(rotation_error(goal, R)))
+    if mode == "axis":
+        return _angle(R[:, 0], goal)
+    return 0.0
 
 
 def distance_to_segment(p, a, b) -> float:
