@@ -384,6 +384,28 @@ ORIENTED = ("    target a at (0.30, 0, 0.25) m rpy (109.0, 34.6, 62.9) deg withi
             "    path turn from a to b straight\n")
 
 
+def _turn(tmp_path, targets: str):
+    """Plan path 'turn' of the example with these targets added: (file, its text, targets a and
+    b, tool0's placement at every sample of the timed straight segment)."""
+    import pinocchio as pin
+
+    from modc.plan.collision import CollisionChecker
+    from modc.plan.task import plan_task
+
+    text = EXAMPLE.read_text(encoding="utf-8").replace("    path seam", targets + "    path seam")
+    cell = tmp_path / "cell.mod"
+    cell.write_text(text, encoding="utf-8")
+    result = plan_task(cell, "turn")
+    robot = check_file(cell).design.robots[0]
+    checker = CollisionChecker(robot)
+    t, q = _samples(result)
+    placements = []
+    for row in q[t >= result.segments[-1].t0 - 1e-9]:
+        pin.forwardKinematics(checker.model, checker.data, row)
+        placements.append(pin.updateFramePlacement(checker.model, checker.data, checker.tool_frame).copy())
+    return cell, text, robot.task_target("a"), robot.task_target("b"), placements
+
+
 @pytest.mark.slow
 def test_oriented_straight_path_follows_the_slerp(tmp_path, capsys):
     """tool0's orientation is interpolated along the segment (slerp), within the targets'
@@ -391,24 +413,11 @@ def test_oriented_straight_path_follows_the_slerp(tmp_path, capsys):
     import pinocchio as pin
 
     from modc.kinematics import rpy_matrix
-    from modc.plan.collision import CollisionChecker
-    from modc.plan.task import plan_task
 
-    text = EXAMPLE.read_text(encoding="utf-8").replace("    path seam", ORIENTED + "    path seam")
-    cell = tmp_path / "cell.mod"
-    cell.write_text(text, encoding="utf-8")
-    result = plan_task(cell, "turn")
-    robot = check_file(cell).design.robots[0]
-    checker = CollisionChecker(robot)
-    a, b = robot.task_target("a"), robot.task_target("b")
+    cell, text, a, b, placements = _turn(tmp_path, ORIENTED)
     Ra, Rb = np.array(rpy_matrix(a.rpy)), np.array(rpy_matrix(b.rpy))
-    seg = result.segments[-1]
-    t, q = _samples(result)
-    on = t >= seg.t0 - 1e-9
     pa, pb = np.array(a.xyz), np.array(b.xyz)
-    for row in q[on]:
-        pin.forwardKinematics(checker.model, checker.data, row)
-        M = pin.updateFramePlacement(checker.model, checker.data, checker.tool_frame)
+    for M in placements:
         x = float(np.clip(np.dot(M.translation - pa, pb - pa) / np.dot(pb - pa, pb - pa), 0, 1))
         R = Ra @ pin.exp3(x * pin.log3(Ra.T @ Rb))
         assert np.linalg.norm(pin.log3(R.T @ M.rotation)) <= math.radians(2) + 1e-9
@@ -433,26 +442,11 @@ def test_pointing_straight_path_turns_the_approach_axis(tmp_path, capsys):
     """With `pointing` ends, tool0's x axis follows the great circle between the two directions
     (within the targets' tolerance at every sample of the timed motion); a direction the arm
     cannot hold along the segment is refused, not ignored."""
-    import pinocchio as pin
-
-    from modc.plan.collision import CollisionChecker
-    from modc.plan.task import plan_task
-
-    text = EXAMPLE.read_text(encoding="utf-8").replace("    path seam", POINTING + "    path seam")
-    cell = tmp_path / "cell.mod"
-    cell.write_text(text, encoding="utf-8")
-    result = plan_task(cell, "turn")
-    robot = check_file(cell).design.robots[0]
-    checker = CollisionChecker(robot)
-    a, b = robot.task_target("a"), robot.task_target("b")
+    cell, text, a, b, placements = _turn(tmp_path, POINTING)
     da, db = np.array(a.pointing) / np.linalg.norm(a.pointing), np.array(b.pointing) / np.linalg.norm(b.pointing)
     theta = math.acos(float(np.clip(da @ db, -1, 1)))
-    seg = result.segments[-1]
-    t, q = _samples(result)
     pa, pb = np.array(a.xyz), np.array(b.xyz)
-    for row in q[t >= seg.t0 - 1e-9]:
-        pin.forwardKinematics(checker.model, checker.data, row)
-        M = pin.updateFramePlacement(checker.model, checker.data, checker.tool_frame)
+    for M in placements:
         x = float(np.clip(np.dot(M.translation - pa, pb - pa) / np.dot(pb - pa, pb - pa), 0, 1))
         d = (math.sin((1 - x) * theta) * da + math.sin(x * theta) * db) / math.sin(theta)  # the great circle
         axis = np.array(M.rotation)[:, 0]
