@@ -82,6 +82,44 @@ def test_a_design_whose_task_cannot_be_planned_is_rejected(monkeypatch):
 
 
 @pytest.mark.slow
+def test_when_every_first_candidate_fails_its_task_the_search_goes_on(monkeypatch):
+    """The static search stops once `top` designs rank first and returns a few candidates to plan;
+    when every one of them fails its task, modc design searches on (asking for more designs)
+    instead of answering "no design", and plans each arm once."""
+    from modc.design import run
+    from modc.plan import task
+    from modc.plan.errors import PlanError
+
+    cell = problem(TASKED.replace("    modules H1, L3\n", "    modules H1, L3, L4\n"))
+    real_search, real_plan = run._search, task.plan_task_robot
+    asked: list[int | None] = []
+
+    def search(*a, **kw):  # the first round stops early with three candidates, as a larger cell's would
+        asked.append(kw.get("enough"))
+        out = real_search(*a, **kw)
+        if len(asked) == 1:
+            out.designs = out.designs[:3]
+        return out
+
+    planned: list[tuple] = []
+
+    def plan(robot, name, **kw):  # the first round's arms cannot do their task
+        arm = tuple((u.name, round(u.pivot, 6), round(u.port, 6), u.link) for u in robot.units)
+        planned.append(arm)
+        if len(set(planned)) <= 3:
+            raise PlanError([], {})
+        return real_plan(robot, name, **kw)
+
+    monkeypatch.setattr(run, "_search", search)
+    monkeypatch.setattr(task, "plan_task_robot", plan)
+    o = run.design(cell, top=1, seed=0)
+    assert asked[0] == 1 and len(asked) == 2 and asked[1] > 1  # searched on, for more designs
+    assert len(o.designs) == 1 and len(set(planned)) > 3  # arms beyond the first round planned
+    assert len(planned) == len(set(planned))  # none planned twice
+    assert sum("cannot be planned" in r for r in o.rejections) == 3
+
+
+@pytest.mark.slow
 def test_modc_design_writes_the_timed_task(tmp_path):
     from modc import trajectory
 

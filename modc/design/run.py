@@ -197,6 +197,9 @@ def _tiers(problem: ResolvedProblem, spec: Spec, hi: int, closest: dict[str, flo
     return tiers
 
 
+MAX_CANDIDATES = 96  # static designs a task cell plans at most, when the first ones all fail planning
+
+
 def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
            executor: Executor | None = None, progress: Callable[..., None] | None = None,
            deadline: float | None = None) -> Outcome:
@@ -217,26 +220,38 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
                                        or ("modules", "mass")}) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
 
+    enough = [top]  # designs after which a round may stop (more when the first candidates all fail planning)
+
     def one(p: ResolvedProblem, units: int | None, k: int, ceiling: Ceiling | None = None,
             diagnosing: bool = True) -> Outcome:
         # the extra candidates to time come from the shapes searched until `top` designs are found
         # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
         # settings, 369 s on a 4-goal visit cell)
-        return _search(p, units, k, seed, executor, progress, deadline, enough=top, ceiling=ceiling,
+        return _search(p, units, k, seed, executor, progress, deadline, enough=enough[0], ceiling=ceiling,
                        diagnosing=diagnosing)
 
-    if problem.base_grid is None:
-        out = one(screen, max_units, n)
-    else:
-        lib = problem.cell.library
-        hi = min(max_units or problem.max_units, lib.rules.max_dof)
-        # designs of equal modules and mass may still differ on a later objective (margin, a task's)
-        ties = any(o not in ("modules", "mass") for o in problem.rank)
-        out = placement.search(screen, max_units, n, longest_reach(problem, hi), one, ties)
-    out.problem = problem
-    tasks.restore(out, points)
-    if tasked:
-        tasks.plan_all(out, top, seed, deadline, _stopping)
+    rejected: dict[str, str] = {}  # chain -> why its tasks could not be planned (planned once only)
+    while True:
+        if problem.base_grid is None:
+            out = one(screen, max_units, n)
+        else:
+            lib = problem.cell.library
+            hi = min(max_units or problem.max_units, lib.rules.max_dof)
+            # designs of equal modules and mass may still differ on a later objective (margin, a task's)
+            ties = any(o not in ("modules", "mass") for o in problem.rank)
+            out = placement.search(screen, max_units, n, longest_reach(problem, hi), one, ties)
+        out.problem = problem
+        tasks.restore(out, points)
+        if not tasked:
+            break
+        found = len(out.designs)
+        tasks.plan_all(out, top, seed, deadline, _stopping, rejected)
+        # every candidate failed its tasks: search on for more of them while there may be more (the
+        # search stopped once `enough` designs ranked first, or it returned as many as asked)
+        exhausted = found < n and enough[0] >= n
+        if out.designs or out.stopped or exhausted or n >= MAX_CANDIDATES:
+            break
+        n = enough[0] = min(n * 4, MAX_CANDIDATES)
     out.reference = reference.evaluate(problem, seed)
     out.seconds = time.perf_counter() - t0
     return out

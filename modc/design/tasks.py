@@ -101,17 +101,24 @@ def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = F
     return replace(d, plans=tuple(plans))
 
 
-def plan_all(out, top: int, seed: int, deadline: float | None, stopping) -> None:
+def plan_all(out, top: int, seed: int, deadline: float | None, stopping,
+             rejected: dict[str, str] | None = None) -> None:
     """Plan every design of the outcome, drop those that fail, rank by the problem's objectives
-    (the task objectives now known) and keep `top`."""
+    (the task objectives now known) and keep `top`. rejected: chain -> why, for chains already
+    planned in vain (not planned again; filled here)."""
+    rejected = {} if rejected is None else rejected
     kept = []
     for d in out.designs:
         why = stopping(deadline)
         if why:
             out.stopped = out.stopped or why
             break
+        if d.chain() in rejected:  # planned in vain in an earlier round: the same reason again
+            out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {rejected[d.chain()]}")
+            continue
         p = plan_design(d, seed, deadline, "coverage" in out.problem.rank)
         if isinstance(p, str):
+            rejected[d.chain()] = p
             out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {p}")
             continue
         kept.append(p)
