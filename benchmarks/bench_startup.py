@@ -8,7 +8,7 @@ checkout (say, the commit before a start-up change): interleaved, on one core.
 Commands, each round in turn: the anchor `python -c pass`; `modc --version` and `modc --help`
 (the command line alone); `modc lint examples/farm.mod` (what a pre-commit hook or CI check pays),
 with modc's cache warm and empty (a fresh install, a CI runner without a cache: the validated
-library is made again; the grammar's tables ship with modc);
+library is made again; the parse's tables are exported from Lark once more);
 `modc examples/farm.mod -o OUT` first (an empty modc cache: grammar tables, library, meshes,
 collision matrix and worst-case torques all computed) and cached (the same compile again);
 and the peers: `yamllint` on the farm's YAML form (benchmarks/data/farm.yaml, about the .mod
