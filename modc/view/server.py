@@ -43,6 +43,16 @@ def torque_table(arm: Arm, q) -> str:
             '<th align="left">τnom / τmax</th><th></th></tr>' + "".join(rows) + "</table>")
 
 
+REAIM = (0.5, 2.0)  # s after a framing is sent: sent again (see View._camera)
+
+
+def _aim(client, cam: Camera) -> None:
+    with client.atomic():
+        client.camera.fov = cam.fov
+        client.camera.look_at = tuple(cam.look_at)
+        client.camera.position = tuple(cam.position)
+
+
 class View:
     def __init__(self, server, page: Page):
         self.server = server
@@ -163,12 +173,26 @@ class View:
         initial.fov, initial.look_at, initial.position = cam.fov, tuple(cam.look_at), tuple(cam.position)
         if everyone or self._framed != self.page.index:
             self._framed = self.page.index
-            for client in self.server.get_clients().values():
-                with client.atomic():
-                    client.camera.fov = cam.fov
-                    client.camera.look_at = tuple(cam.look_at)
-                    client.camera.position = tuple(cam.position)
+            clients = list(self.server.get_clients().values())
+            for client in clients:
+                _aim(client, cam)
+            # a browser still starting up may apply its own camera after ours (seen: a page opened
+            # on a broken file, fixed later, kept viser's default view): aim once more, a moment
+            # later, unless the arm on view changed meanwhile
+            index = self.page.index
+            for delay in REAIM:
+                timer = threading.Timer(delay, self._reaim, (clients, cam, index))
+                timer.daemon = True
+                timer.start()
         return cam
+
+    def _reaim(self, clients, cam: Camera, index: int) -> None:
+        with self.lock:
+            if self.camera is cam and self.page.index == index:
+                for client in clients:
+                    with contextlib.suppress(Exception):  # a browser gone meanwhile
+                        _aim(client, cam)
+                self.server.flush()
 
     def _show_diagnostics(self) -> None:
         text = self.page.source.diagnostics
