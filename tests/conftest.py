@@ -17,6 +17,19 @@ ARM_EXAMPLES = [
 ]
 
 
+def modc_design(tmp_path: Path, text: str, *args: str, timeout: float = 900) -> subprocess.CompletedProcess:
+    """`modc design` run as a user runs it, on `text` written to tmp_path/cell.mod, into
+    tmp_path/out (quiet, no pictures), with a private cache."""
+    import os
+    import sys
+
+    src = tmp_path / "cell.mod"
+    src.write_text(text, encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
+    return subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
+                           "--no-render", *args], capture_output=True, text=True, env=env, timeout=timeout)
+
+
 def checked_ok(text: str, path: str = "t.mod") -> Checked:
     c = check_text(text, path)
     errors = [d for d in c.diagnostics if d.is_error]

@@ -4,12 +4,11 @@ statement not searched yet (`base within … yaw` with a region) refused with a 
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from conftest import modc_design
 
 from modc.compiler import check_file, check_text
 
@@ -36,11 +35,7 @@ def problem(text: str = TASKED):
 
 
 def _design(tmp_path, text: str, *args: str) -> subprocess.CompletedProcess:
-    src = tmp_path / "cell.mod"
-    src.write_text(text, encoding="utf-8")
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
-    return subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
-                           "--no-render", *args], capture_output=True, text=True, env=env, timeout=900)
+    return modc_design(tmp_path, text, *args)
 
 
 @pytest.mark.slow

@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import modc_design
 
 from modc.compiler import check_file, check_text
 
@@ -156,11 +154,7 @@ def test_only_a_shifted_base_reaches_and_its_file_places_the_same_cell(tmp_path)
     fixed = problem(SHIFTED.replace("    base within box size (0.4, 0, 0) m at (0, 0, 0) m step 100 mm\n", ""))
     assert not run.design(fixed, top=1).designs  # at the origin no arm of the bounds reaches a
 
-    src = tmp_path / "cell.mod"
-    src.write_text(SHIFTED, encoding="utf-8")
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
-    r = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
-                        "--no-render", "--top", "2"], capture_output=True, text=True, env=env, timeout=900)
+    r = modc_design(tmp_path, SHIFTED, "--top", "2")
     assert r.returncode == 0, r.stderr
     ranking = json.loads((tmp_path / "out" / "ranking.json").read_text())
     bases = ranking["bases"]["shifted"]

@@ -3,13 +3,11 @@ only part of a region; without it every point of every region is required."""
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import modc_design
 
 from modc.compiler import check_file, check_text
 
@@ -67,11 +65,7 @@ def test_rank_coverage_ranks_a_design_that_serves_part_of_the_region(tmp_path):
     from modc.kinematics import Chain
     from modc.plan.collision import CollisionChecker
 
-    src = tmp_path / "cell.mod"
-    src.write_text(PARTLY, encoding="utf-8")
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONWARNINGS="ignore")
-    r = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"), "-q",
-                        "--no-render", "--top", "2"], capture_output=True, text=True, env=env, timeout=900)
+    r = modc_design(tmp_path, PARTLY, "--top", "2")
     assert r.returncode == 0, r.stderr
     ranking = json.loads((tmp_path / "out" / "ranking.json").read_text())
     shares = [d["coverage"] for d in ranking["designs"]]
