@@ -161,3 +161,35 @@ def test_statements_not_searched_yet_are_refused(tmp_path, statement, what):
     line = text.splitlines().index(f"    {statement.splitlines()[-1].strip()}") + 1
     assert f"cell.mod:{line}:" in r.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_reference_arm_that_passes_is_planned_timed_and_written(tmp_path):
+    """`compare with chain …` on a cell with a task: the reference is planned and timed by the
+    designs' own code, and written beside them so that `modc view` and `modc plan` can show it."""
+    from modc import trajectory
+    from modc.view.ranking import Ranking
+
+    text = TASKED.replace("    rank modules, cycle_time\n", "    rank modules, cycle_time\n"
+                          "    compare with chain H1 - H1(pivot=-45deg) - L3(pivot=-15deg)\n")
+    r = _design(tmp_path, text, "--top", "1")
+    assert r.returncode == 0, r.stderr
+    out = tmp_path / "out"
+    ranking = json.loads((out / "ranking.json").read_text())
+    ref = ranking["reference"]["small"]
+    assert ref["feasible"] and ref["fails"] == []
+    assert ref["file"] == "small_reference.mod" and ref["traj"] == "small_reference.traj.json"
+    assert ref["cycle_time_s"] > 0 and ref["cycle_time_s"] == pytest.approx(
+        sum(s["duration_s"] for s in ref["tasks"][0]["segments"] if s["kind"] != "approach"), abs=1e-5)
+    checked = check_file(out / ref["file"])
+    assert checked.ok
+    robot = checked.design.robots[0]
+    assert [u.name for u in robot.units] == ["H1", "H1", "L3"] and [t.name for t in robot.tasks] == ["serve"]
+    traj, errors = trajectory.load(out / ref["traj"])
+    assert traj is not None and not errors and trajectory.validate_for(traj, robot) == []
+    html = (out / "report.html").read_text()
+    row = html[html.index('<td>reference</td>'):]
+    assert f"{ref['cycle_time_s']:.3f} s" in row[:row.index("</tr>")]
+    assert "by cycle time" in html  # rank 1 against the reference, told on the ranked objectives
+    view = Ranking(out / "ranking.json")  # the viewer lists it after the designs
+    assert view.designs[-1]["rank"] is None and view.file(len(view.designs) - 1) == out / "small_reference.mod"
+    assert "reference" in view.choice(len(view.designs) - 1)

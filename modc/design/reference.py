@@ -3,7 +3,9 @@ with the ranking's own code, so that it can stand beside the designs found. Per 
 screen's IK and obstacle test (evaluate.screen_batch, the target alone: one it misses does not
 hide the others); when every target is reached, the exact check every ranked design passed
 (evaluate.verify). A reference that fails says what it fails; its mass and torque margin come
-from the same compiler check (the torque analysis, over-peak reported rather than refused)."""
+from the same compiler check (the torque analysis, over-peak reported rather than refused).
+A reference that passes them on a cell with tasks is planned and timed like every design
+(tasks.plan_design): its cycle time and energy stand beside theirs, or it fails the task."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
@@ -27,6 +29,17 @@ class Reference:
     targets: dict[str, dict]  # name -> reached, position_error_m (closest found), error_share (of the tolerance)
     fails: tuple[str, ...]  # what keeps it from being a design; () when it passes every check
     verified: Verified | None = None
+    candidate: Candidate | None = None
+    plans: tuple = ()  # modc.plan.task.TaskPlan per task and path of the cell, once planned
+    coverage: float = 1.0  # share of the region points reached (`rank coverage`)
+
+    @property
+    def cycle_time(self) -> float:
+        return sum(p.cycle_time for p in self.plans)
+
+    @property
+    def energy(self) -> float:
+        return sum(p.energy for p in self.plans)
 
     @property
     def feasible(self) -> bool:
@@ -36,12 +49,33 @@ class Reference:
         shares = [t["error_share"] for t in self.targets.values() if t["error_share"] is not None]
         return max(shares, default=None)
 
-    def to_json(self) -> dict:
-        return {"chain": self.chain, "modules": self.modules, "feasible": self.feasible,
-                "mass_kg": None if self.mass is None else round(self.mass, 6),
-                "torque_margin": None if self.margin is None else round(self.margin, 6),
-                "worst_error_share": None if self.worst_share() is None else round(self.worst_share() or 0.0, 6),
-                "targets": self.targets, "fails": list(self.fails)}
+    def to_json(self, name: str | None = None) -> dict:
+        """ranking.json's "reference" entry; name: the design block's, when its files were written
+        (DIR/<name>_reference.mod, and .traj.json once planned)."""
+        out = {"chain": self.chain, "modules": self.modules, "feasible": self.feasible,
+               "mass_kg": None if self.mass is None else round(self.mass, 6),
+               "torque_margin": None if self.margin is None else round(self.margin, 6),
+               "worst_error_share": None if self.worst_share() is None else round(self.worst_share() or 0.0, 6),
+               "targets": self.targets, "fails": list(self.fails)}
+        if name is not None and self.mass is not None:
+            out["file"] = file_name(name)
+        if self.plans:
+            out |= {"cycle_time_s": round(self.cycle_time, 6), "energy_j": round(self.energy, 6),
+                    "peak_torque_share": round(max(p.peak_share for p in self.plans), 6),
+                    "coverage": round(self.coverage, 6),
+                    "tasks": [{"task": p.task, "kind": p.kind, "cycle_time_s": round(p.cycle_time, 6),
+                               "energy_j": round(p.energy, 6), "peak_torque_share": round(p.peak_share, 6),
+                               "segments": [s.to_json() for s in p.segments]} for p in self.plans],
+                    **({"traj": traj_name(name), "traj_task": self.plans[0].task} if name is not None else {})}
+        return out
+
+
+def file_name(problem: str) -> str:
+    return f"{problem}_reference.mod"
+
+
+def traj_name(problem: str) -> str:
+    return f"{problem}_reference.traj.json"
 
 
 def chain_text(robot: Robot) -> str:
@@ -67,21 +101,49 @@ def _static(problem: ResolvedProblem, ref: Robot) -> tuple[float | None, float |
     return library_mass(robot) - payload, float(margin), None
 
 
-def evaluate(problem: ResolvedProblem, seed: int = 0) -> Reference | None:
+def evaluate(problem: ResolvedProblem, seed: int = 0, deadline: float | None = None) -> Reference | None:
     """The block's reference arm on its cell, or None when it names none. Every region point is
-    a target of it, as of the designs (unless `rank coverage`)."""
-    from .tasks import with_points
+    a target of it, as of the designs (unless `rank coverage`). One that passes the static
+    checks on a cell with tasks is planned and timed (deadline: time.time() to give up by)."""
+    from .tasks import has_tasks, with_points
 
-    problem, names = with_points(problem)
-    out = _evaluate(problem, seed)
-    if out is None or not names:
+    screened, names = with_points(problem)
+    out = _evaluate(screened, seed)
+    if out is None:
         return out
+    if names:
+        out = _told(out, names)
+    if out.verified is None or out.candidate is None or not (has_tasks(problem) or "coverage" in problem.rank):
+        return out
+    return _planned(out, seed, deadline, "coverage" in problem.rank)
+
+
+def _told(out: Reference, names: dict[str, str]) -> Reference:
+    """The reference told in the cell's names (region points as `tray[1,0,0]`), its robot without
+    the points as targets (its regions hold them), as tasks.restore tells the designs."""
+    from .tasks import told
+
     fails = []
     for f in out.fails:
         for internal, shown in names.items():
             f = f.replace(f"'{internal}'", f"'{shown}'")
         fails.append(f)
-    return replace(out, targets={names.get(k, k): v for k, v in out.targets.items()}, fails=tuple(fails))
+    verified = None if out.verified is None else told(out.verified, names)
+    return replace(out, targets={names.get(k, k): v for k, v in out.targets.items()}, fails=tuple(fails),
+                   verified=verified)
+
+
+def _planned(out: Reference, seed: int, deadline: float | None, coverage: bool) -> Reference:
+    """The reference with its tasks planned and timed by the designs' own code, or failing the
+    task it cannot serve."""
+    from .rank import Design
+    from .tasks import plan_design
+
+    assert out.verified is not None and out.candidate is not None
+    d = plan_design(Design(out.candidate, out.verified), seed, deadline, coverage)
+    if isinstance(d, str):
+        return replace(out, fails=(*out.fails, d))
+    return replace(out, plans=d.plans, coverage=d.coverage, verified=d.verified)
 
 
 def _evaluate(problem: ResolvedProblem, seed: int) -> Reference | None:
@@ -128,6 +190,6 @@ def _evaluate(problem: ResolvedProblem, seed: int) -> Reference | None:
                 got = v.targets[target.name]
                 targets[target.name] = {"reached": True, **got, "error_share": round(target_share(got, target), 6)}
     if verified is not None:
-        return Reference(text, len(units), verified.mass, verified.margin, targets, (), verified)
+        return Reference(text, len(units), verified.mass, verified.margin, targets, (), verified, cand)
     mass, margin, why = _static(problem, ref)
     return Reference(text, len(units), mass, margin, targets, tuple(fails + ([why] if why else [])))

@@ -102,7 +102,7 @@ def _table(o: Outcome) -> str:
         worst = max((t["position_error_m"] for t in d.verified.targets.values()), default=0.0)
         rows.append(f"<tr><td>{rank}</td><td><code>{escape(d.chain())}</code></td>"
                     + "".join(f"<td>{_cell(k, d)}</td>" for k in cols)
-                    + f"<td>{_share(worst_share(d.verified.targets, cell), worst)}</td><td>{escape(said)}</td>"
+                    + f"<td>{escape(_share(worst_share(d.verified.targets, cell), worst))}</td><td>{escape(said)}</td>"
                     f"<td>{'<br>'.join(f'<code>{escape(x.chain())}</code> ({x.mass:.3f} kg)' for x in d.alternatives)}"
                     "</td></tr>")
     if o.reference is not None:
@@ -125,13 +125,16 @@ def _reference_row(o: Outcome, cols: list[str]) -> str:
             cells.append(f"{r.mass:.3f} kg")
         elif k == "margin" and r.margin is not None:
             cells.append(f"{r.margin * 100:.1f} %")
-        else:  # task figures: the reference is not planned
+        elif k in TASK and r.plans:
+            cells.append(_cell(k, r))
+        else:  # task figures of a reference that could not be planned
             cells.append("—")
     errors = [t["position_error_m"] for t in r.targets.values() if t["position_error_m"] is not None]
     verdict = "passes every check" if r.feasible else "fails: " + "; ".join(r.fails)
     return (f'<tr style="color:{REF}"><td>reference</td><td><code>{escape(r.chain)}</code></td>'
             + "".join(f"<td>{c}</td>" for c in cells)
-            + f"<td>{_share(r.worst_share(), max(errors, default=None))}</td><td>{escape(verdict)}</td><td></td></tr>")
+            + f"<td>{escape(_share(r.worst_share(), max(errors, default=None)))}</td>"
+            f"<td>{escape(verdict)}</td><td></td></tr>")
 
 
 def _reference_text(o: Outcome) -> str:
@@ -143,7 +146,7 @@ def _reference_text(o: Outcome) -> str:
     if not r.feasible:
         return head + escape(f"evaluated on this cell with the ranking's checks, fails: {'; '.join(r.fails)}.") + "</p>"
     best = o.designs[0]
-    ties, decided, (a, b) = versus(static(o.problem.rank), best, r)
+    ties, decided, (a, b) = versus(o.problem.rank if r.plans else static(o.problem.rank), best, r)
     if decided is None:
         said = "it ties rank 1 on every objective"
     else:

@@ -252,7 +252,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         if out.designs or out.stopped or exhausted or n >= MAX_CANDIDATES:
             break
         n = enough[0] = min(n * 4, MAX_CANDIDATES)
-    out.reference = reference.evaluate(problem, seed)
+    out.reference = reference.evaluate(problem, seed, deadline)
     out.seconds = time.perf_counter() - t0
     return out
 

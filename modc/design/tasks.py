@@ -57,21 +57,22 @@ def restore(out, names: dict[str, str]) -> None:
     """The outcome of a search on with_points' problem, told in the cell's names: each design's
     robot without the region points as targets (its regions hold them), its figures under the
     points' names."""
-    from .evaluate import pose_name
-
     if not names:
         return
-    drop = set(names) | {pose_name(n) for n in names}
-    designs = []
-    for d in out.designs:
-        v = d.verified
-        robot = v.robot.model_copy(update={"targets": tuple(t for t in v.robot.targets if t.name not in drop),
-                                           "poses": tuple(p for p in v.robot.poses if p.name not in drop)})
-        targets = {names.get(k, k): x for k, x in v.targets.items()}
-        designs.append(replace(d, verified=replace(v, robot=robot, targets=targets)))
-    out.designs = designs
+    out.designs = [replace(d, verified=told(d.verified, names)) for d in out.designs]
     out.closest = {names.get(k, k): x for k, x in out.closest.items()}
     out.targets = {names.get(k, k): x for k, x in out.targets.items()}
+
+
+def told(v, names: dict[str, str]):
+    """A verified design (evaluate.Verified) of with_points' problem in the cell's names: its robot
+    without the region points as targets and poses, its figures under the points' names."""
+    from .evaluate import pose_name
+
+    drop = set(names) | {pose_name(n) for n in names}
+    robot = v.robot.model_copy(update={"targets": tuple(t for t in v.robot.targets if t.name not in drop),
+                                       "poses": tuple(p for p in v.robot.poses if p.name not in drop)})
+    return replace(v, robot=robot, targets={names.get(k, k): x for k, x in v.targets.items()})
 
 
 def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = False) -> Design | str:

@@ -60,6 +60,25 @@ def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
     return robot_file_text(robot, comments)
 
 
+def reference_file(o: Outcome) -> str | None:
+    """DIR/<name>_reference.mod: the block's `compare with` arm in its cell, with a pose per target
+    when it reaches them all (so that `modc view` and `modc plan` show what it does); None when
+    its chain does not compile."""
+    from ..model.write import robot_file_text
+    from .reference import file_name as ref_name
+
+    r = o.reference
+    if r is None or r.mass is None or (r.verified is None and o.problem.reference is None):
+        return None
+    robot = r.verified.robot if r.verified is not None else o.problem.reference
+    assert robot is not None
+    robot = robot.model_copy(update={"name": ref_name(o.problem.name)[:-len(".mod")]})
+    verdict = "it passes every check the designs passed" if r.feasible else "it fails: " + "; ".join(r.fails)
+    comments = [f"The reference arm of `modc design` for '{o.problem.name}' (`compare with chain {r.chain}`): "
+                f"{r.modules} modules, {r.mass:.3f} kg; {verdict}."]
+    return robot_file_text(robot, comments)
+
+
 def ranking(outcomes: list[Outcome]) -> dict:
     designs = []
     for o in outcomes:
@@ -91,8 +110,8 @@ def ranking(outcomes: list[Outcome]) -> dict:
             "unfinished_shapes": [s for o in outcomes for s in shapes(o, o.unfinished)],
             "coarse_shapes": [s for o in outcomes for s in shapes(o, o.coarse)],
             # `compare with chain …`: per design block naming one, its arm evaluated on the cell
-            **({"reference": refs} if (refs := {o.problem.name: o.reference.to_json() for o in outcomes
-                                                if o.reference is not None}) else {})}
+            **({"reference": refs} if (refs := {o.problem.name: o.reference.to_json(o.problem.name)
+                                                for o in outcomes if o.reference is not None}) else {})}
 
 
 def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> dict[str, str | bytes]:
@@ -106,6 +125,13 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
             out[file_name(o.problem.name, rank)] = robot_file(o, rank, d)
             if d.plans:  # the whole of the first task (ranking.json's traj_task)
                 out[traj_name(o.problem.name, rank)] = d.plans[0].dumps()
+        ref = reference_file(o)
+        if ref is not None:
+            from . import reference
+
+            out[reference.file_name(o.problem.name)] = ref
+            if o.reference.plans:
+                out[reference.traj_name(o.problem.name)] = o.reference.plans[0].dumps()
     out["report.html"] = report_html(outcomes, renders or {})
     # what wrote this directory (write_tree's manifest is what lets a later run replace it)
     marker = {"generator": f"modc {__version__}", "command": "design",

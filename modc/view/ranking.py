@@ -4,7 +4,8 @@ design block has tasks, are the files ranking.json names, beside it: a name that
 (an absolute path, `..`, a symbolic link pointing elsewhere) refuses the whole ranking, so a
 ranking.json handed over from elsewhere cannot make the page read other files.
 
-A design with a trajectory plays it (the segment on view named from the trajectory's
+The block's reference arm (`compare with chain …`, ranking.json's "reference"), when its file was
+written, comes after the designs. A design with a trajectory plays it (the segment on view named from the trajectory's
 "segments"); a design without one starts at its first target's pose (ranking.json's "q").
 
     page = RankingPage(Ranking("out/ranking.json"))
@@ -83,10 +84,17 @@ class Ranking:
                 raise ViewError(f'{self.path}: designs[{k}].traj: expected the name of a trajectory file')
         order = sorted(range(len(designs)), key=lambda k: designs[k]["rank"])
         self.designs = [designs[k] for k in order]
+        where = [f"designs[{k}]" for k in order]
+        # the design blocks' reference arms (`compare with chain …`) that were written, after the designs
+        refs = doc.get("reference")
+        for name, r in sorted(refs.items()) if isinstance(refs, dict) else []:
+            if isinstance(r, dict) and isinstance(r.get("file"), str) and isinstance(r.get("traj", ""), str):
+                self.designs.append({**r, "rank": None})
+                where.append(f"reference.{names.shown(name, 60)}")
         # checked here, for every design: the page opens none of them if one leads out
-        self._files = [self._inside(d["file"], f"designs[{k}].file") for k, d in zip(order, self.designs, strict=True)]
-        self._trajs = [self._inside(d["traj"], f"designs[{k}].traj") if "traj" in d else None
-                       for k, d in zip(order, self.designs, strict=True)]
+        self._files = [self._inside(d["file"], f"{w}.file") for w, d in zip(where, self.designs, strict=True)]
+        self._trajs = [self._inside(d["traj"], f"{w}.traj") if "traj" in d else None
+                       for w, d in zip(where, self.designs, strict=True)]
 
     def _inside(self, name: str, where: str) -> Path:
         folder = self.path.parent.resolve()
@@ -120,7 +128,8 @@ class Ranking:
 
     def caption(self, k: int) -> str:
         d = self.designs[k]
-        parts = [f"design {k + 1} of {len(self.designs)}: rank {d['rank']}"]
+        rank = "the reference arm" if d["rank"] is None else f"rank {d['rank']}"
+        parts = [f"design {k + 1} of {len(self.designs)}: {rank}"]
         if isinstance(d.get("chain"), str):
             parts.append(d["chain"])
         mass = d.get("mass_kg")
@@ -137,7 +146,8 @@ class Ranking:
         d = self.designs[k]
         chain = names.shown(d["chain"], 60) if isinstance(d.get("chain"), str) else names.shown(d["file"], 60)
         cycle = self.cycle_time(k)
-        return f"{k + 1}. rank {d['rank']}: {chain}" + (f", {cycle:.3f} s" if cycle is not None else "")
+        rank = "reference" if d["rank"] is None else f"rank {d['rank']}"
+        return f"{k + 1}. {rank}: {chain}" + (f", {cycle:.3f} s" if cycle is not None else "")
 
     def target_poses(self, k: int, dof: int) -> list[tuple[str, tuple[float, ...]]]:
         """(target, q) of the design's targets as ranking.json gives them; entries not a list of
