@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import pytest
 
 from modc.compiler import check_text
-from modc.design.rank import OBJECTIVES, why
+from modc.design.rank import why
+from modc.objectives import REGISTRY
 from modc.syntax.format import format_text
 
 SMALL = """\
@@ -52,7 +53,7 @@ class Fake:
 def test_why_names_the_ties_and_the_objective_that_decided():
     rank = ("modules", "mass", "margin")
     ds = [Fake(2, 1.411, 0.99, "A"), Fake(2, 1.411, 0.97, "B"), Fake(2, 1.5, 0.2, "C"), Fake(3, 1.2, 0.5, "D")]
-    assert sorted(ds, key=lambda d: tuple(OBJECTIVES[o](d) for o in rank)) == ds
+    assert sorted(ds, key=lambda d: tuple(REGISTRY[o].key(d) for o in rank)) == ds
     assert why(ds, rank) == [
         "ties rank 2 on modules and mass; ahead by torque margin 99 % vs 97 %",
         "ties rank 3 on modules; ahead by mass 1.411 kg vs 1.500 kg",
@@ -212,3 +213,34 @@ def test_the_report_opens_in_headless_chromium(small, tmp_path):
         sent = [e for e in browser.events if e.get("method") == "Network.requestWillBeSent"]
         asked = [e["params"]["request"]["url"] for e in sent]
         assert all(u.startswith(("file:", "data:")) for u in asked), asked
+
+
+def test_a_new_objective_is_one_registry_entry(small, monkeypatch):
+    """An objective is its module and its line in modc.objectives: once registered, `rank` accepts
+    it, the ranking sorts by it, and report.html and ranking.json show it, with no other change."""
+    from dataclasses import replace
+
+    from modc.design import report, write
+    from modc.design.rank import order
+    from modc.objectives import Objective
+
+    heavy = Objective("heaviest", "the heaviest arm first", "arm mass", lambda d: d.mass, unit=" kg", digits=2,
+                      larger_first=True)
+    monkeypatch.setitem(REGISTRY, "heaviest", heavy)
+    text = SMALL.replace("rank modules, mass, margin", "rank heaviest")
+    p = problem(text)  # the check accepts it; the default objectives follow it
+    assert p.rank == ("heaviest", "modules", "mass", "margin")
+    ranked = order(list(small.designs), p.rank)
+    assert [d.mass for d in ranked] == sorted((d.mass for d in small.designs), reverse=True)
+    o = replace(small, problem=p, designs=ranked)
+    html = report.report_html([o], {})
+    assert "<th>arm mass (kg)</th>" in html and f"<td>{ranked[0].mass:.2f} kg</td>" in html
+    doc = write.ranking([o])
+    assert [d["objectives"]["heaviest"] for d in doc["designs"]] == [round(d.mass, 9) for d in ranked]
+    if len(ranked) > 1 and ranked[0].mass != ranked[1].mass:
+        assert doc["designs"][0]["why"].startswith("ahead of rank 2 by arm mass")
+    # unknown until registered: the check names every registered objective
+    monkeypatch.delitem(REGISTRY, "heaviest")
+    c = check_text(text, "small.mod")
+    assert [d.code for d in c.diagnostics if d.is_error] == ["unknown-objective"]
+    assert "modules, mass, margin, cycle_time, energy, coverage" in (c.diagnostics[0].hint or "")

@@ -42,13 +42,15 @@ def test_served_drops_only_the_points_not_reached():
 
 
 def test_coverage_ranks_larger_shares_first():
-    from modc.design.rank import OBJECTIVES, TASK, static
+    from modc.design.rank import TASK, static
+    from modc.objectives import REGISTRY
 
     class D:
         def __init__(self, c):
             self.coverage = c
 
-    assert OBJECTIVES["coverage"](D(1.0)) < OBJECTIVES["coverage"](D(2 / 3)) < OBJECTIVES["coverage"](D(0.1))
+    key = REGISTRY["coverage"].key
+    assert key(D(1.0)) < key(D(2 / 3)) < key(D(0.1))
     assert "coverage" in TASK and static(("coverage", "modules")) == ("modules",)
 
 

@@ -328,11 +328,9 @@ def test_completion_of_statements_and_clauses(server):
         "joint_3",
     ]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ")) == ["home"]
+    # every registered objective, task objectives included
     assert labels(complete_at_end(server, "design d {\n    target t at (0.3, 0, 0.2) m\n    rank ")) == [
-        "modules",
-        "mass",
-        "margin",
-    ]
+        "modules", "mass", "margin", "cycle_time", "energy", "coverage"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose home (0,0,0) deg\n    pose ")) == []
     assert labels(complete_at_end(server, "robot a { chain H1 - L4 - L1\n    pose ready ")) == ["(0, 0, 0) deg"]
     assert labels(complete_at_end(server, "robot a { chain H1 - L1 # a comment ")) == []

@@ -5,7 +5,7 @@ targets, modc.design.tasks.with_points). With it, the region points are optional
 coverage is the share of them it reaches within their tolerances, clear of the cell (the
 planner's own IK and collision model, modc.plan), its tasks visit the points it reaches (the
 others are dropped from the visits of its robot file, which keeps the regions whole) and the
-design is ranked by the share, larger first (rank.OBJECTIVES)."""
+design is ranked by the share, larger first (modc.objectives.coverage)."""
 from __future__ import annotations
 
 from ..model import ResolvedRobot, Robot

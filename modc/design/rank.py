@@ -1,16 +1,15 @@
 """Ranking designs: by the problem's objectives in order (default fewest modules, least mass,
 largest torque margin), then by the chain text, so that the order is total and reproducible.
 
-OBJECTIVES is the one registry of what `rank` may name in a design block: a new objective is an
-entry here (a function of a design to a value, smaller ranks first) and its keyword in
-modc.model.robot (RANK_KEYS / TASK_RANK_KEYS). Task objectives (TASK) are known only once the
+What `rank` may name is modc.objectives' registry (one module per objective), read here at each
+call (REGISTRY[name].key: smaller ranks first). Task objectives (TASK) are known only once the
 design's tasks are planned and timed (modc.design.tasks)."""
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
+from ..objectives import REGISTRY, TASK
 from .evaluate import Candidate, Verified
 
 
@@ -65,19 +64,10 @@ class Screened:
         return self.text
 
 
-OBJECTIVES: dict[str, Callable[[Any], float]] = {
-    "modules": lambda d: d.modules,
-    "mass": lambda d: round(d.mass, 9),
-    "margin": lambda d: 0.0 if d.margin is None else -round(d.margin, 9),
-    "cycle_time": lambda d: round(d.cycle_time, 9),
-    "energy": lambda d: round(d.energy, 9),
-    "coverage": lambda d: -round(getattr(d, "coverage", 1.0), 9),  # larger first; the static search: all
-}
-TASK = frozenset({"cycle_time", "energy", "coverage"})  # known only once the design's tasks are planned
 
 
 def key(objectives: tuple[str, ...], d: Design | Screened) -> tuple:
-    return tuple(OBJECTIVES[o](d) for o in objectives) + (d.chain(),)
+    return tuple(REGISTRY[o].key(d) for o in objectives) + (d.chain(),)
 
 
 def static(objectives: tuple[str, ...]) -> tuple[str, ...]:
@@ -111,24 +101,10 @@ def pareto(points: list[tuple[float, float]]) -> list[bool]:
     return out
 
 
-# How report.html and ranking.json show an objective: its words, its value (in the unit shown)
-# and the unit. An objective not listed here (a newer registry entry) shows its ranking key.
-SHOWN: dict[str, tuple[str, Callable[[Any], float], str]] = {
-    "modules": ("modules", lambda d: d.modules, ""),
-    "mass": ("mass", lambda d: d.mass, " kg"),
-    "margin": ("torque margin", lambda d: d.margin * 100, " %"),
-    "cycle_time": ("cycle time", lambda d: d.cycle_time, " s"),
-    "energy": ("energy", lambda d: d.energy, " J"),
-}
-
-
 def shown(objective: str, d: Any) -> tuple[str, float, str]:
-    """(words, value, unit) of one objective of a design."""
-    if objective in SHOWN:
-        words, value, unit = SHOWN[objective]
-        return words, float(value(d)), unit
-    v = getattr(d, objective, None)
-    return objective.replace("_", " "), float(v if isinstance(v, int | float) else OBJECTIVES[objective](d)), ""
+    """(words, value, unit) of one objective of a design, as report.html and the why sentences show it."""
+    o = REGISTRY[objective]
+    return o.words, o.shown(d), o.unit
 
 
 def _pair(a: float, b: float, unit: str) -> tuple[str, str]:
@@ -146,7 +122,7 @@ def versus(objectives: tuple[str, ...], d: Any, other: Any) -> tuple[list[str], 
     (None: every one ties) and the two values of that one as shown."""
     ties: list[str] = []
     for o in objectives:
-        if OBJECTIVES[o](d) != OBJECTIVES[o](other):
+        if REGISTRY[o].key(d) != REGISTRY[o].key(other):
             _, a, unit = shown(o, d)
             _, b, _ = shown(o, other)
             return ties, o, _pair(a, b, unit)

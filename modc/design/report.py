@@ -8,7 +8,8 @@ from __future__ import annotations
 import base64
 from html import escape
 
-from .rank import OBJECTIVES, TASK, pareto, shown, static, versus, why, worst_share
+from ..objectives import REGISTRY
+from .rank import TASK, pareto, shown, static, versus, why, worst_share
 from .run import Outcome
 from .write import file_name
 
@@ -20,18 +21,12 @@ def _columns(o: Outcome) -> list[str]:
     """The objectives shown: the ranked ones in order, and the task figures of a planned cell."""
     timed = any(d.plans for d in o.designs)
     cols = [k for k in o.problem.rank if timed or k not in TASK]
-    return cols + [k for k in ("cycle_time", "energy") if timed and k not in cols]
+    return cols + [k for k, o in REGISTRY.items() if o.planned_column and timed and k not in cols]
 
 
 def _cell(objective: str, d) -> str:
-    words, value, unit = shown(objective, d)
-    if objective == "mass":
-        return f"{value:.3f}{unit}"
-    if objective == "margin":
-        return f"{value:.1f}{unit}"
-    if objective in ("cycle_time", "energy"):
-        return f"{value:.3f}{unit}" if objective == "cycle_time" else f"{value:.2f}{unit}"
-    return f"{value:g}{unit}"
+    _, value, unit = shown(objective, d)
+    return f"{value:.{REGISTRY[objective].digits}f}{unit}"
 
 
 def _share(share: float | None, worst_m: float | None) -> str:
@@ -119,15 +114,9 @@ def _reference_row(o: Outcome, cols: list[str]) -> str:
     r = o.reference
     cells = []
     for k in cols:
-        if k == "modules":
-            cells.append(str(r.modules))
-        elif k == "mass" and r.mass is not None:
-            cells.append(f"{r.mass:.3f} kg")
-        elif k == "margin" and r.margin is not None:
-            cells.append(f"{r.margin * 100:.1f} %")
-        elif k in TASK and r.plans:
+        if (k in TASK and r.plans) or (k not in TASK and REGISTRY[k].value(r) is not None):
             cells.append(_cell(k, r))
-        else:  # task figures of a reference that could not be planned
+        else:  # not known: task figures of a reference that could not be planned, a chain that does not compile
             cells.append("—")
     errors = [t["position_error_m"] for t in r.targets.values() if t["position_error_m"] is not None]
     verdict = "passes every check" if r.feasible else "fails: " + "; ".join(r.fails)
@@ -150,7 +139,8 @@ def _reference_text(o: Outcome) -> str:
     if decided is None:
         said = "it ties rank 1 on every objective"
     else:
-        ahead = "rank 1 is ahead" if OBJECTIVES[decided](best) < OBJECTIVES[decided](r) else "the reference is ahead"
+        key = REGISTRY[decided].key
+        ahead = "rank 1 is ahead" if key(best) < key(r) else "the reference is ahead"
         said = (f"it ties rank 1 on {', '.join(ties)}; " if ties else "") + \
             f"{ahead} by {shown(decided, best)[0]}: {a} (rank 1) vs {b} (reference)"
     return head + escape(f"passes every check the designs passed; {said}.") + "</p>"

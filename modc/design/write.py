@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 
+from ..objectives import REGISTRY
 from .evaluate import pose_name
 from .rank import Design, why, worst_share
 from .run import Outcome
@@ -90,6 +91,8 @@ def ranking(outcomes: list[Outcome]) -> dict:
                 "targets": d.verified.targets, **task_figures(o, rank, d),
                 "worst_error_share": round(worst_share(d.verified.targets, o.problem.cell), 6),
                 "why": said,  # in words: what decided this rank against the next (the last: the one before)
+                # every ranked objective's value (SI: kg, s, J; shares 0 to 1), in ranking order
+                "objectives": {k: round(float(REGISTRY[k].value(d) or 0.0), 9) for k in o.problem.rank},
                 "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
                                  for a in d.alternatives],
             })

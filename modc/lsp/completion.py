@@ -194,9 +194,9 @@ def _names(an: Analysis, robot: str | None, stmt: str | None, body: list[Any], l
     if body:
         return []
     if stmt == "rank":
-        from ..model.robot import RANK_KEYS
+        from ..objectives import REGISTRY
 
-        return [Completion(k, types.CompletionItemKind.EnumMember, "objective") for k in RANK_KEYS]
+        return [Completion(k, types.CompletionItemKind.EnumMember, o.summary) for k, o in REGISTRY.items()]
     if stmt == "limit":
         return [
             Completion(f"joint_{i}", types.CompletionItemKind.Variable, f"unit {i}: {u}")

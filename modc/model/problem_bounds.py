@@ -8,8 +8,8 @@ from __future__ import annotations
 import math
 
 from ..diagnostics import codes
+from ..objectives import REGISTRY
 from ..syntax import ast
-from .robot import RANK_KEYS, TASK_RANK_KEYS
 
 MAX_LINK_LENGTHS = 12  # per link unit: beyond this the search space is not worth enumerating
 
@@ -86,11 +86,11 @@ def lower_bounds(low, statements: list, block: str) -> dict:
             case ast.Rank():
                 keys = []
                 for k in st.keys:
-                    if k.text not in RANK_KEYS + TASK_RANK_KEYS:
-                        known = ", ".join(RANK_KEYS + TASK_RANK_KEYS)
+                    if k.text not in REGISTRY:
+                        known = ", ".join(REGISTRY)
                         low.error(codes.UNKNOWN_OBJECTIVE.at(k.span, name=k.text, known=known))
                     elif k.text not in keys:
                         keys.append(k.text)
                 # objectives not named keep their default order after the named ones
-                out["rank"] = tuple(keys) + tuple(k for k in RANK_KEYS if k not in keys)
+                out["rank"] = tuple(keys) + tuple(k for k, o in REGISTRY.items() if o.default and k not in keys)
     return out

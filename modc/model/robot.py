@@ -8,6 +8,7 @@ import math
 from typing import ClassVar, Literal
 
 from ..diagnostics import NOWHERE, Span
+from ..objectives import DEFAULT
 from .base import InvalidModel, Value, floats, grid3, hidden, optional, vec3  # noqa: F401 (InvalidModel re-exported)
 from .library import Library
 
@@ -344,8 +345,7 @@ def resolved(robot: Robot, library: Library, **update: object) -> ResolvedRobot:
     return new
 
 
-RANK_KEYS = ("modules", "mass", "margin")  # fewest modules, least mass, largest torque margin
-TASK_RANK_KEYS = ("cycle_time", "energy", "coverage")  # objectives of tasks: ranked only when named
+RANK_KEYS = DEFAULT  # ranked unless named (fewest modules, least mass, largest torque margin): modc.objectives
 
 
 class Problem(Value):

@@ -10,6 +10,7 @@ from typing import Annotated, Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from ..names import IDENTIFIER, MAX_NAME
+from ..objectives import REGISTRY
 
 # Names are checked while lowering (invalid-name, one rule for both forms); the schema states the rule.
 _NAME_SCHEMA: dict[str, Any] = {"pattern": f"^{IDENTIFIER}$", "maxLength": MAX_NAME}
@@ -151,7 +152,7 @@ class DesignDoc(_Doc):
     modules: list[str] | None = Field(None, description="unit types a chain may use, e.g. [H1, H3, L3, L4]")
     links: str | None = Field(None, description='link lengths to try: "220 mm" or "150 mm to 300 mm step 50 mm"')
     rank: list[str] | None = Field(
-        None, description="objectives in order: modules, mass, margin, cycle_time, energy, coverage")
+        None, description="objectives in order: " + ", ".join(REGISTRY))
     compare_with: list[str | UnitItem] | None = Field(
         None, description='a reference arm shown beside the designs, units base first: ["H1", "L4(pivot=-90deg)"]')
 
