@@ -165,6 +165,7 @@ def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: f
 
     kept, pruned, touching = poses(problem, longest)
     outs: list[Outcome] = []
+    at: dict[int, ResolvedProblem] = {}  # id(design) -> the problem of the pose it was found at
     searched: set[int] = set()
     designs: list[Design] = []
     levels = _levels(problem, max_units)
@@ -180,8 +181,9 @@ def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: f
                     break  # every chain of this number of units has more modules than the top designs
             sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None,
                                              "min_units": lo, "max_units": hi})
-            o = one(sub, hi, top, ceiling, False)
+            o = one(sub, hi, top, ceiling, False, swaps=False)
             outs.append(o)
+            at.update((id(d), sub) for d in o.designs)
             searched.add(i)
             designs = _best_per_chain(designs + list(o.designs), problem.rank)
             stopped = stopped or o.stopped
@@ -193,7 +195,7 @@ def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: f
     if not designs and kept and not stopped:  # why none: the nearest pose's search, told per target
         diagnosis = one(problem.model_copy(update={"cell": cell_at(problem.cell, kept[0]), "base_grid": None}),
                         max_units, top)
-    out = Outcome(problem, designs[:top])
+    out = Outcome(problem, [_swaps(at[id(d)], top, d) for d in designs[:top]])
     out.bases_searched, out.bases_pruned, out.bases_total = len(searched), pruned, len(kept) + pruned + touching
     out.bases_touching = touching
     names = [t.name for t in problem.cell.targets]
@@ -217,6 +219,15 @@ def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: f
     if diagnosis is not None:
         out.targets = diagnosis.targets
     return out
+
+
+def _swaps(sub: ResolvedProblem, top: int, d: Design) -> Design:
+    """d with its other H/L splits checked at its pose (as the pose's own search would have):
+    only for the designs the merged ranking keeps."""
+    from .run import _mass
+    from .verify_order import Verifier
+
+    return Verifier(sub, top, None, _mass).swaps(d)
 
 
 def _best_per_chain(designs: list[Design], objectives: tuple[str, ...]) -> list[Design]:
