@@ -8,6 +8,23 @@ searched with its base as written (one pose) and with `base within box size (0.2
 (0, 0, 0) m step 50 mm` (5 x 5 = 25 poses): run.design (--top 1 by default, seed 0), CPU seconds of
 this process pinned to one core (BLAS pools at one thread), and their ratio (goal: at most 5).
 bench_base() is the function bench_design.py calls.
+
+Figures (CPU s, one core, 2-core machine shared with other jobs, load average 1-4, each bench
+run with an empty MODC_CACHE_DIR; two runs each for --top 1, alternating before/after):
+
+    2026-11-27     --top   1 pose      25 poses     ratio     best (25 poses)
+    before 8e67231   1     1.0 / 0.6   20.1 / 18.6  21 / 30   H2(pivot=30deg) - L2(pivot=-15deg)
+    after            1     0.8 / 0.9   15.7 / 18.8  20 / 21     - L4(pivot=15deg) at (-0.05, 0.1, 0) m
+    before 8e67231   3     35.8        19.7         0.55      (same three designs before and after)
+    after            3     30.9        15.6         0.50
+
+The one-pose figure (0.6-1.0 s) is noise-dominated; the ratio with it. Goal (<= 5) not met:
+15 poses are in reach and 8 of them need a real search (0.7-3.6 s each, the base as written
+being among the cheapest), because designs of equal modules and mass (every 3-unit shape of
+this library weighs 1.82 kg in one split) are told apart by torque margin across poses
+(modc/design/placement.py says why no sound bound skips them). With --top 3 the grid is
+cheaper than one pose: 25 poses give three 1.82 kg designs, one pose has to search on to heavier
+shapes for its third.
 """
 from __future__ import annotations
 
