@@ -177,7 +177,7 @@ def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: f
 
     kept, pruned, touching = poses(problem, longest)
     outs: list[Outcome] = []
-    at: dict[int, ResolvedProblem] = {}  # id(design) -> the problem of the pose it was found at
+    at: dict[int, ResolvedProblem] = {}  # id(design) -> its pose's problem (outs keeps every design alive)
     searched: set[int] = set()
     designs: list[Design] = []
     levels = _levels(problem, max_units)
