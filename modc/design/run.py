@@ -223,12 +223,12 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     enough = [top]  # designs after which a round may stop (more when the first candidates all fail planning)
 
     def one(p: ResolvedProblem, units: int | None, k: int, ceiling: Ceiling | None = None,
-            diagnosing: bool = True) -> Outcome:
+            diagnosing: bool = True, swaps: bool = True) -> Outcome:
         # the extra candidates to time come from the shapes searched until `top` designs are found
         # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
         # settings, 369 s on a 4-goal visit cell)
         return _search(p, units, k, seed, executor, progress, deadline, enough=enough[0], ceiling=ceiling,
-                       diagnosing=diagnosing)
+                       diagnosing=diagnosing, swaps=swaps)
 
     rejected: dict[str, str] = {}  # chain -> why its tasks could not be planned (planned once only)
     while True:
@@ -268,7 +268,7 @@ def longest_reach(problem: ResolvedProblem, hi: int) -> float:
 
 def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int, executor: Executor | None,
             progress: Callable[..., None] | None, deadline: float | None, enough: int | None = None,
-            ceiling: Ceiling | None = None, diagnosing: bool = True) -> Outcome:
+            ceiling: Ceiling | None = None, diagnosing: bool = True, swaps: bool = True) -> Outcome:
     """The static search: designs ranked by the problem's (static) objectives.
 
     With the default objectives (fewest modules first), chains are searched by number of units,
@@ -278,7 +278,8 @@ def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int
     ROUND does not depend on the number of workers, so neither does where the search stops.
     deadline (time.time()) and search.STOP end it early with what was found. ceiling: only shapes
     that could rank before it are searched (base placement: what other poses found); diagnosing:
-    say per target why there is no design (probes of seconds each)."""
+    say per target why there is no design (probes of seconds each); swaps: check each design's
+    other H/L splits as its alternatives (base placement does it for the merged designs only)."""
     t0 = time.perf_counter()
     spec = Spec.of(problem)
     lib = problem.cell.library
@@ -405,7 +406,7 @@ def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int
     out.coarse = [r.shape.label() for r in searched if r.finished and not r.complete]
     out.complete = not out.unfinished and not out.coarse
     out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
-    out.designs = [tally.swaps(d) for d in distinct(tally.accepted, problem.rank)[:top]]
+    out.designs = [tally.swaps(d) if swaps else d for d in distinct(tally.accepted, problem.rank)[:top]]
     if not out.designs and diagnosing:
         out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0

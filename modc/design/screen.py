@@ -119,20 +119,28 @@ def static_torques(robot, qs) -> np.ndarray:
     chain = Chain(robot)
     g = rpy_matrix(robot.base.rpy).T @ np.array(GRAVITY_VECTOR)
     per_unit = [unit_parts(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units]
+    frame = {"unit": "T_base_unit", "twist1": "T_base_twist1", "joint": "T_base_joint"}
+    # (unit, frame, first joint that carries it) and mass, centre in that frame: the same every pose
+    where = [(i, frame[part.frame], i if part.frame == "joint" else i - 1)
+             for i, parts in enumerate(per_unit) for part in parts]
+    masses = [part.mass for parts in per_unit for part in parts]
+    local = [_part_com(part) for parts in per_unit for part in parts]
+    if robot.payload is not None:  # carried by every joint, at tool0's offset
+        masses.append(robot.payload.mass)
+    carried = np.array([w[2] for w in where] + [robot.dof - 1] * (robot.payload is not None), int)
+    M = np.array(masses, float)
     out = np.zeros((len(qs), robot.dof))
     for k, q in enumerate(qs):
         frames = chain.frames(np.asarray(q, float))
-        bodies = []  # (first joint that carries it, mass, centre in base_link)
-        for i, (f, parts) in enumerate(zip(frames, per_unit, strict=True)):
-            for part in parts:
-                T = f[{"unit": "T_base_unit", "twist1": "T_base_twist1", "joint": "T_base_joint"}[part.frame]]
-                carried_from = i if part.frame == "joint" else i - 1
-                bodies.append((carried_from, part.mass, T[:3, :3] @ _part_com(part) + T[:3, 3]))
+        centres = [frames[i][f][:3, :3] @ c + frames[i][f][:3, 3] for (i, f, _), c in zip(where, local, strict=True)]
         if robot.payload is not None:
-            T = chain.T_base_tool(np.asarray(q, float))
-            bodies.append((robot.dof - 1, robot.payload.mass, T[:3, :3] @ np.asarray(robot.payload.com) + T[:3, 3]))
+            T = (frames[-1]["T_base_end"] if frames else np.eye(4)) @ chain.T_flange_tool
+            centres.append(T[:3, :3] @ np.asarray(robot.payload.com) + T[:3, 3])
+        C = np.array(centres)
         for i, f in enumerate(frames):
             p, z = f["T_base_joint"][:3, 3], f["T_base_joint"][:3, 2]
-            moment = sum((np.cross(c - p, m * g) for j, m, c in bodies if j >= i), np.zeros(3))
-            out[k, i] = abs(float(z @ moment))
+            on = carried >= i
+            F = M[on] @ (C[on] - p)  # sum of m (c - p): z . sum (c - p) x m g = F . (g x z)
+            gz = (g[1] * z[2] - g[2] * z[1], g[2] * z[0] - g[0] * z[2], g[0] * z[1] - g[1] * z[0])
+            out[k, i] = abs(float(F[0] * gz[0] + F[1] * gz[1] + F[2] * gz[2]))
     return out
