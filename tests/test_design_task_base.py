@@ -179,3 +179,19 @@ def test_only_a_shifted_base_reaches_and_its_file_places_the_same_cell(tmp_path)
         # the obstacle stands where the cell put it
         post = next(o for o in robot.obstacles if o.name == "post")
         assert np.allclose(T_world_base[:3, :3] @ post.origin.xyz + T_world_base[:3, 3], (0.45, -0.25, 0.15))
+
+
+def test_the_reference_arm_stands_at_a_base_pose_where_it_passes():
+    """`compare with chain …` with `base within`: the reference is judged at the grid's poses too
+    (nearest first), not only at the base as written, where no arm reaches target a."""
+    from modc.design import placement, reference, run
+
+    best = run.design(problem(), top=1).designs[0]
+    p = problem(SHIFTED.replace("    base within", f"    compare with chain {best.chain()}\n    base within"))
+    kept = placement.poses(p, run.longest_reach(p, 3))[0]
+    r = reference.evaluate(p, seed=0, poses=kept)
+    assert r is not None and r.feasible, r.fails if r else None
+    assert r.verified is not None and r.verified.robot.base.xyz[0] > 0.05
+    assert r.to_json("shifted")["base"]["xyz_m"] == pytest.approx(list(r.verified.robot.base.xyz))
+    at_origin = reference.evaluate(p, seed=0)
+    assert at_origin is not None and not at_origin.feasible and "'a'" in " ".join(at_origin.fails)

@@ -8,11 +8,12 @@ A reference that passes them on a cell with tasks is planned and timed like ever
 (tasks.plan_design): its cycle time and energy stand beside theirs, or it fails the task."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..model import ResolvedProblem, Robot
+from ..model import ResolvedProblem, Robot, Transform
 from .evaluate import Candidate, Spec, Verified, _sub_targets, screen_batch, verify
 from .rank import target_share
 from .space import Shape
@@ -59,6 +60,10 @@ class Reference:
                "targets": self.targets, "fails": list(self.fails)}
         if name is not None and self.mass is not None:
             out["file"] = file_name(name)
+        if self.verified is not None:  # where its base_link stands in the cell (`base within`: the pose found)
+            base = self.verified.robot.base
+            out["base"] = {"xyz_m": [round(v, 9) + 0.0 for v in base.xyz],
+                           "rpy_deg": [round(math.degrees(v), 6) + 0.0 for v in base.rpy]}
         if self.plans:
             out |= {"cycle_time_s": round(self.cycle_time, 6), "energy_j": round(self.energy, 6),
                     "peak_torque_share": round(max(p.peak_share for p in self.plans), 6),
@@ -101,21 +106,40 @@ def _static(problem: ResolvedProblem, ref: Robot) -> tuple[float | None, float |
     return library_mass(robot) - payload, float(margin), None
 
 
-def evaluate(problem: ResolvedProblem, seed: int = 0, deadline: float | None = None) -> Reference | None:
+def evaluate(problem: ResolvedProblem, seed: int = 0, deadline: float | None = None,
+             poses: list[Transform] | None = None) -> Reference | None:
     """The block's reference arm on its cell, or None when it names none. Every region point is
     a target of it, as of the designs (unless `rank coverage`). One that passes the static
-    checks on a cell with tasks is planned and timed (deadline: time.time() to give up by)."""
-    from .tasks import has_tasks, with_points
+    checks on a cell with tasks is planned and timed (deadline: time.time() to give up by).
+    poses (`base within`: the grid's poses worth a search, nearest first): the reference stands
+    at the first one where it passes the static checks, else it is told at the nearest."""
+    from .placement import cell_at
+    from .tasks import has_tasks
+
+    if not poses:
+        out = _at(problem, seed)
+    else:
+        first = None
+        for pose in poses:
+            out = _at(problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None}), seed)
+            first = first or out
+            if out is None or out.verified is not None:
+                break
+        else:
+            out = first
+    tasked = has_tasks(problem) or "coverage" in problem.rank
+    if out is None or out.verified is None or out.candidate is None or not tasked:
+        return out
+    return _planned(out, seed, deadline, "coverage" in problem.rank)
+
+
+def _at(problem: ResolvedProblem, seed: int) -> Reference | None:
+    """The reference on the problem's cell, as it stands, before any planning."""
+    from .tasks import with_points
 
     screened, names = with_points(problem)
     out = _evaluate(screened, seed)
-    if out is None:
-        return out
-    if names:
-        out = _told(out, names)
-    if out.verified is None or out.candidate is None or not (has_tasks(problem) or "coverage" in problem.rank):
-        return out
-    return _planned(out, seed, deadline, "coverage" in problem.rank)
+    return _told(out, names) if out is not None and names else out
 
 
 def _told(out: Reference, names: dict[str, str]) -> Reference:

@@ -252,7 +252,10 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         if out.designs or out.stopped or exhausted or n >= MAX_CANDIDATES:
             break
         n = enough[0] = min(n * 4, MAX_CANDIDATES)
-    out.reference = reference.evaluate(problem, seed, deadline)
+    grid = None if problem.base_grid is None else \
+        placement.poses(problem, longest_reach(problem, min(max_units or problem.max_units,
+                                                            problem.cell.library.rules.max_dof)))[0]
+    out.reference = reference.evaluate(problem, seed, deadline, grid)
     out.seconds = time.perf_counter() - t0
     return out
 
