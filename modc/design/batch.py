@@ -121,34 +121,32 @@ class Flat:
 
 
 def _rot(R, P):
-    """R . P for stacks (3, 3, B) of rotations."""
-    return np.stack([np.stack([R[i, 0] * P[0, k] + R[i, 1] * P[1, k] + R[i, 2] * P[2, k] for k in range(3)])
-                     for i in range(3)])
+    """R . P for stacks (3, 3, B) of rotations: sum_j R[i, j] P[j, k], the terms added in j order."""
+    return R[:, 0, None] * P[None, 0] + R[:, 1, None] * P[None, 1] + R[:, 2, None] * P[None, 2]
 
 
 def _apply(R, v):
-    """R . v for (3, 3, B) and (3, B)."""
-    return np.stack([R[i, 0] * v[0] + R[i, 1] * v[1] + R[i, 2] * v[2] for i in range(3)])
+    """R . v for (3, 3, B) and (3, B), the terms added in column order."""
+    return R[:, 0] * v[0] + R[:, 1] * v[1] + R[:, 2] * v[2]
 
 
-def forward_flat(f: Flat, q: np.ndarray):
+def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True):
     """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
-    and position (3, B)."""
+    (None without rotation: a position-only solve never reads it) and position (3, B)."""
     n, B = q.shape
     p = np.empty((n, 3, B))
     z = np.empty((n, 3, B))
     c, s = np.cos(q), np.sin(q)
-    R, t = f.k_R[0].copy(), f.k_t[0]  # base_link is the identity: K_0 needs no product
+    R, t = f.k_R[0], f.k_t[0]  # base_link is the identity: K_0 needs no product
     for i in range(n):
         if i:
             t = t + _apply(R, f.k_t[i])
             R = _rot(R, f.k_R[i])
-        x, y = R[:, 0].copy(), R[:, 1]
-        R[:, 0] = c[i] * x + s[i] * y
-        R[:, 1] = c[i] * y - s[i] * x
+        x, y = R[:, 0], R[:, 1]
+        R = np.stack([c[i] * x + s[i] * y, c[i] * y - s[i] * x, R[:, 2]], 1)
         p[i] = t
         z[i] = R[:, 2]
-    return p, z, _rot(R, f.k_R[n]), t + _apply(R, f.k_t[n])
+    return p, z, _rot(R, f.k_R[n]) if rotation else None, t + _apply(R, f.k_t[n])
 
 
 def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:
