@@ -130,16 +130,35 @@ def _apply(R, v):
     return R[:, 0] * v[0] + R[:, 1] * v[1] + R[:, 2] * v[2]
 
 
-def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True):
+def _rz_times(c, s, K_R, k_t):
+    """Rz(theta) . K for a rotation stack (3, 3, B) and a translation (3, B): two rows mixed."""
+    R = np.stack([c * K_R[0] - s * K_R[1], s * K_R[0] + c * K_R[1], K_R[2]])
+    t = np.stack([c * k_t[0] - s * k_t[1], s * k_t[0] + c * k_t[1], k_t[2]])
+    return R, t
+
+
+def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True, local: bool = False):
     """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
-    (None without rotation: a position-only solve never reads it) and position (3, B)."""
+    (None without rotation: a position-only solve never reads it) and position (3, B).
+
+    local: in joint 1's frame before its rotation (K_0 left out: joint 1 turns about z through
+    the origin), where the first products are Rz(q_1) . K_1 - two rows mixed, not a 3x3 product;
+    a caller that moves its targets into that frame gets the same distances."""
     n, B = q.shape
     p = np.empty((n, 3, B))
     z = np.empty((n, 3, B))
     c, s = np.cos(q), np.sin(q)
-    R, t = f.k_R[0], f.k_t[0]  # base_link is the identity: K_0 needs no product
-    for i in range(n):
-        if i:
+    if local:
+        p[0], z[0, :2], z[0, 2] = 0.0, 0.0, 1.0
+        R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
+        if n == 1:
+            return p, z, R if rotation else None, t
+        first = 1
+    else:
+        R, t = f.k_R[0], f.k_t[0]  # base_link is the identity: K_0 needs no product
+        first = 0
+    for i in range(first, n):
+        if i > first:
             t = t + _apply(R, f.k_t[i])
             R = _rot(R, f.k_R[i])
         x, y = R[:, 0], R[:, 1]

@@ -199,7 +199,11 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     # iterations leaves: the screen is a local search, and such runs end beyond the tolerance
     give_up = np.asarray(tg.tol_p, float)[t_idx] * STALL_FACTOR
     ref = np.full(B, np.inf)
-    p, z, R_tool, t_tool = forward_flat(f, q, rotation=oriented)
+    if not oriented:  # position only: in joint 1's frame (batch.forward_flat, local)
+        d = runs.xyz - f.k_t[0]
+        runs.xyz = np.stack([f.k_R[0][0, k] * d[0] + f.k_R[0][1, k] * d[1] + f.k_R[0][2, k] * d[2] for k in range(3)])
+    local = not oriented
+    p, z, R_tool, t_tool = forward_flat(f, q, rotation=oriented, local=local)
     e_p, e_r, cost = _residual(runs, R_tool, t_tool, oriented)
     lam = np.full(B, LAMBDA0)
     for it in range(iterations + 1):
@@ -238,7 +242,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
             J = np.concatenate([J, w * runs.rotation_rows(z, R_tool)], axis=1)  # (n, 6, b)
             e = np.concatenate([e_p, w * e_r], axis=0)  # (6, b)
         qn = np.minimum(np.maximum(q + _step(J, e, lam), lo), hi)
-        pn, zn, Rn, tn = forward_flat(f, qn, rotation=oriented)
+        pn, zn, Rn, tn = forward_flat(f, qn, rotation=oriented, local=local)
         e_pn, e_rn, cost_n = _residual(runs, Rn, tn, oriented)
         ok = (cost_n < cost) & active
         np.copyto(q, qn, where=ok)
