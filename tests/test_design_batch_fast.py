@@ -232,8 +232,8 @@ def test_forward_without_rotation_gives_the_same_positions_and_axes():
     want = forward_plain(f, q)
     with_rot, without = forward_flat(f, q), forward_flat(f, q, rotation=False)
     for a, b in zip(want, with_rot, strict=True):
-        assert np.array_equal(a, b)
-    assert without[2] is None and all(np.array_equal(want[k], without[k]) for k in (0, 1, 3))
+        assert np.abs(a - b).max() < 1e-12
+    assert without[2] is None and all(np.abs(want[k] - without[k]).max() < 1e-12 for k in (0, 1, 3))
     # in joint 1's frame: the same points and axes once K_0 is put back
     p, z, R, t = forward_flat(f, q, local=True)
     R0, t0 = np.moveaxis(f.k_R[0], -1, 0), f.k_t[0].T  # (B, 3, 3), (B, 3)
@@ -242,10 +242,19 @@ def test_forward_without_rotation_gives_the_same_positions_and_axes():
     assert np.abs(np.einsum("bij,nbj->nbi", R0, np.moveaxis(z, -1, 1)) - np.moveaxis(want[1], -1, 1)).max() < 1e-12
     assert np.abs(np.einsum("bij,jb->bi", R0, t) + t0 - want[3].T).max() < 1e-12
     assert np.abs(np.einsum("bij,jkb->bik", R0, R) - np.moveaxis(want[2], -1, 0)).max() < 1e-12
+    t_local = forward_flat(f, q, rotation=False, local=True)[3]
+    assert np.abs(np.einsum("bij,jb->bi", R0, t_local) + t0 - want[3].T).max() < 1e-12
     one = Flat(f.k_R[:2], f.k_t[:2])  # a single joint: K_0, then K_1 to the tool
-    p1, z1, R1, t1 = forward_flat(one, q[:1], local=True)
     w1 = forward_plain(one, q[:1])
-    assert np.abs(np.einsum("bij,jb->bi", R0, t1) + t0 - w1[3].T).max() < 1e-12
+    for rotation in (True, False):
+        t1 = forward_flat(one, q[:1], rotation=rotation, local=True)[3]
+        assert np.abs(np.einsum("bij,jb->bi", R0, t1) + t0 - w1[3].T).max() < 1e-12
+        assert np.abs(forward_flat(one, q[:1], rotation=rotation)[3] - w1[3]).max() < 1e-12
+    two = Flat(f.k_R[[0, 1, 3]], f.k_t[[0, 1, 3]])  # two joints
+    w2 = forward_plain(two, q[:2])
+    for rotation in (True, False):
+        t2 = forward_flat(two, q[:2], rotation=rotation, local=True)[3]
+        assert np.abs(np.einsum("bij,jb->bi", R0, t2) + t0 - w2[3].T).max() < 1e-12
 
 
 def test_nearest_obstacle_equals_the_plain_distance():

@@ -121,25 +121,30 @@ class Flat:
 
 
 def _rot(R, P):
-    """R . P for stacks (3, 3, B) of rotations: sum_j R[i, j] P[j, k], the terms added in j order."""
-    return R[:, 0, None] * P[None, 0] + R[:, 1, None] * P[None, 1] + R[:, 2, None] * P[None, 2]
+    """R . P for stacks (3, 3, B) of rotations (einsum: several times faster here than broadcast
+    products, which stream (3, 3, B) temporaries)."""
+    return np.einsum("ijb,jkb->ikb", R, P)
 
 
 def _apply(R, v):
-    """R . v for (3, 3, B) and (3, B), the terms added in column order."""
-    return R[:, 0] * v[0] + R[:, 1] * v[1] + R[:, 2] * v[2]
+    """R . v for (3, 3, B) and (3, B)."""
+    return np.einsum("ijb,jb->ib", R, v)
+
+
+def _rz_vec(c, s, v):
+    """Rz(theta) . v for (3, B)."""
+    return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]])
 
 
 def _rz_times(c, s, K_R, k_t):
     """Rz(theta) . K for a rotation stack (3, 3, B) and a translation (3, B): two rows mixed."""
-    R = np.stack([c * K_R[0] - s * K_R[1], s * K_R[0] + c * K_R[1], K_R[2]])
-    t = np.stack([c * k_t[0] - s * k_t[1], s * k_t[0] + c * k_t[1], k_t[2]])
-    return R, t
+    return np.stack([c * K_R[0] - s * K_R[1], s * K_R[0] + c * K_R[1], K_R[2]]), _rz_vec(c, s, k_t)
 
 
 def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True, local: bool = False):
     """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
-    (None without rotation: a position-only solve never reads it) and position (3, B).
+    and position (3, B). Without rotation (a position-only solve) tool0's rotation is None and
+    the last joint costs three matrix-vector products, not a 3x3 product.
 
     local: in joint 1's frame before its rotation (K_0 left out: joint 1 turns about z through
     the origin), where the first products are Rz(q_1) . K_1 - two rows mixed, not a 3x3 product;
@@ -150,9 +155,10 @@ def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True, local: bool = Fa
     c, s = np.cos(q), np.sin(q)
     if local:
         p[0], z[0, :2], z[0, 2] = 0.0, 0.0, 1.0
-        R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
         if n == 1:
+            R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
             return p, z, R if rotation else None, t
+        R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
         first = 1
     else:
         R, t = f.k_R[0], f.k_t[0]  # base_link is the identity: K_0 needs no product
@@ -160,7 +166,14 @@ def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True, local: bool = Fa
     for i in range(first, n):
         if i > first:
             t = t + _apply(R, f.k_t[i])
+            if i == n - 1 and not rotation:
+                # tool0 = t + R . K_i . Rz(q_i) . t(K_n)
+                p[i], z[i] = t, _apply(R, f.k_R[i][:, 2])
+                return p, z, None, t + _apply(R, _apply(f.k_R[i], _rz_vec(c[i], s[i], f.k_t[n])))
             R = _rot(R, f.k_R[i])
+        elif i == n - 1 and not rotation:
+            p[i], z[i] = t, R[:, 2]
+            return p, z, None, t + _apply(R, _rz_vec(c[i], s[i], f.k_t[n]))
         x, y = R[:, 0], R[:, 1]
         R = np.stack([c[i] * x + s[i] * y, c[i] * y - s[i] * x, R[:, 2]], 1)
         p[i] = t

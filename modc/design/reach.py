@@ -8,6 +8,7 @@ chosen joint vectors are then checked exactly by modc.design.evaluate.verify.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -147,10 +148,15 @@ def _ldl_solve(A: dict, b: list, n: int) -> np.ndarray:
     return np.stack(x)
 
 
+@functools.lru_cache(maxsize=8)
+def _triu(n: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.triu_indices(n)
+
+
 def _step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
     """The damped least-squares step dq (n, B): (J^T J + lam I) dq = J^T e, J (n, m, B), e (m, B)."""
     n, m = J.shape[:2]
-    iu, ju = np.triu_indices(n)
+    iu, ju = _triu(n)
     prod = J[iu, 0] * J[ju, 0]
     rhs = J[:, 0] * e[0]
     for k in range(1, m):
