@@ -8,7 +8,6 @@ chosen joint vectors are then checked exactly by modc.design.evaluate.verify.
 """
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -148,24 +147,14 @@ def _ldl_solve(A: dict, b: list, n: int) -> np.ndarray:
     return np.stack(x)
 
 
-@functools.lru_cache(maxsize=8)
-def _triu(n: int) -> tuple[np.ndarray, np.ndarray]:
-    return np.triu_indices(n)
-
-
 def _step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
     """The damped least-squares step dq (n, B): (J^T J + lam I) dq = J^T e, J (n, m, B), e (m, B)."""
-    n, m = J.shape[:2]
-    iu, ju = _triu(n)
-    prod = J[iu, 0] * J[ju, 0]
-    rhs = J[:, 0] * e[0]
-    for k in range(1, m):
-        prod += J[iu, k] * J[ju, k]
-        rhs += J[:, k] * e[k]
-    A = {(int(i), int(j)): prod[k] for k, (i, j) in enumerate(zip(iu, ju, strict=True))}
+    n = J.shape[0]
+    JJ = np.einsum("ikb,jkb->ijb", J, J)
+    A = {(i, j): JJ[i, j] for i in range(n) for j in range(i, n)}
     for i in range(n):
         A[i, i] = A[i, i] + lam
-    return _ldl_solve(A, list(rhs), n)
+    return _ldl_solve(A, list(np.einsum("ikb,kb->ib", J, e)), n)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
