@@ -8,6 +8,7 @@ modc.kinematics.Chain stays the reference (tests compare the two).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,25 @@ class Geometry:
     @property
     def dof(self) -> int:
         return self.pre.shape[1]
+
+    @functools.cached_property
+    def joints(self) -> np.ndarray:
+        """K_0 = PRE_1, K_i = POST_i . PRE_(i+1), K_n = POST_n . tool (C, n+1, 4, 4): the transform
+        from one joint's rotation to the next. Computed once per geometry and carried by take(),
+        so the IK calls of one screen (a target and a seed at a time) share them."""
+        C, n = self.pre.shape[:2]
+        K = np.empty((C, n + 1, 4, 4))
+        K[:, 0] = self.pre[:, 0]
+        K[:, 1:n] = self.post[:, :-1] @ self.pre[:, 1:]
+        K[:, n] = self.post[:, -1] @ self.flange_tool
+        return K
+
+    def take(self, idx) -> Geometry:
+        """The candidates idx (with their joint transforms, when computed)."""
+        out = Geometry(self.pre[idx], self.post[idx], self.t1, self.flange_tool)
+        if "joints" in self.__dict__:
+            out.__dict__["joints"] = self.__dict__["joints"][idx]
+        return out
 
 
 def geometry(units, pivots: np.ndarray, ports: np.ndarray, links, tool_xyz, tool_rpy) -> Geometry:
@@ -107,12 +127,7 @@ class Flat:
 
     @classmethod
     def of(cls, g: Geometry, c_idx: np.ndarray) -> Flat:
-        C, n = g.pre.shape[:2]
-        K = np.empty((C, n + 1, 4, 4))
-        K[:, 0] = g.pre[:, 0]
-        K[:, 1:n] = g.post[:, :-1] @ g.pre[:, 1:]
-        K[:, n] = g.post[:, -1] @ g.flange_tool
-        Kc = K[c_idx]
+        Kc = g.joints[c_idx]
         return cls(np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, :3], 0, -1)),
                    np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, 3], 0, -1)))
 

@@ -130,7 +130,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
             # iterations more than its runs)
             group = seeds if seeds[0] < SEEDS and need.size <= FEW else seeds[:1]
             seeds = seeds[len(group):]
-            sub = Geometry(g.pre[need], g.post[need], g.t1, g.flange_tool)
+            sub = g.take(need)
             start = q[need, warm, hit[need, warm].argmax(-1)][:, None] if group == [SEEDS] else q0[group]
             qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), start, lo, hi)
             got = np.zeros(need.size, bool)
@@ -143,7 +143,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
                 if h.any() and len(spec.obstacles.shape):
                     # only the runs that reached their target are worth a collision test
                     c = np.flatnonzero(h)
-                    one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+                    one = sub.take(c)
                     _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
                     h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
                 q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r

@@ -349,7 +349,7 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         if not ok.any():
             continue
         k = np.flatnonzero(ok)
-        sub = type(g)(g.pre[k], g.post[k], g.t1, g.flange_tool)
+        sub = g.take(k)
         s = screen_batch(spec, shape, piv[k], por[k], s0, g=sub)
         screened += len(k)
         closest = np.minimum(closest, s.closest.min(0))
@@ -367,7 +367,15 @@ def _keep(found: list[Found], s, piv: np.ndarray, por: np.ndarray) -> list[Found
     if cand.size == 0:
         return found
     entries: list[tuple[tuple, int, Found | None]] = [(order_key(f), -1, f) for f in found]
-    entries += [(key, j, None) for j, key in enumerate(_keys(s.worst, piv[cand], por[cand]))]
+    # the keys' first two parts (worst to 1 %, twists set) first: a setting with KEEP others
+    # strictly ahead on them cannot be kept, and needs no full key
+    vals = np.concatenate([piv[cand], por[cand]], axis=1)
+    head = list(zip([round(float(w), 2) for w in s.worst], np.count_nonzero(np.abs(vals) > 1e-9, axis=1).tolist(),
+                    strict=True))
+    cut = sorted([e[0][:2] for e in entries] + head)[KEEP - 1] if len(entries) + len(head) >= KEEP else None
+    near = [j for j, h in enumerate(head) if cut is None or h <= cut]
+    keys = _keys(s.worst[near], piv[cand[near]], por[cand[near]])
+    entries += [(key, j, None) for j, key in zip(near, keys, strict=True)]
     best = sorted(entries, key=lambda e: e[0])[:KEEP]  # stable: the order the old list had on ties
     out = []
     for _, j, f in best:
