@@ -179,6 +179,28 @@ def distance_plain(obstacles, pts):
     return out
 
 
+def collides_plain(obstacles, frames, radii, step=0.02):
+    """screen.collides as it was: every sample of every segment near an obstacle measured."""
+    R, n = frames.shape[:2]
+    if len(obstacles.shape) == 0 or R == 0:
+        return np.zeros(R, bool)
+    a, b = frames[:, :, :3, :], frames[:, :, 1:, :]
+    mid, half = (a + b) / 2, np.linalg.norm(b - a, axis=-1) / 2
+    near = distance_plain(obstacles, mid.reshape(-1, 3)).min(-1).reshape(R, n, 3) - half - radii < -1e-3
+    near[:, 0, 0] = False
+    out = np.zeros(R, bool)
+    if not near.any():
+        return out
+    m = int(np.ceil(0.25 / step)) + 1
+    ts = np.linspace(0.0, 1.0, m)
+    r_i, n_i, s_i = np.nonzero(near)
+    aa, bb = a[r_i, n_i, s_i], b[r_i, n_i, s_i]
+    pts = aa[:, None, :] + (bb - aa)[:, None, :] * ts[:, None]
+    d = distance_plain(obstacles, pts.reshape(-1, 3)).min(-1).reshape(len(r_i), m) - radii[s_i][:, None]
+    np.logical_or.at(out, r_i, (d < -1e-3).any(-1))
+    return out
+
+
 def order_key_plain(f) -> tuple:
     vals = np.concatenate([np.array(f.pivots), np.array(f.ports)])
     return (round(f.worst, 2), int(np.count_nonzero(np.abs(vals) > 1e-9)), round(float(np.abs(vals).sum()), 9),
@@ -199,11 +221,12 @@ def keep_plain(found, s, piv, por):
 @pytest.fixture
 def plain(monkeypatch):
     """Switch the screen to the reference path (within the test)."""
-    from modc.design import reach, screen, search
+    from modc.design import evaluate, reach, screen, search
 
     def use():
         monkeypatch.setattr(reach, "solve", solve_plain)
         monkeypatch.setattr(screen.Obstacles, "nearest", lambda self, pts: distance_plain(self, pts).min(-1))
+        monkeypatch.setattr(evaluate, "collides", collides_plain)
         monkeypatch.setattr(search, "order_key", order_key_plain)
         monkeypatch.setattr(search, "_keep", keep_plain)
     return use
@@ -276,6 +299,27 @@ def test_nearest_obstacle_equals_the_plain_distance():
     pts = np.random.default_rng(4).uniform(-0.6, 0.6, (5000, 3))
     assert np.array_equal(spec_obstacles.nearest(pts), distance_plain(spec_obstacles, pts).min(-1))
     assert np.array_equal(spec_obstacles.distance(pts), distance_plain(spec_obstacles, pts))
+
+
+@pytest.mark.parametrize("text", [THREE, ORIENTED])
+def test_collisions_skip_only_samples_their_segment_ends_prove_clear(text):
+    from modc.design import search
+    from modc.design.batch import forward, geometry
+    from modc.design.evaluate import Spec
+    from modc.design.screen import collides
+    from modc.design.space import Shape
+
+    spec = Spec.of(problem(text))
+    shape = Shape((4, 4, 3), (None, None, None))
+    lib, tool = spec.problem.cell.library, spec.problem.cell.tool
+    types = [lib.units[k] for k in shape.kinds]
+    piv, por = search._settings(search.axes(spec, shape), 3, 9000, 9400)
+    g = geometry(types, piv, por, [t.x23 for t in types], tool.xyz, tool.rpy)
+    q = np.random.default_rng(8).uniform(-2.9, 2.9, (400, 1, 1, 3))
+    frames = forward(g, q, points=True)[3][:, 0, 0]
+    got = collides(spec.obstacles, frames, spec.radii)
+    assert np.array_equal(got, collides_plain(spec.obstacles, frames, spec.radii))
+    assert 0 < got.sum() < len(got)
 
 
 def test_order_keys_of_a_block_equal_the_key_of_each_setting():
