@@ -159,8 +159,10 @@ def _step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """a x b along axis 1 of (n, 3, B) stacks."""
-    return np.stack([a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1], a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]], 1)
+    out = np.empty(a.shape)
+    for k, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.subtract(a[:, i] * b[:, j], a[:, j] * b[:, i], out=out[:, k])
+    return out
 
 
 def _sq(v: np.ndarray) -> np.ndarray:
@@ -215,7 +217,8 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
             if it >= 2 * STALL_EVERY:
                 active &= ~((cost > STALL_GAIN * ref) & (ep > give_up))
             ref = cost
-        if active.sum() < 0.8 * active.size or not active.any():  # compaction costs: do it in steps
+        left = np.count_nonzero(active)
+        if left < 0.8 * active.size or not left:  # compaction costs: do it in steps
             gone = ~active
             q_all[:, live[gone]], ep_all[live[gone]] = q[:, gone], ep[gone]
             if oriented:
@@ -226,9 +229,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
             if oriented:
                 R_tool, e_r, er = R_tool[..., active], e_r[:, active], er[active]
             active = active[active]
-            if live.size == 0:
-                break
-        if not active.any():
+        if not left:
             break
         # J columns: position z_i x (p_tool - p_i), rotation z_i (weighted, oriented targets only)
         J = _cross(z, t_tool[None] - p)  # (n, 3, b)
