@@ -185,10 +185,9 @@ def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True, local: bool = Fa
     c, s = np.cos(q), np.sin(q)
     if local:
         p[0], z[0, :2], z[0, 2] = 0.0, 0.0, 1.0
-        if n == 1:
-            R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
-            return p, z, R if rotation else None, t
         R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
+        if n == 1:
+            return p, z, R if rotation else None, t
         first = 1
     else:
         R, t = f.k_R[0], f.k_t[0]  # base_link is the identity: K_0 needs no product
