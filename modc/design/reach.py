@@ -138,13 +138,13 @@ def _ldl_solve(A: dict, b: list, n: int) -> np.ndarray:
         for k in range(i):
             yi = yi - L[i, k] * y[k]
         y.append(yi)
-    x: list = [None] * n
+    x = np.empty((n, len(d[0])))
     for i in range(n - 1, -1, -1):
         xi = y[i] / d[i]
         for k in range(i + 1, n):
             xi = xi - L[k, i] * x[k]
         x[i] = xi
-    return np.stack(x)
+    return x
 
 
 def _step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
@@ -166,8 +166,8 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _sq(v: np.ndarray) -> np.ndarray:
-    """|v|^2 along axis 0 of (3, B), the terms added in order."""
-    return v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+    """|v|^2 along axis 0 of (3, B)."""
+    return np.einsum("ib,ib->b", v, v)
 
 
 def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
@@ -237,7 +237,9 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
         if oriented:
             J = np.concatenate([J, w * runs.rotation_rows(z, R_tool)], axis=1)  # (n, 6, b)
             e = np.concatenate([e_p, w * e_r], axis=0)  # (6, b)
-        qn = np.minimum(np.maximum(q + _step(J, e, lam), lo), hi)
+        qn = _step(J, e, lam)
+        qn += q
+        np.minimum(np.maximum(qn, lo, out=qn), hi, out=qn)
         pn, zn, Rn, tn = forward_flat(f, qn, rotation=oriented, local=local)
         e_pn, e_rn, cost_n = _residual(runs, Rn, tn, oriented)
         ok = (cost_n < cost) & active
