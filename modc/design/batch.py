@@ -8,6 +8,7 @@ modc.kinematics.Chain stays the reference (tests compare the two).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,25 @@ class Geometry:
     @property
     def dof(self) -> int:
         return self.pre.shape[1]
+
+    @functools.cached_property
+    def joints(self) -> np.ndarray:
+        """K_0 = PRE_1, K_i = POST_i . PRE_(i+1), K_n = POST_n . tool (C, n+1, 4, 4): the transform
+        from one joint's rotation to the next. Computed once per geometry and carried by take(),
+        so the IK calls of one screen (a target and a seed at a time) share them."""
+        C, n = self.pre.shape[:2]
+        K = np.empty((C, n + 1, 4, 4))
+        K[:, 0] = self.pre[:, 0]
+        K[:, 1:n] = self.post[:, :-1] @ self.pre[:, 1:]
+        K[:, n] = self.post[:, -1] @ self.flange_tool
+        return K
+
+    def take(self, idx) -> Geometry:
+        """The candidates idx (with their joint transforms, when computed)."""
+        out = Geometry(self.pre[idx], self.post[idx], self.t1, self.flange_tool)
+        if "joints" in self.__dict__:
+            out.__dict__["joints"] = self.__dict__["joints"][idx]
+        return out
 
 
 def geometry(units, pivots: np.ndarray, ports: np.ndarray, links, tool_xyz, tool_rpy) -> Geometry:
@@ -107,12 +127,7 @@ class Flat:
 
     @classmethod
     def of(cls, g: Geometry, c_idx: np.ndarray) -> Flat:
-        C, n = g.pre.shape[:2]
-        K = np.empty((C, n + 1, 4, 4))
-        K[:, 0] = g.pre[:, 0]
-        K[:, 1:n] = g.post[:, :-1] @ g.pre[:, 1:]
-        K[:, n] = g.post[:, -1] @ g.flange_tool
-        Kc = K[c_idx]
+        Kc = g.joints[c_idx]
         return cls(np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, :3], 0, -1)),
                    np.ascontiguousarray(np.moveaxis(Kc[:, :, :3, 3], 0, -1)))
 
@@ -121,34 +136,77 @@ class Flat:
 
 
 def _rot(R, P):
-    """R . P for stacks (3, 3, B) of rotations."""
-    return np.stack([np.stack([R[i, 0] * P[0, k] + R[i, 1] * P[1, k] + R[i, 2] * P[2, k] for k in range(3)])
-                     for i in range(3)])
+    """R . P for stacks (3, 3, B) of rotations (einsum: several times faster here than broadcast
+    products, which stream (3, 3, B) temporaries)."""
+    return np.einsum("ijb,jkb->ikb", R, P)
 
 
 def _apply(R, v):
     """R . v for (3, 3, B) and (3, B)."""
-    return np.stack([R[i, 0] * v[0] + R[i, 1] * v[1] + R[i, 2] * v[2] for i in range(3)])
+    return np.einsum("ijb,jb->ib", R, v)
 
 
-def forward_flat(f: Flat, q: np.ndarray):
+def _rz_vec(c, s, v):
+    """Rz(theta) . v for (3, B) or, row by row, (3, 3, B): two rows mixed (written into one
+    array: a stack costs more than the arithmetic at a few hundred runs)."""
+    out = np.empty(v.shape)
+    np.subtract(c * v[0], s * v[1], out=out[0])
+    np.add(s * v[0], c * v[1], out=out[1])
+    out[2] = v[2]
+    return out
+
+
+def _rz_times(c, s, K_R, k_t):
+    """Rz(theta) . K for a rotation stack (3, 3, B) and a translation (3, B)."""
+    return _rz_vec(c, s, K_R), _rz_vec(c, s, k_t)
+
+
+def _turn(R, c, s):
+    """R . Rz(theta) for (3, 3, B): two columns mixed."""
+    out = np.empty(R.shape)
+    x, y = R[:, 0], R[:, 1]
+    np.add(c * x, s * y, out=out[:, 0])
+    np.subtract(c * y, s * x, out=out[:, 1])
+    out[:, 2] = R[:, 2]
+    return out
+
+
+def forward_flat(f: Flat, q: np.ndarray, rotation: bool = True, local: bool = False):
     """One run per column: q (n, B) -> joint origins and axes (n, 3, B), tool0's rotation (3, 3, B)
-    and position (3, B)."""
+    and position (3, B). Without rotation (a position-only solve) tool0's rotation is None and
+    the last joint costs three matrix-vector products, not a 3x3 product.
+
+    local: in joint 1's frame before its rotation (K_0 left out: joint 1 turns about z through
+    the origin), where the first products are Rz(q_1) . K_1 - two rows mixed, not a 3x3 product;
+    a caller that moves its targets into that frame gets the same distances."""
     n, B = q.shape
     p = np.empty((n, 3, B))
     z = np.empty((n, 3, B))
     c, s = np.cos(q), np.sin(q)
-    R, t = f.k_R[0].copy(), f.k_t[0]  # base_link is the identity: K_0 needs no product
-    for i in range(n):
-        if i:
+    if local:
+        p[0], z[0, :2], z[0, 2] = 0.0, 0.0, 1.0
+        R, t = _rz_times(c[0], s[0], f.k_R[1], f.k_t[1])
+        if n == 1:
+            return p, z, R if rotation else None, t
+        first = 1
+    else:
+        R, t = f.k_R[0], f.k_t[0]  # base_link is the identity: K_0 needs no product
+        first = 0
+    for i in range(first, n):
+        if i > first:
             t = t + _apply(R, f.k_t[i])
+            if i == n - 1 and not rotation:
+                # tool0 = t + R . K_i . Rz(q_i) . t(K_n)
+                p[i], z[i] = t, _apply(R, f.k_R[i][:, 2])
+                return p, z, None, t + _apply(R, _apply(f.k_R[i], _rz_vec(c[i], s[i], f.k_t[n])))
             R = _rot(R, f.k_R[i])
-        x, y = R[:, 0].copy(), R[:, 1]
-        R[:, 0] = c[i] * x + s[i] * y
-        R[:, 1] = c[i] * y - s[i] * x
+        elif i == n - 1 and not rotation:
+            p[i], z[i] = t, R[:, 2]
+            return p, z, None, t + _apply(R, _rz_vec(c[i], s[i], f.k_t[n]))
+        R = _turn(R, c[i], s[i])
         p[i] = t
         z[i] = R[:, 2]
-    return p, z, _rot(R, f.k_R[n]), t + _apply(R, f.k_t[n])
+    return p, z, _rot(R, f.k_R[n]) if rotation else None, t + _apply(R, f.k_t[n])
 
 
 def rotation_error(R_target: np.ndarray, R: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ the cell and against themselves beyond the SRDF's disabled pairs). A faster phys
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -56,16 +57,30 @@ class Screened:
     the closest position error (C, T), whether an IK run got within tolerance at all (C, T,
     collisions aside), whether the target was tried; per feasible candidate its worst error as
     a share of the tolerance (0: dead on, 1: at the edge) and the joint vectors that pass the
-    screen, best first."""
+    screen, best first (solution(j), built on demand: a search keeps a few of thousands)."""
 
     feasible: np.ndarray
     score: np.ndarray
     closest: np.ndarray
-    solutions: list[list[list[np.ndarray]]] = field(default_factory=list)
     hit: np.ndarray = field(default_factory=lambda: np.zeros(0))
     tried: np.ndarray = field(default_factory=lambda: np.zeros(0))
     worst: np.ndarray = field(default_factory=lambda: np.zeros(0))
     reached: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (C, T): within tolerance, clear of the cell
+    runs: tuple = ()  # q (C, T, S, n), ratio (C, T, S), passed (C, T, S) of every run
+
+    def solution(self, j: int) -> list[list[np.ndarray]]:
+        """The j-th feasible candidate's joint vectors per target, best first."""
+        q, ratio, passed = self.runs
+        cand = int(np.flatnonzero(self.feasible)[j])
+        out = []
+        for t in range(ratio.shape[1]):
+            order = np.argsort(ratio[cand, t] + 1e3 * ~passed[cand, t], kind="stable")
+            out.append([q[cand, t, s] for s in order if passed[cand, t, s]])
+        return out
+
+    @functools.cached_property
+    def solutions(self) -> list[list[list[np.ndarray]]]:
+        return [self.solution(j) for j in range(int(self.feasible.sum()))]
 
 
 def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
@@ -115,7 +130,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
             # iterations more than its runs)
             group = seeds if seeds[0] < SEEDS and need.size <= FEW else seeds[:1]
             seeds = seeds[len(group):]
-            sub = Geometry(g.pre[need], g.post[need], g.t1, g.flange_tool)
+            sub = g.take(need)
             start = q[need, warm, hit[need, warm].argmax(-1)][:, None] if group == [SEEDS] else q0[group]
             qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), start, lo, hi)
             got = np.zeros(need.size, bool)
@@ -128,7 +143,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
                 if h.any() and len(spec.obstacles.shape):
                     # only the runs that reached their target are worth a collision test
                     c = np.flatnonzero(h)
-                    one = Geometry(sub.pre[c], sub.post[c], g.t1, g.flange_tool)
+                    one = sub.take(c)
                     _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
                     h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
                 q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r
@@ -141,16 +156,10 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     # how far from feasible: metres missed on the targets tried, plus a metre per target not reached
     excess = np.where(np.isfinite(closest), np.maximum(closest - tg.tol_p[None], 0.0), 0.0)
     score = np.where(feasible, 0.0, excess.sum(-1) + (~reached).sum(-1) * 1.0)
-    sols, worst = [], []
-    for cand in np.flatnonzero(feasible):
-        per_target = []
-        for t in range(T):
-            order = np.argsort(ratio[cand, t] + 1e3 * ~hit[cand, t], kind="stable")
-            per_target.append([q[cand, t, s] for s in order if hit[cand, t, s]])
-        sols.append(per_target)
-        worst.append(max(float(ratio[cand, t][hit[cand, t]].min()) for t in range(T)))
-    return Screened(np.asarray(feasible), np.asarray(score), closest, sols, ik_hit, tried, np.asarray(worst, float),
-                    np.asarray(reached))
+    # the worst target's best run that passed, as a share of the tolerance (min and max are exact)
+    worst = np.where(hit[feasible], ratio[feasible], np.inf).min(-1).max(-1) if T else np.zeros(int(feasible.sum()))
+    return Screened(np.asarray(feasible), np.asarray(score), closest, ik_hit, tried, np.asarray(worst, float),
+                    np.asarray(reached), (q, ratio, hit))
 
 
 @dataclass(frozen=True)

@@ -105,16 +105,6 @@ class _Runs:
         out.any_oriented, out.any_pointed = self.any_oriented, self.any_pointed
         return out
 
-    def residual(self, R_tool, t_tool):
-        e_p = self.xyz - t_tool
-        if self.any_oriented:
-            e_r = _rotation_error(self.R, R_tool) * self.oriented
-            if self.any_pointed:
-                e_r = np.where(self.pointed, axis_error(R_tool[:, 0], self.axis), e_r)
-        else:
-            e_r = np.zeros_like(e_p)
-        return e_p, e_r
-
     def rotation_rows(self, z, R_tool):
         """The rotation rows of J (n, 3, b): the joint axes z; for a `pointing` run without their
         part about tool0's x axis (turning about it changes nothing the target asks for)."""
@@ -125,13 +115,69 @@ class _Runs:
         return Jr
 
 
+def _ldl_solve(A: dict, b: list, n: int) -> np.ndarray:
+    """x (n, B) with A x = b for B symmetric positive definite n x n systems at once (A: the upper
+    triangle, A[i, j] for i <= j, each (B,)): an LDL^T factorisation written out element-wise -
+    A = J^T J + lam I has lam > 0, so no pivot is needed - a few dozen vector operations where a
+    LAPACK call per system costs a microsecond each."""
+    L: dict = {}
+    d: list = []
+    for j in range(n):
+        dj = A[j, j]
+        for k in range(j):
+            dj = dj - L[j, k] * L[j, k] * d[k]
+        d.append(dj)
+        for i in range(j + 1, n):
+            a = A[j, i]
+            for k in range(j):
+                a = a - L[i, k] * L[j, k] * d[k]
+            L[i, j] = a / dj
+    y: list = []
+    for i in range(n):
+        yi = b[i]
+        for k in range(i):
+            yi = yi - L[i, k] * y[k]
+        y.append(yi)
+    x = np.empty((n, len(d[0])))
+    for i in range(n - 1, -1, -1):
+        xi = y[i] / d[i]
+        for k in range(i + 1, n):
+            xi = xi - L[k, i] * x[k]
+        x[i] = xi
+    return x
+
+
+def _step(J: np.ndarray, e: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """The damped least-squares step dq (n, B): (J^T J + lam I) dq = J^T e, J (n, m, B), e (m, B)."""
+    n = J.shape[0]
+    JJ = np.einsum("ikb,jkb->ijb", J, J)
+    A = {(i, j): JJ[i, j] for i in range(n) for j in range(i, n)}
+    for i in range(n):
+        A[i, i] = A[i, i] + lam
+    return _ldl_solve(A, list(np.einsum("ikb,kb->ib", J, e)), n)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b along axis 1 of (n, 3, B) stacks."""
+    out = np.empty(a.shape)
+    for k, (i, j) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.subtract(a[:, i] * b[:, j], a[:, j] * b[:, i], out=out[:, k])
+    return out
+
+
+def _sq(v: np.ndarray) -> np.ndarray:
+    """|v|^2 along axis 0 of (3, B)."""
+    return np.einsum("ib,ib->b", v, v)
+
+
 def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
     """Runs from every seed q0 (S, n), or per candidate (C, S, n), towards every target, for
     every candidate of g. Returns q (C, T, S, n), position error (C, T, S) m, orientation error
     (C, T, S) rad.
 
     The runs are one flat batch; a run leaves it when it is within 1e-7 m (and 1e-6 rad) of its target or
-    stalls (its damping saturates), so late iterations cost only what is still moving."""
+    stalls (its damping saturates), so late iterations cost only what is still moving. Targets
+    without an orientation take a position-only path: no tool rotation, three residual rows."""
     C, n, T, S = g.pre.shape[0], g.dof, len(tg.names), q0.shape[-2]
     lo, hi = np.asarray(lower, float)[:, None], np.asarray(upper, float)[:, None]
     B = C * T * S
@@ -139,58 +185,84 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     t_idx = np.tile(np.repeat(np.arange(T), S), C)
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
-    ep_all, er_all = np.empty(B), np.empty(B)
+    ep_all, er_all = np.empty(B), np.zeros(B)
     w = ROTATION_WEIGHT
     live = np.arange(B)
     q = q_all.copy()
     f = Flat.of(g, c_idx)
     runs = _Runs(tg, t_idx)
-    # runs go on well inside the tolerances (LM converges quadratically there): reported errors are ~0
-    tol_p, tol_r = np.full(B, 1e-7), np.full(B, 1e-6)
+    oriented = runs.any_oriented
     # a run still STALL_FACTOR tolerances off that has not cut its cost by STALL_GAIN in STALL_EVERY
     # iterations leaves: the screen is a local search, and such runs end beyond the tolerance
     give_up = np.asarray(tg.tol_p, float)[t_idx] * STALL_FACTOR
     ref = np.full(B, np.inf)
-    p, z, R_tool, t_tool = forward_flat(f, q)
-    R_tool = np.array(R_tool)  # kept per run (the `pointing` rows of J need tool0's x axis)
-    e_p, e_r = runs.residual(R_tool, t_tool)
-    cost = (e_p ** 2).sum(0) + w * w * (e_r ** 2).sum(0)
+    if not oriented:  # position only: in joint 1's frame (batch.forward_flat, local)
+        d = runs.xyz - f.k_t[0]
+        runs.xyz = np.stack([f.k_R[0][0, k] * d[0] + f.k_R[0][1, k] * d[1] + f.k_R[0][2, k] * d[2] for k in range(3)])
+    local = not oriented
+    p, z, R_tool, t_tool = forward_flat(f, q, rotation=oriented, local=local)
+    e_p, e_r, cost = _residual(runs, R_tool, t_tool, oriented)
     lam = np.full(B, LAMBDA0)
     for it in range(iterations + 1):
-        ep, er = np.sqrt((e_p ** 2).sum(0)), np.sqrt((e_r ** 2).sum(0))
-        active = ((ep > tol_p) | (er > tol_r)) & (lam < 1e4) & (it < iterations)
+        # runs go on well inside the tolerances (LM converges quadratically there): reported errors are ~0
+        if oriented:
+            ep, er = np.sqrt(_sq(e_p)), np.sqrt(_sq(e_r))
+            active = ((ep > 1e-7) | (er > 1e-6)) & (lam < 1e4)
+        else:
+            ep = np.sqrt(cost)
+            active = (ep > 1e-7) & (lam < 1e4)
+        if it == iterations:
+            active[:] = False
         if it % STALL_EVERY == 0:
             if it >= 2 * STALL_EVERY:
                 active &= ~((cost > STALL_GAIN * ref) & (ep > give_up))
-            ref = cost.copy()
-        if active.sum() < 0.8 * active.size or not active.any():  # compaction costs: do it in steps
+            ref = cost
+        left = np.count_nonzero(active)
+        if left < 0.8 * active.size or not left:  # compaction costs: do it in steps
             gone = ~active
-            q_all[:, live[gone]], ep_all[live[gone]], er_all[live[gone]] = q[:, gone], ep[gone], er[gone]
+            q_all[:, live[gone]], ep_all[live[gone]] = q[:, gone], ep[gone]
+            if oriented:
+                er_all[live[gone]] = er[gone]
             live, q, f, runs = live[active], q[:, active], f.take(active), runs.take(active)
-            tol_p, tol_r, give_up, ref = tol_p[active], tol_r[active], give_up[active], ref[active]
-            p, z, t_tool, e_p, e_r = p[..., active], z[..., active], t_tool[:, active], e_p[:, active], e_r[:, active]
-            R_tool = R_tool[..., active]
-            cost, lam = cost[active], lam[active]
+            give_up, ref, cost, lam = give_up[active], ref[active], cost[active], lam[active]
+            p, z, t_tool, e_p = p[..., active], z[..., active], t_tool[:, active], e_p[:, active]
+            if oriented:
+                R_tool, e_r, er = R_tool[..., active], e_r[:, active], er[active]
             active = active[active]
-            if live.size == 0:
-                break
-        if not active.any():
+        if not left:
             break
         # J columns: position z_i x (p_tool - p_i), rotation z_i (weighted, oriented targets only)
-        Jp = np.cross(z, t_tool[None] - p, axis=1)  # (n, 3, b)
-        J = np.concatenate([Jp, w * runs.rotation_rows(z, R_tool)], axis=1)  # (n, 6, b)
-        e = np.concatenate([e_p, w * e_r], axis=0)  # (6, b)
-        A = np.einsum("ikb,jkb->bij", J, J)
-        A[:, np.arange(n), np.arange(n)] += lam[:, None]
-        rhs = np.einsum("ikb,kb->bi", J, e)
-        dq = np.linalg.solve(A, rhs[..., None])[..., 0].T
-        qn = np.clip(q + dq, lo, hi)
-        pn, zn, Rn, tn = forward_flat(f, qn)
-        e_pn, e_rn = runs.residual(Rn, tn)
-        cost_n = (e_pn ** 2).sum(0) + w * w * (e_rn ** 2).sum(0)
+        J = _cross(z, t_tool[None] - p)  # (n, 3, b)
+        e = e_p
+        if oriented:
+            J = np.concatenate([J, w * runs.rotation_rows(z, R_tool)], axis=1)  # (n, 6, b)
+            e = np.concatenate([e_p, w * e_r], axis=0)  # (6, b)
+        qn = _step(J, e, lam)
+        qn += q
+        np.minimum(np.maximum(qn, lo, out=qn), hi, out=qn)
+        pn, zn, Rn, tn = forward_flat(f, qn, rotation=oriented, local=local)
+        e_pn, e_rn, cost_n = _residual(runs, Rn, tn, oriented)
         ok = (cost_n < cost) & active
-        q[:, ok], p[..., ok], z[..., ok], t_tool[:, ok] = qn[:, ok], pn[..., ok], zn[..., ok], tn[:, ok]
-        R_tool[..., ok] = Rn[..., ok]
-        e_p[:, ok], e_r[:, ok], cost[ok] = e_pn[:, ok], e_rn[:, ok], cost_n[ok]
+        np.copyto(q, qn, where=ok)
+        np.copyto(p, pn, where=ok)
+        np.copyto(z, zn, where=ok)
+        np.copyto(t_tool, tn, where=ok)
+        np.copyto(e_p, e_pn, where=ok)
+        if oriented:
+            np.copyto(R_tool, Rn, where=ok)
+            np.copyto(e_r, e_rn, where=ok)
+        cost = np.where(ok, cost_n, cost)
         lam = np.where(ok, np.maximum(lam / 3.0, 1e-9), lam * 4.0)
     return q_all.T.reshape(C, T, S, n), ep_all.reshape(C, T, S), er_all.reshape(C, T, S)
+
+
+def _residual(runs: _Runs, R_tool, t_tool, oriented: bool):
+    """Position and rotation residuals and the cost |e_p|^2 + w^2 |e_r|^2 (no rotation part for
+    position-only runs: e_r None)."""
+    e_p = runs.xyz - t_tool
+    if not oriented:
+        return e_p, None, _sq(e_p)
+    e_r = _rotation_error(runs.R, R_tool) * runs.oriented
+    if runs.any_pointed:
+        e_r = np.where(runs.pointed, axis_error(R_tool[:, 0], runs.axis), e_r)
+    return e_p, e_r, _sq(e_p) + ROTATION_WEIGHT * ROTATION_WEIGHT * _sq(e_r)

@@ -96,17 +96,20 @@ def shape_seed(seed: int, shape: Shape) -> int:
     return zlib.crc32(f"{seed}:{shape.label()}".encode()) & 0x7FFFFFFF
 
 
-def _complexity(pivots, ports) -> tuple:
-    """Simplest first: fewest twists set, then the smallest angles, then the values."""
-    vals = np.concatenate([pivots, ports])
-    return (int(np.count_nonzero(np.abs(vals) > 1e-9)), round(float(np.abs(vals).sum()), 9),
-            tuple(round(float(v), 9) for v in vals))
+def _keys(worst, pivots: np.ndarray, ports: np.ndarray) -> list[tuple]:
+    """order_key of settings (rows of pivots and ports) with these worst shares, without building
+    their Found: simplest first is fewest twists set, then the smallest angles, then the values."""
+    vals = np.concatenate([pivots, ports], axis=1)
+    count = np.count_nonzero(np.abs(vals) > 1e-9, axis=1)
+    total = np.abs(vals).sum(1)
+    return [(round(float(w), 2), int(c), round(float(a), 9), tuple(round(float(v), 9) for v in row))
+            for w, c, a, row in zip(worst, count, total, vals, strict=True)]
 
 
 def order_key(f: Found) -> tuple:
     """Deepest inside the tolerances first (to 1 % of a tolerance: IK runs end ~1e-7 m off a
     reachable target, and such differences mean nothing), then simplest."""
-    return (round(f.worst, 2), *_complexity(np.array(f.pivots), np.array(f.ports)))
+    return _keys([f.worst], np.array([f.pivots]), np.array([f.ports]))[0]
 
 
 def _coarse_index(count: int, i0: int, stride: int) -> list[int]:
@@ -346,19 +349,42 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         if not ok.any():
             continue
         k = np.flatnonzero(ok)
-        sub = type(g)(g.pre[k], g.post[k], g.t1, g.flange_tool)
+        sub = g.take(k)
         s = screen_batch(spec, shape, piv[k], por[k], s0, g=sub)
         screened += len(k)
         closest = np.minimum(closest, s.closest.min(0))
         hit |= s.hit.any(0)
         clear |= s.reached.any(0)
-        for j, c in enumerate(np.flatnonzero(s.feasible)):
-            sols = tuple(tuple(tuple(float(x) for x in q) for q in per) for per in s.solutions[j])
-            found.append(Found(tuple(float(x) for x in piv[k[c]]), tuple(float(x) for x in por[k[c]]), sols,
-                               float(s.worst[j])))
-        found = sorted(found, key=order_key)[:KEEP]
+        found = _keep(found, s, piv[k], por[k])
     return Part(shape, lo, hi, upto, tuple(found), screened, excluded, tuple(float(x) for x in closest),
                 tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), full)
+
+
+def _keep(found: list[Found], s, piv: np.ndarray, por: np.ndarray) -> list[Found]:
+    """The KEEP best of found and the block's feasible settings (screened as s, twists piv, por),
+    by order_key; a Found is built only for the settings kept (a block can pass thousands)."""
+    cand = np.flatnonzero(s.feasible)
+    if cand.size == 0:
+        return found
+    entries: list[tuple[tuple, int, Found | None]] = [(order_key(f), -1, f) for f in found]
+    # the keys' first two parts (worst to 1 %, twists set) first: a setting with KEEP others
+    # strictly ahead on them cannot be kept, and needs no full key
+    vals = np.concatenate([piv[cand], por[cand]], axis=1)
+    head = list(zip([round(float(w), 2) for w in s.worst], np.count_nonzero(np.abs(vals) > 1e-9, axis=1).tolist(),
+                    strict=True))
+    cut = sorted([e[0][:2] for e in entries] + head)[KEEP - 1] if len(entries) + len(head) >= KEEP else None
+    near = [j for j, h in enumerate(head) if cut is None or h <= cut]
+    keys = _keys(s.worst[near], piv[cand[near]], por[cand[near]])
+    entries += [(key, j, None) for j, key in zip(near, keys, strict=True)]
+    best = sorted(entries, key=lambda e: e[0])[:KEEP]  # stable: the order the old list had on ties
+    out = []
+    for _, j, f in best:
+        if f is None:
+            c = cand[j]
+            sols = tuple(tuple(tuple(float(x) for x in q) for q in per) for per in s.solution(j))
+            f = Found(tuple(float(x) for x in piv[c]), tuple(float(x) for x in por[c]), sols, float(s.worst[j]))
+        out.append(f)
+    return out
 
 
 Work = tuple[Shape, tuple[tuple[int, int], ...], bool | tuple]  # a shape, ranges, what they index (see _listed)
