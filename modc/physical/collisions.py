@@ -27,8 +27,11 @@ three things, none of which can change a result:
      reason is certain: one collision -> not Never, and then more than 5 % free samples -> not
      Always (it stays enabled); >= 95 % collisions -> Always. Never pairs see every sample.
   2. a vectorised broad phase: forward kinematics of all samples at once in numpy, then a
-     bounding sphere per link and per mesh (plus a 1 mm margin). A sphere contains its mesh, so
-     spheres apart => meshes apart; only samples where some spheres of a pair touch reach coal.
+     bounding sphere per link and per mesh (plus a 1 mm margin), then, for meshes whose spheres
+     touch, their bounding boxes in their own frames (oriented boxes, the same margin, the
+     separating axis test). A sphere or box contains its mesh, so spheres or boxes apart =>
+     meshes apart; only samples where some boxes of a pair touch reach coal (on the farm arm,
+     none of the 2,887 whose spheres touched: the box saves ~2,900 exact tests, ~40 ms).
      (Bounding volumes are only a filter: classifying with them alone -- or with convex hulls --
      would be conservative for Never but would wrongly disable pairs as Default or Always.)
   3. the exact test of a link pair is one pinocchio call over all its mesh pairs, stopping at
@@ -260,16 +263,24 @@ class _Checker:
                 for j in ib:
                     sub.addCollisionPair(pin.CollisionPair(i, j))
             self.exact.append((sub, sub.createData()))
-        # a bounding sphere per mesh and per link, in the frame of the joint that carries it
+        # a bounding sphere per mesh and per link, in the frame of the joint that carries it, and a
+        # box per mesh (its bounding box in its own frame, grown by half the margin on every side)
         self.spheres: dict[int, tuple[int, np.ndarray, float]] = {}  # geometry index -> sphere
         self.link_spheres: dict[str, tuple[int, np.ndarray, float]] = {}
+        n_geo = len(gm.geometryObjects)
+        self.box_joint = np.zeros(n_geo, int)
+        self.box_R, self.box_c, self.box_h = np.zeros((n_geo, 3, 3)), np.zeros((n_geo, 3)), np.zeros((n_geo, 3))
         for link in sorted({name for pr in pairs for name in pr}, key=geo.links.index):
             pts = []
             for k in geo.objects[link]:
                 o = gm.geometryObjects[k]
-                v = hull_points(o.geometry) @ np.asarray(o.placement.rotation).T
-                v += np.asarray(o.placement.translation)
+                local = hull_points(o.geometry)
+                Rk, tk = np.asarray(o.placement.rotation), np.asarray(o.placement.translation)
+                v = local @ Rk.T + tk
                 self.spheres[k] = (o.parentJoint, *enclosing_sphere(v))
+                lo, hi = local.min(axis=0), local.max(axis=0)
+                self.box_joint[k], self.box_R[k] = o.parentJoint, Rk
+                self.box_c[k], self.box_h[k] = Rk @ ((lo + hi) / 2) + tk, (hi - lo) / 2 + SPHERE_MARGIN / 2
                 pts.append(v)
             assert len({gm.geometryObjects[k].parentJoint for k in geo.objects[link]}) == 1
             joint = gm.geometryObjects[geo.objects[link][0]].parentJoint
@@ -304,13 +315,41 @@ class _Checker:
             rows = np.flatnonzero(d2 < (lr[lcol[a]] + lr[lcol[b]] + SPHERE_MARGIN) ** 2)
             if rows.size == 0:
                 continue
-            ia = [mcol[m] for m in self.geo.objects[a]]
-            ib = [mcol[m] for m in self.geo.objects[b]]
+            ga, gb = self.geo.objects[a], self.geo.objects[b]
+            ia = [mcol[m] for m in ga]
+            ib = [mcol[m] for m in gb]
             ca, cb = mc[rows][:, ia], mc[rows][:, ib]
             d2 = ((ca[:, :, None, :] - cb[:, None, :, :]) ** 2).sum(axis=-1)
             reach = (mr[ia][:, None] + mr[ib][None, :] + SPHERE_MARGIN) ** 2
-            mask[rows, k] = (d2 < reach).any(axis=(1, 2))
+            r, i, j = np.nonzero(d2 < reach)  # mesh pairs whose spheres touch: do their boxes?
+            near = ~self._boxes_apart(R, p, rows[r], np.asarray(ga)[i], np.asarray(gb)[j])
+            mask[rows[r[near]], k] = True
         return mask
+
+    def _boxes_apart(self, R: np.ndarray, p: np.ndarray, n: np.ndarray, ga: np.ndarray,
+                     gb: np.ndarray) -> np.ndarray:
+        """(M,) bool: are the boxes of meshes ga[m] and gb[m] apart in sample n[m]? The separating
+        axis test of two oriented boxes (15 axes), each box holding its mesh with half the margin to
+        spare on every side; |R| is taken 1e-9 larger, so rounding can only make boxes touch."""
+        Ra = R[n, self.box_joint[ga]] @ self.box_R[ga]  # (M, 3, 3): box axes in the world, as columns
+        Rb = R[n, self.box_joint[gb]] @ self.box_R[gb]
+        ca = (R[n, self.box_joint[ga]] @ self.box_c[ga][:, :, None])[:, :, 0] + p[n, self.box_joint[ga]]
+        cb = (R[n, self.box_joint[gb]] @ self.box_c[gb][:, :, None])[:, :, 0] + p[n, self.box_joint[gb]]
+        ha, hb = self.box_h[ga], self.box_h[gb]
+        C = Ra.transpose(0, 2, 1) @ Rb  # b's axes in a's frame
+        t = (Ra.transpose(0, 2, 1) @ (cb - ca)[:, :, None])[:, :, 0]  # b's centre in a's frame
+        A = np.abs(C) + 1e-9
+        apart = (np.abs(t) > ha + (A @ hb[:, :, None])[:, :, 0]).any(axis=1)  # a's axes
+        tb = (C.transpose(0, 2, 1) @ t[:, :, None])[:, :, 0]
+        apart |= (np.abs(tb) > (A.transpose(0, 2, 1) @ ha[:, :, None])[:, :, 0] + hb).any(axis=1)  # b's axes
+        for i in range(3):  # a_i x b_j
+            i1, i2 = (i + 1) % 3, (i + 2) % 3
+            for j in range(3):
+                j1, j2 = (j + 1) % 3, (j + 2) % 3
+                reach = (ha[:, i1] * A[:, i2, j] + ha[:, i2] * A[:, i1, j]
+                         + hb[:, j1] * A[:, i, j2] + hb[:, j2] * A[:, i, j1])
+                apart |= np.abs(t[:, i2] * C[:, i1, j] - t[:, i1] * C[:, i2, j]) > reach
+        return apart
 
     def set_configuration(self, q: np.ndarray) -> None:
         self.pin.forwardKinematics(self.geo.model, self.data, q)
