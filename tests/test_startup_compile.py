@@ -146,3 +146,23 @@ def test_the_box_test_finds_touching_and_apart_boxes():
     d = 0.5 + 0.5 * np.sqrt(2)  # a box turned 45 deg reaches 0.707 along x
     assert apart((d + 0.01, 0, 0), np.pi / 4) and not apart((d - 0.01, 0, 0), np.pi / 4)
     assert not apart((0.7, 0.7, 0), 0)  # overlapping along both x and y
+
+
+def test_unique_rows_merges_as_np_unique_did():
+    """meshes.unique_rows (rows as bytes) keeps np.unique(axis=0)'s first occurrences and
+    inverse up to the order of the unique rows, which every caller sets by first appearance;
+    -0.0 and 0.0 are one value, as numbers."""
+    import numpy as np
+
+    from modc.physical.meshes import unique_rows
+
+    rng = np.random.default_rng(1)
+    for a in (rng.integers(-3, 3, size=(400, 3)), rng.integers(-2, 2, size=(300, 3)).astype(np.float32) * 0.5,
+              np.array([[0.0, -0.0, 1.0], [-0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [1.0, 0.0, -0.0]], np.float32)):
+        _, first0, inverse0 = np.unique(a, axis=0, return_index=True, return_inverse=True)
+        first, inverse = unique_rows(a)
+        order0, order = np.argsort(first0), np.argsort(first)
+        assert np.array_equal(first0[order0], first[order])
+        rank0, rank = np.empty_like(order0), np.empty_like(order)
+        rank0[order0], rank[order] = np.arange(len(order0)), np.arange(len(order))
+        assert np.array_equal(rank0[inverse0.reshape(-1)], rank[inverse])

@@ -23,7 +23,7 @@ from ..kinematics import rpy_matrix
 from ..model import Robot
 from .assembly import Description
 from .constants import GRAVITY_VECTOR
-from .meshes import tessellate
+from .meshes import tessellate, unique_rows
 from .parts import Part
 
 ROOT = "base_link"
@@ -104,7 +104,7 @@ def _mesh_arrays(part: Part) -> tuple[np.ndarray, np.ndarray]:
     corners merged into one vertex in order of first appearance (assimp's JoinIdenticalVertices)."""
     vertices, faces, _ = tessellate(part)
     corners = vertices[faces].reshape(-1, 3).astype(np.float32)
-    unique, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
+    first, inverse = unique_rows(corners)
     order = np.argsort(first)
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
