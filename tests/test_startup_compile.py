@@ -166,3 +166,75 @@ def test_unique_rows_merges_as_np_unique_did():
         rank0, rank = np.empty_like(order0), np.empty_like(order)
         rank0[order0], rank[order] = np.arange(len(order0)), np.arange(len(order))
         assert np.array_equal(rank0[inverse0.reshape(-1)], rank[inverse])
+
+
+def _example_robots():
+    from conftest import EXAMPLES
+
+    from modc.compiler import check_file
+
+    return [r for f in EXAMPLES for r in check_file(f).design.resolved_robots()]
+
+
+def test_the_numpy_gravity_derivatives_are_pinocchios():
+    """Statics.gravity_with_jacobians equals pinocchio's g(q) and dg/dq (the reference) on every
+    example arm, a tilted base and another payload included."""
+    import numpy as np
+
+    from modc.compiler import check_text
+    from modc.dynamics.model import Dynamics, with_payload
+    from modc.physical.assembly import describe
+    from modc.physical.statics import Statics
+
+    text = ("robot t {\n    chain H1 - L4(port=30deg) - L3\n    base at (0, 0, 0.1) m rpy (20, -35, 10) deg\n"
+            "    payload 200 g at (0.01, 0.02, 0) m\n}\n")
+    (tilted,) = check_text(text, "t.mod").design.resolved_robots()
+    loads = []
+    for robot in [*_example_robots(), tilted]:
+        for payload in (None, (0.3, (0.0, 0.01, 0.02))):
+            statics = Statics(robot, describe(with_payload(robot, payload)))
+            dyn = Dynamics(robot, payload)
+            assert np.array_equal(statics.lower, dyn.lower) and np.array_equal(statics.upper, dyn.upper)
+            Q = np.random.default_rng(5).uniform(dyn.lower, dyn.upper, size=(40, robot.dof))
+            G, J = statics.gravity_with_jacobians(Q)
+            assert np.allclose(G, dyn.gravities(Q), rtol=0, atol=1e-11)
+            assert np.allclose(J, dyn.gravity_with_jacobians(Q)[1], rtol=0, atol=1e-11)
+            loads.append(np.abs(G).max())
+    assert min(loads[-2:]) > 0.1 and sum(x > 0.1 for x in loads) > len(loads) // 2  # real loads (a planar arm has none)
+
+
+def test_the_worst_case_on_the_numpy_statics_reports_what_pinocchio_does():
+    """The compile's torque search (numpy statics) and the reference (pinocchio) give the same
+    report on every example arm: same worst torques (to 1e-9 N·m) and poses (to 1e-9 rad)."""
+    from modc.dynamics.worst import Dynamics, worst_case
+    from modc.physical.statics import Statics
+
+    for robot in _example_robots():
+        fast, ref = worst_case(Statics(robot)), worst_case(Dynamics(robot))
+        assert [j.to_json() for j in fast] == [j.to_json() for j in ref]
+        for a, b in zip(fast, ref, strict=True):
+            assert abs(a.tau - b.tau) < 1e-9 and max(abs(x - y) for x, y in zip(a.q, b.q, strict=True)) < 1e-9
+
+
+def test_the_collision_matrix_needs_no_pinocchio_and_equals_the_naive_one(tmp_path):
+    """collisions.geometry + compute run on numpy and coal alone (a fresh process imports no
+    pinocchio), and classify every example arm's pairs as compute_naive (pinocchio) does."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from modc.compiler import check_file; from modc.physical.assembly import describe;"
+            "from modc.physical.collisions import compute, geometry;"
+            f"(r,) = check_file({str(FARM)!r}).design.resolved_robots();"
+            "m = compute(geometry(describe(r)), samples=300);"
+            "print('pinocchio' in sys.modules, 'coal' in sys.modules, len(m.disabled) > 0)")
+    env = {"PYTHONPATH": str(ROOT), "MODC_CACHE_DIR": str(tmp_path), "PATH": "/usr/bin:/bin"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["False", "True", "True"]
+
+    from modc.physical import collisions
+    from modc.physical.assembly import describe
+
+    for robot in _example_robots():
+        geo = collisions.geometry(describe(robot))
+        assert collisions.compute(geo, samples=1200, seed=4) == collisions.compute_naive(geo, samples=1200, seed=4)

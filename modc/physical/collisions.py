@@ -43,7 +43,7 @@ the filter's margin keeps near-contacts out of the broad phase's hands).
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -103,32 +103,103 @@ class CollisionMatrix:
         return None
 
 
+@dataclass(frozen=True)
+class Joints:
+    """An arm's joints for numpy forward kinematics (every one revolute): per joint j (0: the
+    universe) its parent, its frame at q = 0 in the parent's frame (R, t), its axis and q index."""
+
+    parents: tuple[int, ...]
+    R: np.ndarray  # (nj, 3, 3)
+    t: np.ndarray  # (nj, 3)
+    axis: np.ndarray  # (nj, 3), unit
+    idx_q: tuple[int, ...]
+    lower: np.ndarray  # (nq,) position limits as the model has them (joint_limits() cleans them)
+    upper: np.ndarray
+
+
 @dataclass
 class Geometry:
-    """A pinocchio model and collision GeometryModel of one arm, plus its link graph."""
+    """An arm's collision model: its link graph, its joints (numpy forward kinematics; None: other
+    joint types, pinocchio's) and its collision meshes placed on the joints. compute() needs no
+    more and imports no pinocchio; model and geom_model (pinocchio's Model and GeometryModel of
+    the same arm) are built on first use."""
 
-    model: Any  # pin.Model
-    geom_model: Any  # pin.GeometryModel (collision meshes)
     links: tuple[str, ...]
     edges: tuple[tuple[str, str], ...]  # (parent, child) per URDF joint
-    objects: dict[str, list[int]]  # link -> indices into geom_model.geometryObjects
+    objects: dict[str, list[int]]  # link -> indices into meshes (and geom_model.geometryObjects)
+    joints: Joints | None
+    meshes: list[tuple[int, np.ndarray, np.ndarray, Any]]  # (joint, R, t in the joint's frame, coal geometry)
+    pin_models: Callable[[], tuple[Any, Any]] = field(repr=False, compare=False)
+    _pin: tuple[Any, Any] | None = field(default=None, repr=False, compare=False)
 
     @property
     def geometry_links(self) -> tuple[str, ...]:
         return tuple(name for name in self.links if self.objects.get(name))
 
+    @property
+    def model(self) -> Any:
+        """pin.Model"""
+        if self._pin is None:
+            self._pin = self.pin_models()
+        return self._pin[0]
+
+    @property
+    def geom_model(self) -> Any:
+        """pin.GeometryModel (collision meshes)"""
+        self.model  # noqa: B018 - builds both
+        assert self._pin is not None
+        return self._pin[1]
+
 
 def geometry(desc: Description) -> Geometry:
-    """The arm's collision model, built in memory from its Description (no files)."""
+    """The arm's collision model, built in memory from its Description (no files, no pinocchio:
+    the same joints, meshes and placements as multibody.model and multibody.geometry make)."""
     from . import multibody
 
-    model = multibody.model(desc)
-    geom_model = multibody.geometry(desc, model)
+    placed = multibody.link_frames(desc)
+    parents, Ms, lower, upper = [0], [np.eye(4)], [], []
+    for j in desc.joints:
+        if j.kind == "revolute":
+            assert j.limits is not None
+            parents.append(placed[j.parent][0])
+            Ms.append(placed[j.parent][1] @ j.T_parent_child)
+            lower.append(j.limits.lower)
+            upper.append(j.limits.upper)
+    M = np.array(Ms)
+    nj = len(parents)
+    joints = Joints(tuple(parents), M[:, :3, :3], M[:, :3, 3], np.tile([0.0, 0.0, 1.0], (nj, 1)),
+                    tuple(range(-1, nj - 1)), np.array(lower, float), np.array(upper, float))
     links = tuple(link.name for link in desc.links)
     objects: dict[str, list[int]] = {name: [] for name in links}
-    for i, go in enumerate(geom_model.geometryObjects):
-        objects[model.frames[go.parentFrame].name].append(i)
-    return Geometry(model, geom_model, links, tuple((j.parent, j.child) for j in desc.joints), objects)
+    meshes: list[tuple[int, np.ndarray, np.ndarray, Any]] = []
+    for link in desc.links:  # multibody.geometry's order
+        joint, T = placed[link.name]
+        for v in link.visuals:
+            P = T @ v.T_link_part
+            objects[link.name].append(len(meshes))
+            meshes.append((joint, P[:3, :3], P[:3, 3], multibody.bvh(v.part)))
+
+    def pin_models() -> tuple[Any, Any]:
+        model = multibody.model(desc)
+        return model, multibody.geometry(desc, model)
+
+    return Geometry(links, tuple((j.parent, j.child) for j in desc.joints), objects, joints, meshes, pin_models)
+
+
+def _joints_of(model) -> Joints | None:
+    """A pinocchio model's joints, when every one is revolute (else None)."""
+    kinds = [model.joints[j].shortname() for j in range(1, model.njoints)]
+    if not all(k in _REVOLUTE_AXES or k == "JointModelRevoluteUnaligned" for k in kinds):
+        return None
+    axes = [np.array([0.0, 0.0, 1.0])]
+    for j in range(1, model.njoints):
+        known = _REVOLUTE_AXES.get(model.joints[j].shortname())
+        axes.append(np.asarray(model.joints[j].extract().axis if known is None else known, float))
+    return Joints(tuple(model.parents), np.array([np.asarray(M.rotation) for M in model.jointPlacements]),
+                  np.array([np.asarray(M.translation) for M in model.jointPlacements]),
+                  np.array([a / np.linalg.norm(a) for a in axes]),
+                  (-1, *(model.joints[j].idx_q for j in range(1, model.njoints))),
+                  np.array(model.lowerPositionLimit, float), np.array(model.upperPositionLimit, float))
 
 
 def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
@@ -155,9 +226,12 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
     edges = tuple((str(j.find("parent").get("link")), str(j.find("child").get("link")))  # type: ignore[union-attr]
                   for j in xml.findall("joint"))
     objects: dict[str, list[int]] = {name: [] for name in links}
+    meshes: list[tuple[int, np.ndarray, np.ndarray, Any]] = []
     for i, go in enumerate(geom_model.geometryObjects):
         objects[model.frames[go.parentFrame].name].append(i)
-    return Geometry(model, geom_model, links, edges, objects)
+        meshes.append((go.parentJoint, np.asarray(go.placement.rotation), np.asarray(go.placement.translation),
+                       go.geometry))
+    return Geometry(links, edges, objects, _joints_of(model), meshes, lambda: (model, geom_model))
 
 
 def adjacent_pairs(links: tuple[str, ...], edges, has_geometry) -> set[frozenset[str]]:
@@ -181,8 +255,10 @@ def adjacent_pairs(links: tuple[str, ...], edges, has_geometry) -> set[frozenset
 
 
 def joint_limits(model) -> tuple[np.ndarray, np.ndarray]:
-    """Position limits to sample within; an unbounded (continuous) joint gets one turn."""
-    lo, hi = np.array(model.lowerPositionLimit, float), np.array(model.upperPositionLimit, float)
+    """Position limits to sample within (of a pin.Model or Joints); an unbounded (continuous)
+    joint gets one turn."""
+    lo, hi = (np.array(model.lower, float), np.array(model.upper, float)) if isinstance(model, Joints) else (
+        np.array(model.lowerPositionLimit, float), np.array(model.upperPositionLimit, float))
     bad = ~(np.isfinite(lo) & np.isfinite(hi)) | (np.abs(lo) > 1e10) | (np.abs(hi) > 1e10)
     lo[bad], hi[bad] = -np.pi, np.pi
     return lo, hi
@@ -207,6 +283,9 @@ def batch_placements(model, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Forward kinematics of N configurations at once: world rotation (N, njoints, 3, 3) and
     translation (N, njoints, 3) of every joint frame (index 0 = universe), as pinocchio's
     data.oMi. Revolute joints are done in numpy; any other joint type falls back to pinocchio."""
+    joints = _joints_of(model)
+    if joints is not None:
+        return placements(joints, Q)
     import pinocchio as pin
 
     N = Q.shape[0]
@@ -214,76 +293,72 @@ def batch_placements(model, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     R = np.empty((N, nj, 3, 3))
     p = np.empty((N, nj, 3))
     R[:, 0], p[:, 0] = np.eye(3), 0.0
-    kinds = [model.joints[j].shortname() for j in range(1, nj)]
-    if not all(k in _REVOLUTE_AXES or k == "JointModelRevoluteUnaligned" for k in kinds):
-        data = model.createData()
-        for n, q in enumerate(Q):
-            pin.forwardKinematics(model, data, q)
-            for j in range(1, nj):
-                R[n, j], p[n, j] = data.oMi[j].rotation, data.oMi[j].translation
-        return R, p
+    data = model.createData()
+    for n, q in enumerate(Q):
+        pin.forwardKinematics(model, data, q)
+        for j in range(1, nj):
+            R[n, j], p[n, j] = data.oMi[j].rotation, data.oMi[j].translation
+    return R, p
+
+
+def placements(joints: Joints, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """batch_placements in numpy, for revolute joints."""
+    N = Q.shape[0]
+    nj = len(joints.parents)
+    R = np.empty((N, nj, 3, 3))
+    p = np.empty((N, nj, 3))
+    R[:, 0], p[:, 0] = np.eye(3), 0.0
     for j in range(1, nj):
-        jm = model.joints[j]
-        known = _REVOLUTE_AXES.get(jm.shortname())
-        axis = np.asarray(jm.extract().axis if known is None else known, float)
-        M = model.jointPlacements[j]
-        parent = model.parents[j]
+        parent = joints.parents[j]
         Rpar = R[:, parent].reshape(N * 3, 3)
-        p[:, j] = p[:, parent] + (Rpar @ np.asarray(M.translation)).reshape(N, 3)
-        R0 = Rpar @ np.asarray(M.rotation)  # (N*3, 3): the joint frame at q = 0
+        p[:, j] = p[:, parent] + (Rpar @ joints.t[j]).reshape(N, 3)
+        R0 = Rpar @ joints.R[j]  # (N*3, 3): the joint frame at q = 0
         # R0 @ Rot(axis, q) = R0 + sin q (R0 K) + (1 - cos q) (R0 K^2)   (Rodrigues)
-        k = np.asarray(axis, float) / np.linalg.norm(axis)
+        k = joints.axis[j]
         K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
         R0K = R0 @ K
-        angle = Q[:, jm.idx_q]
+        angle = Q[:, joints.idx_q[j]]
         s_, c_ = np.repeat(np.sin(angle), 3)[:, None], np.repeat(1.0 - np.cos(angle), 3)[:, None]
         R[:, j] = (R0 + s_ * R0K + c_ * (R0K @ K)).reshape(N, 3, 3)
     return R, p
 
 
 class _Checker:
-    """Broad phase (bounding spheres, all samples at once in numpy) and exact mesh tests of
-    link pairs for one Geometry."""
+    """Broad phase (bounding spheres and boxes, all samples at once in numpy) and exact mesh tests
+    of link pairs (coal) for one Geometry."""
 
     def __init__(self, geo: Geometry, pairs: list[tuple[str, str]]):
-        import pinocchio as pin
+        import coal
 
-        self.pin = pin
+        self.coal = coal
         self.geo = geo
-        model, gm = geo.model, geo.geom_model
-        self.data = model.createData()
         self.pairs = pairs
-        # one small GeometryModel per link pair: all mesh pairs across the two links
-        self.exact = []
-        for a, b in pairs:
-            sub = pin.GeometryModel()
-            ia = [sub.addGeometryObject(gm.geometryObjects[k]) for k in geo.objects[a]]
-            ib = [sub.addGeometryObject(gm.geometryObjects[k]) for k in geo.objects[b]]
-            for i in ia:
-                for j in ib:
-                    sub.addCollisionPair(pin.CollisionPair(i, j))
-            self.exact.append((sub, sub.createData()))
+        # pinocchio's collision request (GeometryData's): one contact is enough, no contact points
+        self.request = coal.CollisionRequest()
+        self.request.enable_contact = False
+        self.exact = [[(i, j) for i in geo.objects[a] for j in geo.objects[b]] for a, b in pairs]
+        self._at: tuple[np.ndarray, np.ndarray] | None = None  # joint placements of the last set_configuration
+        self._placed: dict[int, Any] = {}  # mesh -> its coal.Transform3s there
         # a bounding sphere per mesh and per link, in the frame of the joint that carries it, and a
         # box per mesh (its bounding box in its own frame, grown by half the margin on every side)
         self.spheres: dict[int, tuple[int, np.ndarray, float]] = {}  # geometry index -> sphere
         self.link_spheres: dict[str, tuple[int, np.ndarray, float]] = {}
-        n_geo = len(gm.geometryObjects)
+        n_geo = len(geo.meshes)
         self.box_joint = np.zeros(n_geo, int)
         self.box_R, self.box_c, self.box_h = np.zeros((n_geo, 3, 3)), np.zeros((n_geo, 3)), np.zeros((n_geo, 3))
         for link in sorted({name for pr in pairs for name in pr}, key=geo.links.index):
             pts = []
             for k in geo.objects[link]:
-                o = gm.geometryObjects[k]
-                local = hull_points(o.geometry)
-                Rk, tk = np.asarray(o.placement.rotation), np.asarray(o.placement.translation)
+                joint, Rk, tk, shape = geo.meshes[k]
+                local = hull_points(shape)
                 v = local @ Rk.T + tk
-                self.spheres[k] = (o.parentJoint, *enclosing_sphere(v))
+                self.spheres[k] = (joint, *enclosing_sphere(v))
                 lo, hi = local.min(axis=0), local.max(axis=0)
-                self.box_joint[k], self.box_R[k] = o.parentJoint, Rk
+                self.box_joint[k], self.box_R[k] = joint, Rk
                 self.box_c[k], self.box_h[k] = Rk @ ((lo + hi) / 2) + tk, (hi - lo) / 2 + SPHERE_MARGIN / 2
                 pts.append(v)
-            assert len({gm.geometryObjects[k].parentJoint for k in geo.objects[link]}) == 1
-            joint = gm.geometryObjects[geo.objects[link][0]].parentJoint
+            assert len({geo.meshes[k][0] for k in geo.objects[link]}) == 1
+            joint = geo.meshes[geo.objects[link][0]][0]
             self.link_spheres[link] = (joint, *enclosing_sphere(np.vstack(pts)))
         self.exact_tests = 0
 
@@ -291,7 +366,7 @@ class _Checker:
         """(N, pairs) bool: may the two links touch in sample n? False is certain: every mesh
         lies in its sphere, spheres closer than SPHERE_MARGIN count as touching. Link spheres
         first, then the spheres of the meshes in the samples where those touch."""
-        R, p = batch_placements(self.geo.model, Q)
+        R, p = self.placements(Q)
         N = Q.shape[0]
 
         def world(spheres: dict) -> tuple[dict, np.ndarray, np.ndarray]:
@@ -351,16 +426,35 @@ class _Checker:
                 apart |= np.abs(t[:, i2] * C[:, i1, j] - t[:, i1] * C[:, i2, j]) > reach
         return apart
 
+    def placements(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        joints = self.geo.joints
+        return placements(joints, Q) if joints is not None else batch_placements(self.geo.model, Q)
+
     def set_configuration(self, q: np.ndarray) -> None:
-        self.pin.forwardKinematics(self.geo.model, self.data, q)
+        R, p = self.placements(np.asarray(q, float)[None])
+        self._at = (R[0], p[0])
+        self._placed = {}
+
+    def _transform(self, m: int) -> Any:
+        tf = self._placed.get(m)
+        if tf is None:
+            assert self._at is not None
+            R, p = self._at
+            joint, Rm, tm, _ = self.geo.meshes[m]
+            tf = self._placed[m] = self.coal.Transform3s(R[joint] @ Rm, R[joint] @ tm + p[joint])
+        return tf
 
     def collides(self, k: int) -> bool:
         """Exact test of link pair k (meshes, stop at the first colliding pair) at the
         configuration of the last set_configuration."""
-        sub, sub_data = self.exact[k]
-        self.pin.updateGeometryPlacements(self.geo.model, self.data, sub, sub_data)
         self.exact_tests += 1
-        return bool(self.pin.computeCollisions(sub, sub_data, True))
+        meshes = self.geo.meshes
+        for i, j in self.exact[k]:
+            result = self.coal.CollisionResult()
+            if self.coal.collide(meshes[i][3], self._transform(i), meshes[j][3], self._transform(j), self.request,
+                                 result):
+                return True
+        return False
 
 
 def _sample(checker: _Checker, n: int, active: list[int], Q: np.ndarray, samples: int,
@@ -430,8 +524,7 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
     reasons: dict[tuple[str, str], str] = {p: "Adjacent" for p in all_pairs if frozenset(p) in adjacent}
     candidates = [p for p in all_pairs if p not in reasons]
 
-    model = geo.model
-    lower, upper = joint_limits(model)
+    lower, upper = joint_limits(geo.joints if geo.joints is not None else geo.model)
     q0 = default_configuration(lower, upper)
     counts: dict[tuple[str, str], tuple[int, int]] = {}
     stats = {"pairs": len(all_pairs), "sampled_pairs": 0, "samples_run": 0, "broad_phase_hits": 0, "exact_tests": 0}
@@ -533,5 +626,6 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
 
 
 __all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "UNCHECKED_REASONS", "CollisionMatrix",
-           "Geometry", "Pair", "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive",
-           "default_configuration", "geometry", "joint_limits", "load", "sample_configurations"]
+           "Geometry", "Joints", "Pair", "adjacent_pairs", "batch_placements", "cached_matrix", "compute",
+           "compute_naive", "default_configuration", "geometry", "joint_limits", "load", "placements",
+           "sample_configurations"]
