@@ -45,6 +45,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -118,6 +119,23 @@ class Joints:
 
 
 @dataclass
+class Mesh:
+    """One collision mesh: the joint carrying it, its placement in that joint's frame (R, t), the
+    points whose hull holds it (its vertices, in its own frame) and its coal geometry, made on
+    first use (a matrix whose pairs the bounding boxes settle needs no coal at all)."""
+
+    joint: int
+    R: np.ndarray
+    t: np.ndarray
+    points: np.ndarray
+    make_shape: Callable[[], Any] = field(repr=False, compare=False)
+
+    @property
+    def shape(self) -> Any:
+        return self.make_shape()
+
+
+@dataclass
 class Geometry:
     """An arm's collision model: its link graph, its joints (numpy forward kinematics; None: other
     joint types, pinocchio's) and its collision meshes placed on the joints. compute() needs no
@@ -128,7 +146,7 @@ class Geometry:
     edges: tuple[tuple[str, str], ...]  # (parent, child) per URDF joint
     objects: dict[str, list[int]]  # link -> indices into meshes (and geom_model.geometryObjects)
     joints: Joints | None
-    meshes: list[tuple[int, np.ndarray, np.ndarray, Any]]  # (joint, R, t in the joint's frame, coal geometry)
+    meshes: list[Mesh]  # in geom_model's order
     pin_models: Callable[[], tuple[Any, Any]] = field(repr=False, compare=False)
     _pin: tuple[Any, Any] | None = field(default=None, repr=False, compare=False)
 
@@ -171,13 +189,14 @@ def geometry(desc: Description) -> Geometry:
                     tuple(range(-1, nj - 1)), np.array(lower, float), np.array(upper, float))
     links = tuple(link.name for link in desc.links)
     objects: dict[str, list[int]] = {name: [] for name in links}
-    meshes: list[tuple[int, np.ndarray, np.ndarray, Any]] = []
+    meshes: list[Mesh] = []
     for link in desc.links:  # multibody.geometry's order
         joint, T = placed[link.name]
         for v in link.visuals:
             P = T @ v.T_link_part
             objects[link.name].append(len(meshes))
-            meshes.append((joint, P[:3, :3], P[:3, 3], multibody.bvh(v.part)))
+            points = multibody.mesh_vertices(v.part)  # the vertices bvh(part) holds
+            meshes.append(Mesh(joint, P[:3, :3], P[:3, 3], points, partial(multibody.bvh, v.part)))
 
     def pin_models() -> tuple[Any, Any]:
         model = multibody.model(desc)
@@ -226,11 +245,11 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
     edges = tuple((str(j.find("parent").get("link")), str(j.find("child").get("link")))  # type: ignore[union-attr]
                   for j in xml.findall("joint"))
     objects: dict[str, list[int]] = {name: [] for name in links}
-    meshes: list[tuple[int, np.ndarray, np.ndarray, Any]] = []
+    meshes: list[Mesh] = []
     for i, go in enumerate(geom_model.geometryObjects):
         objects[model.frames[go.parentFrame].name].append(i)
-        meshes.append((go.parentJoint, np.asarray(go.placement.rotation), np.asarray(go.placement.translation),
-                       go.geometry))
+        meshes.append(Mesh(go.parentJoint, np.asarray(go.placement.rotation), np.asarray(go.placement.translation),
+                           hull_points(go.geometry), partial(lambda g: g, go.geometry)))
     return Geometry(links, edges, objects, _joints_of(model), meshes, lambda: (model, geom_model))
 
 
@@ -328,15 +347,10 @@ class _Checker:
     of link pairs (coal) for one Geometry."""
 
     def __init__(self, geo: Geometry, pairs: list[tuple[str, str]]):
-        import coal
-
-        self.coal = coal
         self.geo = geo
         self.pairs = pairs
-        # pinocchio's collision request (GeometryData's): one contact is enough, no contact points
-        self.request = coal.CollisionRequest()
-        self.request.enable_contact = False
         self.exact = [[(i, j) for i in geo.objects[a] for j in geo.objects[b]] for a, b in pairs]
+        self._coal: tuple[Any, Any, dict[int, Any]] | None = None  # coal, its request, the meshes' shapes
         self._at: tuple[np.ndarray, np.ndarray] | None = None  # joint placements of the last set_configuration
         self._placed: dict[int, Any] = {}  # mesh -> its coal.Transform3s there
         # a bounding sphere per mesh and per link, in the frame of the joint that carries it, and a
@@ -349,16 +363,16 @@ class _Checker:
         for link in sorted({name for pr in pairs for name in pr}, key=geo.links.index):
             pts = []
             for k in geo.objects[link]:
-                joint, Rk, tk, shape = geo.meshes[k]
-                local = hull_points(shape)
+                mesh = geo.meshes[k]
+                joint, Rk, tk, local = mesh.joint, mesh.R, mesh.t, mesh.points
                 v = local @ Rk.T + tk
                 self.spheres[k] = (joint, *enclosing_sphere(v))
                 lo, hi = local.min(axis=0), local.max(axis=0)
                 self.box_joint[k], self.box_R[k] = joint, Rk
                 self.box_c[k], self.box_h[k] = Rk @ ((lo + hi) / 2) + tk, (hi - lo) / 2 + SPHERE_MARGIN / 2
                 pts.append(v)
-            assert len({geo.meshes[k][0] for k in geo.objects[link]}) == 1
-            joint = geo.meshes[geo.objects[link][0]][0]
+            assert len({geo.meshes[k].joint for k in geo.objects[link]}) == 1
+            joint = geo.meshes[geo.objects[link][0]].joint
             self.link_spheres[link] = (joint, *enclosing_sphere(np.vstack(pts)))
         self.exact_tests = 0
 
@@ -435,24 +449,32 @@ class _Checker:
         self._at = (R[0], p[0])
         self._placed = {}
 
-    def _transform(self, m: int) -> Any:
+    def _transform(self, coal, m: int) -> Any:
         tf = self._placed.get(m)
         if tf is None:
             assert self._at is not None
             R, p = self._at
-            joint, Rm, tm, _ = self.geo.meshes[m]
-            tf = self._placed[m] = self.coal.Transform3s(R[joint] @ Rm, R[joint] @ tm + p[joint])
+            mesh = self.geo.meshes[m]
+            tf = self._placed[m] = coal.Transform3s(R[mesh.joint] @ mesh.R, R[mesh.joint] @ mesh.t + p[mesh.joint])
         return tf
 
     def collides(self, k: int) -> bool:
         """Exact test of link pair k (meshes, stop at the first colliding pair) at the
         configuration of the last set_configuration."""
+        if self._coal is None:
+            import coal
+
+            request = coal.CollisionRequest()  # pinocchio's (GeometryData's): one contact, no contact points
+            request.enable_contact = False
+            self._coal = coal, request, {}
+        coal, request, shapes = self._coal
         self.exact_tests += 1
-        meshes = self.geo.meshes
         for i, j in self.exact[k]:
-            result = self.coal.CollisionResult()
-            if self.coal.collide(meshes[i][3], self._transform(i), meshes[j][3], self._transform(j), self.request,
-                                 result):
+            for m in (i, j):
+                if m not in shapes:
+                    shapes[m] = self.geo.meshes[m].shape
+            if coal.collide(shapes[i], self._transform(coal, i), shapes[j], self._transform(coal, j), request,
+                            coal.CollisionResult()):
                 return True
         return False
 
@@ -532,8 +554,9 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
     if candidates:
         checker = _Checker(geo, candidates)
         checker.set_configuration(q0)
+        near = checker.broad_phase(q0[None])[0]  # pairs whose boxes are apart do not collide there
         for k, p in enumerate(candidates):
-            if checker.collides(k):
+            if near[k] and checker.collides(k):
                 reasons[p] = "Default"
         active = [k for k, p in enumerate(candidates) if p not in reasons]
         stats["sampled_pairs"] = len(active)

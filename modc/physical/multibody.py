@@ -111,14 +111,18 @@ def _mesh_arrays(part: Part) -> tuple[np.ndarray, np.ndarray]:
     return corners[first[order]].astype(np.float64), rank[inverse.reshape(-1)].reshape(-1, 3).astype(np.int64)
 
 
+def mesh_vertices(part: Part) -> np.ndarray:
+    """The vertices of bvh(part), scaled as the URDF scales the part (no coal needed)."""
+    return _mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0])
+
+
 @lru_cache(maxsize=512)
 def bvh(part: Part) -> Any:
     """The part's collision mesh as a coal BVH model (OBBRSS, as pinocchio loads meshes), scaled
     as the URDF scales it. Shared by every geometry object that uses the part (read-only)."""
     import coal
 
-    vertices, triangles = _mesh_arrays(part)
-    vertices = vertices * np.array([part.scale_x, 1.0, 1.0])
+    vertices, triangles = mesh_vertices(part), _mesh_arrays(part)[1]
     mesh = coal.BVHModelOBBRSS()
     mesh.beginModel(len(triangles), len(vertices))
     mesh.addVertices(vertices)
@@ -146,7 +150,7 @@ def enclosing_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
 @lru_cache(maxsize=512)
 def bounding_sphere(part: Part) -> tuple[np.ndarray, float]:
     """A sphere containing the part's collision mesh (as scaled), in the part's frame."""
-    return enclosing_sphere(_mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0]))
+    return enclosing_sphere(mesh_vertices(part))
 
 
 _MESHES: dict[int, tuple[Part, tuple[Any, np.ndarray, float]]] = {}
