@@ -33,6 +33,7 @@ def _ascend(model: Any, joint: np.ndarray, q: np.ndarray, iters: int = ITERS) ->
     Per ascent: take the gradient, then halve the step from the last one (x1.5 after a success)
     until a step gains, or give up below MIN_STEP; stop where the projected gradient vanishes."""
     lo, hi = model.lower, model.upper
+    lo_in, hi_in = lo + 1e-12, hi - 1e-12
     L = len(joint)
     q = q.copy()
     g, J = model.gravity_with_jacobians(q)
@@ -46,13 +47,14 @@ def _ascend(model: Any, joint: np.ndarray, q: np.ndarray, iters: int = ITERS) ->
         """Lanes a take the gradient at their pose (g_a, J_a: the model at it); a lane that has taken
         `iters` of them, or whose projected gradient vanishes, stops."""
         over = taken[a] >= iters
-        active[a[over]] = False
-        a, g_a, J_a = a[~over], g_a[~over], J_a[~over]
-        d = np.sign(g_a[np.arange(len(a)), joint[a]])[:, None] * J_a[np.arange(len(a)), joint[a]]
+        if over.any():
+            active[a[over]] = False
+            a, g_a, J_a = a[~over], g_a[~over], J_a[~over]
+        rows, ja = np.arange(len(a)), joint[a]
+        d = np.sign(g_a[rows, ja])[:, None] * J_a[rows, ja]
         qa = q[a]
-        free = ~(((qa <= lo + 1e-12) & (d < 0)) | ((qa >= hi - 1e-12) & (d > 0)))
-        d = d * free
-        nrm = np.linalg.norm(d, axis=1)
+        d[((qa <= lo_in) & (d < 0)) | ((qa >= hi_in) & (d > 0))] = 0.0  # pushing out of the box: held
+        nrm = np.sqrt((d * d).sum(axis=1))
         flat = nrm < 1e-10
         active[a[flat]] = False
         grad[a], norm[a] = d, np.where(flat, 1.0, nrm)

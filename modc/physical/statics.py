@@ -43,52 +43,57 @@ class Statics:
         self.parents = parents
         self.M = np.array(M)  # (nj, 4, 4): joint j's frame at q = 0 in its parent joint's frame
         self.lower, self.upper = np.array(lower, float), np.array(upper, float)
-        bodies = []  # (joint carrying it, mass, centre of mass in that joint's frame); base_link's holds no joint
+        # the bodies on each joint, summed: mass m_j and first moment h_j = sum m_b c_b (joint frame)
+        n = self.nq
+        self.m_joint, self.h_joint = np.zeros(n), np.zeros((n, 3))
         for link in desc.links:
             joint, T = placed[link.name]
-            if link.inertial is not None and joint > 0:
-                bodies.append((joint, link.inertial.mass, T[:3, :3] @ np.asarray(link.inertial.com, float) + T[:3, 3]))
-        self.body_joint = np.array([b[0] for b in bodies], int)
-        self.mass = np.array([b[1] for b in bodies], float)
-        self.com = np.array([b[2] for b in bodies], float).reshape(-1, 3)
+            if link.inertial is not None and joint > 0:  # base_link's own mass holds no joint
+                m = link.inertial.mass
+                self.m_joint[joint - 1] += m
+                self.h_joint[joint - 1] += m * (T[:3, :3] @ np.asarray(link.inertial.com, float) + T[:3, 3])
         # carries[i, j]: joint i + 1 carries joint j + 1 (itself included)
-        n = self.nq
         carries = np.zeros((n, n), bool)
         for k in range(1, n + 1):
             a = k
             while a > 0:
                 carries[a - 1, k - 1] = True
                 a = parents[a]
-        self.carries_body = carries[:, self.body_joint - 1].astype(float)  # (n, bodies)
-        self._k_carries_i = carries.T[None]  # [i, k]: joint k carries joint i (k = i too)
-        self._i_carries_k = (carries & ~np.eye(n, dtype=bool))[None]  # [i, k]: i carries k, k != i
+        self._carries = carries.astype(float)
+        self._m_carried = self._carries @ self.m_joint  # (n,): the mass joint i holds
+        self._k_carries_i = carries.T.astype(float)[None]  # [i, k]: joint k carries joint i (k = i too)
+        self._i_carries_k = (carries & ~np.eye(n, dtype=bool)).astype(float)[None]  # [i, k]: i carries k, k != i
         gx, gy, gz = self.g
         self._g_cross = np.array([[0.0, -gz, gy], [gz, 0.0, -gx], [-gy, gx, 0.0]])  # v @ this = v x g
+        # M_j @ Rz(q) = cos q (M_j C) + sin q (M_j S) + M_j Z: joint j's frame turned by q, in its parent's
+        C, S, Z = np.diag([1.0, 1.0, 0.0]), np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]), np.diag(
+            [0.0, 0.0, 1.0])
+        R = self.M[:, :3, :3]
+        self._MC, self._MS, self._MZ = R @ C, R @ S, R @ Z
 
-    def _frames(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Every joint frame's rotation (N, nj, 3, 3) and origin (N, nj, 3) in base_link (0: base_link)."""
-        N = Q.shape[0]
-        nj = self.nq + 1
-        R = np.empty((N, nj, 3, 3))
-        p = np.empty((N, nj, 3))
-        R[:, 0], p[:, 0] = np.eye(3), 0.0
-        c, s = np.cos(Q), np.sin(Q)
-        for j in range(1, nj):
+    def _frames(self, Q: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """Per joint 1..n: its frame's rotation (N, 3, 3) and origin (N, 3) in base_link."""
+        c, s = np.cos(Q)[:, :, None, None], np.sin(Q)[:, :, None, None]
+        turned = c * self._MC[None, 1:] + s * self._MS[None, 1:] + self._MZ[None, 1:]  # (N, n, 3, 3)
+        Rs: list[np.ndarray] = []
+        ps: list[np.ndarray] = []
+        for j in range(1, self.nq + 1):
             par = self.parents[j]
-            R0 = R[:, par] @ self.M[j, :3, :3]
-            p[:, j] = R[:, par] @ self.M[j, :3, 3] + p[:, par]
-            cj, sj = c[:, j - 1, None], s[:, j - 1, None]
-            R[:, j, :, 0] = cj * R0[:, :, 0] + sj * R0[:, :, 1]  # R0 @ Rz(q)
-            R[:, j, :, 1] = cj * R0[:, :, 1] - sj * R0[:, :, 0]
-            R[:, j, :, 2] = R0[:, :, 2]
-        return R, p
+            if par == 0:  # on base_link
+                Rs.append(turned[:, j - 1])
+                ps.append(np.broadcast_to(self.M[j, :3, 3], (Q.shape[0], 3)))
+            else:
+                Rs.append(Rs[par - 1] @ turned[:, j - 1])
+                ps.append(Rs[par - 1] @ self.M[j, :3, 3] + ps[par - 1])
+        return Rs, ps
 
     def _moments(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Joint axes z_i and r_i = sum m_b (c_b - p_i) over the bodies joint i carries, (N, n, 3) each."""
-        R, p = self._frames(Q)
-        c = (R[:, self.body_joint] @ self.com[None, :, :, None])[..., 0] + p[:, self.body_joint]  # (N, bodies, 3)
-        r = self.carries_body @ (self.mass[:, None] * c) - (self.carries_body @ self.mass)[None, :, None] * p[:, 1:]
-        return R[:, 1:, :, 2], r
+        Rs, ps = self._frames(Q)
+        R, p = np.stack(Rs, axis=1), np.stack(ps, axis=1)  # (N, n, 3, 3), (N, n, 3)
+        first = (R @ self.h_joint[:, :, None])[..., 0] + self.m_joint[:, None] * p  # sum m_b c_b per joint
+        r = self._carries @ first - self._m_carried[:, None] * p
+        return R[:, :, :, 2], r
 
     def gravities(self, Q) -> np.ndarray:
         """(N, n) holding torques g(q) of the poses Q (N, n), N·m."""
@@ -103,7 +108,7 @@ class Statics:
         # (z_k x z_i).(r_i x g) + z_i.((z_k x r_i) x g) = z_k.(z_i x (r_i x g) + r_i x (g x z_i)), by triple products
         upper = -np.einsum("nkd,nid->nik", z, _cross(z, rxg) + _cross(r, -(z @ self._g_cross)))
         lower = -np.einsum("nid,nkd->nik", z, _cross(z, r) @ self._g_cross)  # z_i.((z_k x r_k) x g)
-        return tau, np.where(self._k_carries_i, upper, 0.0) + np.where(self._i_carries_k, lower, 0.0)
+        return tau, self._k_carries_i * upper + self._i_carries_k * lower
 
     def gravity_jacobians(self, Q) -> np.ndarray:
         """(N, n, n) dg/dq of the poses Q."""
