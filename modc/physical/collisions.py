@@ -354,13 +354,18 @@ class _Checker:
         self._at: tuple[np.ndarray, np.ndarray] | None = None  # joint placements of the last set_configuration
         self._placed: dict[int, Any] = {}  # mesh -> its coal.Transform3s there
         # a bounding sphere per mesh and per link, in the frame of the joint that carries it, and a
-        # box per mesh (its bounding box in its own frame, grown by half the margin on every side)
+        # box per mesh (its bounding box in its own frame) and per link (its meshes' bounding box in
+        # the joint's frame), grown by half the margin on every side: boxes 0..n_geo-1 are the
+        # meshes', then one per link (link_box)
         self.spheres: dict[int, tuple[int, np.ndarray, float]] = {}  # geometry index -> sphere
         self.link_spheres: dict[str, tuple[int, np.ndarray, float]] = {}
         n_geo = len(geo.meshes)
-        self.box_joint = np.zeros(n_geo, int)
-        self.box_R, self.box_c, self.box_h = np.zeros((n_geo, 3, 3)), np.zeros((n_geo, 3)), np.zeros((n_geo, 3))
-        for link in sorted({name for pr in pairs for name in pr}, key=geo.links.index):
+        used = sorted({name for pr in pairs for name in pr}, key=geo.links.index)
+        self.link_box = {link: n_geo + i for i, link in enumerate(used)}
+        n_box = n_geo + len(used)
+        self.box_joint = np.zeros(n_box, int)
+        self.box_R, self.box_c, self.box_h = np.zeros((n_box, 3, 3)), np.zeros((n_box, 3)), np.zeros((n_box, 3))
+        for link in used:
             pts = []
             for k in geo.objects[link]:
                 mesh = geo.meshes[k]
@@ -373,13 +378,22 @@ class _Checker:
                 pts.append(v)
             assert len({geo.meshes[k].joint for k in geo.objects[link]}) == 1
             joint = geo.meshes[geo.objects[link][0]].joint
-            self.link_spheres[link] = (joint, *enclosing_sphere(np.vstack(pts)))
+            v = np.vstack(pts)
+            self.link_spheres[link] = (joint, *enclosing_sphere(v))
+            b, lo, hi = self.link_box[link], v.min(axis=0), v.max(axis=0)
+            self.box_joint[b], self.box_R[b] = joint, np.eye(3)
+            self.box_c[b], self.box_h[b] = (lo + hi) / 2, (hi - lo) / 2 + SPHERE_MARGIN / 2
+        self.sphere_joint = np.array([self.spheres.get(k, (0, None, 0.0))[0] for k in range(n_geo)], int)
+        self.sphere_c = np.array([self.spheres[k][1] if k in self.spheres else np.zeros(3) for k in range(n_geo)],
+                                 float).reshape(-1, 3)
+        self.sphere_r = np.array([self.spheres.get(k, (0, None, 0.0))[2] for k in range(n_geo)], float)
         self.exact_tests = 0
 
     def broad_phase(self, Q: np.ndarray) -> np.ndarray:
         """(N, pairs) bool: may the two links touch in sample n? False is certain: every mesh
-        lies in its sphere, spheres closer than SPHERE_MARGIN count as touching. Link spheres
-        first, then the spheres of the meshes in the samples where those touch."""
+        lies in its spheres and boxes, which count as touching when closer than SPHERE_MARGIN.
+        Link spheres, then link boxes, then the meshes' spheres and boxes, each only in the
+        samples the one before could not settle."""
         R, p = self.placements(Q)
         N = Q.shape[0]
 
@@ -397,23 +411,28 @@ class _Checker:
             return {k: i for i, k in enumerate(keys)}, c, np.array([spheres[k][2] for k in keys])
 
         lcol, lc, lr = world(self.link_spheres)
-        mcol, mc, mr = world(self.spheres)
         mask = np.zeros((N, len(self.pairs)), bool)
         for k, (a, b) in enumerate(self.pairs):
             d2 = ((lc[:, lcol[a]] - lc[:, lcol[b]]) ** 2).sum(axis=1)
             rows = np.flatnonzero(d2 < (lr[lcol[a]] + lr[lcol[b]] + SPHERE_MARGIN) ** 2)
+            if rows.size:  # the links' spheres touch: do the links' boxes?
+                links = np.full(rows.size, self.link_box[a]), np.full(rows.size, self.link_box[b])
+                rows = rows[~self._boxes_apart(R, p, rows, *links)]
             if rows.size == 0:
                 continue
-            ga, gb = self.geo.objects[a], self.geo.objects[b]
-            ia = [mcol[m] for m in ga]
-            ib = [mcol[m] for m in gb]
-            ca, cb = mc[rows][:, ia], mc[rows][:, ib]
+            ga, gb = np.asarray(self.geo.objects[a]), np.asarray(self.geo.objects[b])
+            ca, cb = self._centres(R, p, rows, ga), self._centres(R, p, rows, gb)  # (rows, meshes, 3)
             d2 = ((ca[:, :, None, :] - cb[:, None, :, :]) ** 2).sum(axis=-1)
-            reach = (mr[ia][:, None] + mr[ib][None, :] + SPHERE_MARGIN) ** 2
+            reach = (self.sphere_r[ga][:, None] + self.sphere_r[gb][None, :] + SPHERE_MARGIN) ** 2
             r, i, j = np.nonzero(d2 < reach)  # mesh pairs whose spheres touch: do their boxes?
-            near = ~self._boxes_apart(R, p, rows[r], np.asarray(ga)[i], np.asarray(gb)[j])
+            near = ~self._boxes_apart(R, p, rows[r], ga[i], gb[j])
             mask[rows[r[near]], k] = True
         return mask
+
+    def _centres(self, R: np.ndarray, p: np.ndarray, rows: np.ndarray, meshes: np.ndarray) -> np.ndarray:
+        """(rows, meshes, 3): the meshes' sphere centres in the world in samples rows."""
+        n, j = rows[:, None], self.sphere_joint[meshes][None, :]
+        return (R[n, j] @ self.sphere_c[meshes][:, :, None])[..., 0] + p[n, j]  # R[n, j]: (rows, meshes, 3, 3)
 
     def _boxes_apart(self, R: np.ndarray, p: np.ndarray, n: np.ndarray, ga: np.ndarray,
                      gb: np.ndarray) -> np.ndarray:
