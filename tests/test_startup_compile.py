@@ -102,7 +102,7 @@ def test_the_box_filter_changes_no_collision_result_and_spares_exact_tests(examp
     import numpy as np
 
     from modc.compiler import check_file
-    from modc.physical import collisions
+    from modc.physical import broadphase, collisions
     from modc.physical.assembly import describe
 
     monkeypatch.setenv("MODC_NO_CACHE", "1")
@@ -110,7 +110,7 @@ def test_the_box_filter_changes_no_collision_result_and_spares_exact_tests(examp
         geo = collisions.geometry(describe(robot))
         boxed = collisions.compute(geo, samples=3000, seed=2)
         with monkeypatch.context() as m:  # spheres alone: every box is said to touch
-            m.setattr(collisions._Checker, "_boxes_apart", lambda self, R, p, n, ga, gb: np.zeros(len(n), bool))
+            m.setattr(broadphase.Checker, "_boxes_apart", lambda self, R, p, n, ga, gb: np.zeros(len(n), bool))
             spheres = collisions.compute(geo, samples=3000, seed=2)
         assert boxed == spheres  # the classification (counts and stats do not compare)
         # a pair seen colliding is known to be free often enough only at the next sample that
@@ -127,9 +127,9 @@ def test_the_box_test_finds_touching_and_apart_boxes():
     of their extents along the separating axis, touching within it."""
     import numpy as np
 
-    from modc.physical.collisions import _Checker
+    from modc.physical.broadphase import Checker
 
-    c = _Checker.__new__(_Checker)
+    c = Checker.__new__(Checker)
     c.box_joint = np.array([1, 2])
     c.box_R = np.array([np.eye(3), np.eye(3)])
     c.box_c = np.zeros((2, 3))
