@@ -239,3 +239,27 @@ def test_the_collision_matrix_needs_no_pinocchio_and_equals_the_naive_one(tmp_pa
     for robot in _example_robots():
         geo = collisions.geometry(describe(robot))
         assert collisions.compute(geo, samples=1200, seed=4) == collisions.compute_naive(geo, samples=1200, seed=4)
+
+
+ARM_CACHES = {"builds", "collisions", "meshes", "torque"}  # keyed by the arm compiled (its design, parts, robot)
+
+
+def test_the_benchmarks_install_caches_are_every_cache_a_compile_keys_by_modc_alone(tmp_path):
+    """bench_startup's "first compile of a new arm" keeps INSTALL_CACHES warm and empties the rest:
+    a compile writes exactly those kinds and the arm's, so a new cache kind must be placed in one."""
+    import os
+    import subprocess
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        from bench_startup import INSTALL_CACHES
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MODC_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("MODC_NO_CACHE", None)
+    out = subprocess.run([sys.executable, "-m", "modc", str(FARM), "-o", str(tmp_path / "out")], env=env,
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    kinds = {p.name for p in (tmp_path / "cache").iterdir()}
+    assert kinds == set(INSTALL_CACHES) | ARM_CACHES and not set(INSTALL_CACHES) & ARM_CACHES
