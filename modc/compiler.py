@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -69,8 +69,11 @@ def parse_text(text: str, path: str) -> tuple[ast.File, list[Diagnostic]]:
     return parse(text, path)
 
 
-def check_text(text: str, path: str = "<string>", library: str | None = None, **options) -> Checked:
-    """Parse, lower and run the passes. options go to the pass Context (analyses=…, torque_severity=…)."""
+def check_text(text: str, path: str = "<string>", library: str | None = None,
+               before_analyses: Callable[[Design], object] | None = None, **options) -> Checked:
+    """Parse, lower and run the passes. options go to the pass Context (analyses=…, torque_severity=…).
+    before_analyses(design) is called once the checks have run, before the analyses (which may
+    write modc's caches: check_compile protects the inputs the checks found there)."""
     from .syntax.parser import normalize_newlines
 
     text = normalize_newlines(text)  # the same length: offsets into the original stay right
@@ -81,11 +84,22 @@ def check_text(text: str, path: str = "<string>", library: str | None = None, **
         options["torque_analysis"] = analyse
     ctx = Context(diagnostics=diags, library_override=library, **options)
     design = lower(tree, ctx.diagnostics)
-    design = run_all(design, ctx)
+    if before_analyses is None:
+        design = run_all(design, ctx)
+    else:
+        from .passes import PASSES, check_torque
+
+        first = PASSES.index(check_torque)  # the first pass that runs an analysis the driver hands in
+        for p in PASSES[:first]:
+            design = p.run(design, ctx)
+        before_analyses(design)
+        for p in PASSES[first:]:
+            design = p.run(design, ctx)
     return Checked(design, ctx.diagnostics, {**ctx.sources, path: text}, tree)
 
 
-def check_file(path: str | os.PathLike, library: str | None = None, **options) -> Checked:
+def check_file(path: str | os.PathLike, library: str | None = None,
+               before_analyses: Callable[[Design], object] | None = None, **options) -> Checked:
     p = str(path)
     if not p.endswith((".mod", *YAML_SUFFIXES)):
         raise InputError(codes.UNSUPPORTED_INPUT.at(Span.point(p), path=p))
@@ -95,7 +109,21 @@ def check_file(path: str | os.PathLike, library: str | None = None, **options) -
         from .model import Design
 
         return Checked(Design(path=p), [e.diagnostic], {p: e.text} if e.text is not None else {})
-    return check_text(text, p, library, **options)
+    return check_text(text, p, library, before_analyses, **options)
+
+
+def check_compile(file: str | os.PathLike, library: str | None = None, **options) -> tuple[Checked, list[str]]:
+    """check_file with analyses (options as check_file's), and the command's inputs (inputs_of)
+    from the same check: FILE and --library are protected from modc's caches at once, the library
+    files the robots use as soon as the checks have found them, before the analyses write to the
+    caches. One parse and one check where inputs_of, then check_file, made two. An unreadable
+    FILE raises InputError as check_file does (FILE protected already)."""
+    inputs = inputs_of(file, library, check=False)
+
+    def found(design: Design) -> None:
+        inputs[:] = inputs_of(file, library, Checked(design, []))
+
+    return check_file(file, library, before_analyses=found, **options), inputs
 
 
 def build(checked: Checked, only: list[str] | None = None, **options) -> dict[str, str | bytes]:
@@ -178,18 +206,18 @@ def write_tree(files: dict[str, str | bytes], out: str | os.PathLike, force: boo
 
 
 def inputs_of(file: str | os.PathLike, library: str | None = None, checked: Checked | None = None,
-              more: Iterable[str | os.PathLike] = ()) -> list[str]:
+              more: Iterable[str | os.PathLike] = (), check: bool = True) -> list[str]:
     """Every input file of a command: FILE, the --library file, each library file FILE's robots
     and design blocks use (from checked, a modc.compiler.Checked; found by checking FILE when not
-    given), and `more` (a trajectory file). Built-in libraries ship with modc and are left out.
-    They are protected from the caches (protect) from this call on."""
+    given, unless check is False), and `more` (a trajectory file). Built-in libraries ship with
+    modc and are left out. They are protected from the caches (protect) from this call on."""
     from .model import library as lib
     from .outputs import protect
 
     found = [os.fspath(file), *(os.fspath(m) for m in more)]
     if library and library not in lib.BUILTIN:
         found.append(library)
-    if checked is None:
+    if checked is None and check:
         try:
             checked = check_file(file, library)
         except (InputError, OSError, ValueError):  # the command itself reports an unreadable file

@@ -45,13 +45,16 @@ def manifest_text(files: Mapping[str, str | bytes]) -> str:
 
 def write_files(files: Mapping[str, str | bytes], root: Path) -> None:
     """Write a tree under root exactly as `modc FILE -o OUT` does (UTF-8, '\\n' line ends)."""
+    made: set[Path] = set()  # folders made (or found) already: a mkdir is a system call per file otherwise
     for rel, content in files.items():
         parts = Path(rel).parts
         if not parts or Path(rel).is_absolute() or ".." in parts or MANIFEST in parts[:1]:
             # a backend bug, never the user's input (names pass the identifier rule): refuse to leave OUT
             raise ValueError(f"refusing to write {rel!r}: not a relative path inside OUT")
         target = root / rel
-        target.parent.mkdir(parents=True, exist_ok=True)
+        if target.parent not in made:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            made.add(target.parent)
         target.write_bytes(_encode(content))
 
 

@@ -64,13 +64,12 @@ def compile_cmd(
     verbose: bool,
 ) -> None:
     """Check FILE and write URDF, meshes and a report into OUT."""
-    from ..compiler import COMPILE_ANALYSES, InputError, build_cached, check_file, inputs_of
+    from ..compiler import COMPILE_ANALYSES, InputError, build_cached, check_compile
     from ..outputs import check_output_dir, write_tree
 
     Verbosity.quiet, Verbosity.verbose = quiet, verbose
-    inputs = inputs_of(file, library)  # first: the analyses' caches must know them (modc.outputs)
-    try:
-        checked = check_file(file, library, analyses=COMPILE_ANALYSES, torque_severity=torque or "error")
+    try:  # the inputs are protected before the analyses write to modc's caches (modc.outputs)
+        checked, inputs = check_compile(file, library, analyses=COMPILE_ANALYSES, torque_severity=torque or "error")
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
         raise SystemExit(EXIT_USAGE) from None

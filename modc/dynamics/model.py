@@ -51,6 +51,15 @@ class Dynamics:
     def gravity_derivatives(self, q) -> np.ndarray:
         return np.array(self.pin.computeGeneralizedGravityDerivatives(self.model, self.data, np.asarray(q, float)))
 
+    def gravities(self, Q) -> np.ndarray:
+        """(N, n) g(q) of the poses Q (N, n): Statics.gravities' interface (worst_case runs on either)."""
+        return np.array([self.gravity(q) for q in np.atleast_2d(np.asarray(Q, float))])
+
+    def gravity_with_jacobians(self, Q) -> tuple[np.ndarray, np.ndarray]:
+        """g(q) (N, n) and dg/dq (N, n, n) of the poses Q."""
+        Q = np.atleast_2d(np.asarray(Q, float))
+        return self.gravities(Q), np.array([self.gravity_derivatives(q) for q in Q])
+
     def mass_matrix(self, q) -> np.ndarray:
         M = np.array(self.pin.crba(self.model, self.data, np.asarray(q, float)))
         return np.triu(M) + np.triu(M, 1).T  # crba fills the upper triangle

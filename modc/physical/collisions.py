@@ -26,13 +26,19 @@ three things, none of which can change a result:
   1. link pairs, not mesh pairs, are classified, and a pair leaves the loop as soon as its
      reason is certain: one collision -> not Never, and then more than 5 % free samples -> not
      Always (it stays enabled); >= 95 % collisions -> Always. Never pairs see every sample.
-  2. a vectorised broad phase: forward kinematics of all samples at once in numpy, then a
-     bounding sphere per link and per mesh (plus a 1 mm margin). A sphere contains its mesh, so
-     spheres apart => meshes apart; only samples where some spheres of a pair touch reach coal.
+  2. a vectorised broad phase (modc.physical.broadphase): forward kinematics of all samples at
+     once in numpy, then a bounding sphere per link, a box per link (its meshes' bounding box in
+     its joint's frame), a sphere per mesh and an oriented box per mesh (its bounding box in its
+     own frame, separating axis test), each with a 1 mm margin and each only in the samples the
+     one before left open. Every bound contains what it bounds, so bounds apart => meshes
+     apart; only samples where some mesh boxes of a pair touch reach coal (the farm arm: none,
+     at the default pose included, where spheres alone sent 2,890 samples to coal).
      (Bounding volumes are only a filter: classifying with them alone -- or with convex hulls --
      would be conservative for Never but would wrongly disable pairs as Default or Always.)
-  3. the exact test of a link pair is one pinocchio call over all its mesh pairs, stopping at
-     the first collision (coal's BVH rejects far meshes at the root).
+  3. the exact test of a link pair is coal over its mesh pairs, placed by the same numpy
+     kinematics, stopping at the first collision (coal's BVH rejects far meshes at the root);
+     coal is imported at the first exact test, pinocchio not at all (Geometry builds its
+     pinocchio models for other users, on first use).
 Samples are drawn and visited in order on one thread, so the result depends only on the arm's
 geometry and joints, the sample count and the seed: same input -> same matrix on any machine and thread
 count (barring floating-point differences in coal for meshes that touch to within rounding;
@@ -40,8 +46,9 @@ the filter's margin keeps near-contacts out of the broad phase's hands).
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -49,13 +56,21 @@ import numpy as np
 
 from ..model.robot import default_position
 from .assembly import Description
-from .multibody import enclosing_sphere, hull_points
+from .broadphase import (
+    ALWAYS_PERCENT,
+    CHUNK,
+    SPHERE_MARGIN,
+    Checker,
+    Joints,
+    batch_placements,
+    joints_of,
+    placements,
+    sample,
+)
+from .multibody import hull_points
 
 DEFAULT_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling density"
 DEFAULT_SEED = 0
-ALWAYS_PERCENT = 95  # "Always": colliding in at least this percentage of the samples
-CHUNK = 4096  # samples per broad-phase batch (bounds memory for large sample counts)
-SPHERE_MARGIN = 1e-3  # m: bounding spheres closer than this count as touching (the filter errs towards testing meshes)
 
 REASONS = ("Adjacent", "Default", "Always", "Never")
 # Which pairs a collision check skips: the one rule of `modc plan`, `modc sim` (both engines) and
@@ -101,31 +116,90 @@ class CollisionMatrix:
 
 
 @dataclass
-class Geometry:
-    """A pinocchio model and collision GeometryModel of one arm, plus its link graph."""
+class Mesh:
+    """One collision mesh: the joint carrying it, its placement in that joint's frame (R, t), the
+    points whose hull holds it (its vertices, in its own frame) and its coal geometry, made on
+    first use (a matrix whose pairs the bounding boxes settle needs no coal at all)."""
 
-    model: Any  # pin.Model
-    geom_model: Any  # pin.GeometryModel (collision meshes)
+    joint: int
+    R: np.ndarray
+    t: np.ndarray
+    points: np.ndarray
+    make_shape: Callable[[], Any] = field(repr=False, compare=False)
+
+    @property
+    def shape(self) -> Any:
+        return self.make_shape()
+
+
+@dataclass
+class Geometry:
+    """An arm's collision model: its link graph, its joints (numpy forward kinematics; None: other
+    joint types, pinocchio's) and its collision meshes placed on the joints. compute() needs no
+    more and imports no pinocchio; model and geom_model (pinocchio's Model and GeometryModel of
+    the same arm) are built on first use."""
+
     links: tuple[str, ...]
     edges: tuple[tuple[str, str], ...]  # (parent, child) per URDF joint
-    objects: dict[str, list[int]]  # link -> indices into geom_model.geometryObjects
+    objects: dict[str, list[int]]  # link -> indices into meshes (and geom_model.geometryObjects)
+    joints: Joints | None
+    meshes: list[Mesh]  # in geom_model's order
+    pin_models: Callable[[], tuple[Any, Any]] = field(repr=False, compare=False)
+    _pin: tuple[Any, Any] | None = field(default=None, repr=False, compare=False)
 
     @property
     def geometry_links(self) -> tuple[str, ...]:
         return tuple(name for name in self.links if self.objects.get(name))
 
+    @property
+    def model(self) -> Any:
+        """pin.Model"""
+        if self._pin is None:
+            self._pin = self.pin_models()
+        return self._pin[0]
+
+    @property
+    def geom_model(self) -> Any:
+        """pin.GeometryModel (collision meshes)"""
+        self.model  # noqa: B018 - builds both
+        assert self._pin is not None
+        return self._pin[1]
+
 
 def geometry(desc: Description) -> Geometry:
-    """The arm's collision model, built in memory from its Description (no files)."""
+    """The arm's collision model, built in memory from its Description (no files, no pinocchio:
+    the same joints, meshes and placements as multibody.model and multibody.geometry make)."""
     from . import multibody
 
-    model = multibody.model(desc)
-    geom_model = multibody.geometry(desc, model)
+    placed = multibody.link_frames(desc)
+    parents, Ms, lower, upper = [0], [np.eye(4)], [], []
+    for j in desc.joints:
+        if j.kind == "revolute":
+            assert j.limits is not None
+            parents.append(placed[j.parent][0])
+            Ms.append(placed[j.parent][1] @ j.T_parent_child)
+            lower.append(j.limits.lower)
+            upper.append(j.limits.upper)
+    M = np.array(Ms)
+    nj = len(parents)
+    joints = Joints(tuple(parents), M[:, :3, :3], M[:, :3, 3], np.tile([0.0, 0.0, 1.0], (nj, 1)),
+                    tuple(range(-1, nj - 1)), np.array(lower, float), np.array(upper, float))
     links = tuple(link.name for link in desc.links)
     objects: dict[str, list[int]] = {name: [] for name in links}
-    for i, go in enumerate(geom_model.geometryObjects):
-        objects[model.frames[go.parentFrame].name].append(i)
-    return Geometry(model, geom_model, links, tuple((j.parent, j.child) for j in desc.joints), objects)
+    meshes: list[Mesh] = []
+    for link in desc.links:  # multibody.geometry's order
+        joint, T = placed[link.name]
+        for v in link.visuals:
+            P = T @ v.T_link_part
+            objects[link.name].append(len(meshes))
+            points = multibody.mesh_vertices(v.part)  # the vertices bvh(part) holds
+            meshes.append(Mesh(joint, P[:3, :3], P[:3, 3], points, partial(multibody.bvh, v.part)))
+
+    def pin_models() -> tuple[Any, Any]:
+        model = multibody.model(desc)
+        return model, multibody.geometry(desc, model)
+
+    return Geometry(links, tuple((j.parent, j.child) for j in desc.joints), objects, joints, meshes, pin_models)
 
 
 def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
@@ -152,9 +226,12 @@ def load(files: Mapping[str, str | bytes], urdf_path: str) -> Geometry:
     edges = tuple((str(j.find("parent").get("link")), str(j.find("child").get("link")))  # type: ignore[union-attr]
                   for j in xml.findall("joint"))
     objects: dict[str, list[int]] = {name: [] for name in links}
+    meshes: list[Mesh] = []
     for i, go in enumerate(geom_model.geometryObjects):
         objects[model.frames[go.parentFrame].name].append(i)
-    return Geometry(model, geom_model, links, edges, objects)
+        meshes.append(Mesh(go.parentJoint, np.asarray(go.placement.rotation), np.asarray(go.placement.translation),
+                           hull_points(go.geometry), partial(lambda g: g, go.geometry)))
+    return Geometry(links, edges, objects, joints_of(model), meshes, lambda: (model, geom_model))
 
 
 def adjacent_pairs(links: tuple[str, ...], edges, has_geometry) -> set[frozenset[str]]:
@@ -178,8 +255,10 @@ def adjacent_pairs(links: tuple[str, ...], edges, has_geometry) -> set[frozenset
 
 
 def joint_limits(model) -> tuple[np.ndarray, np.ndarray]:
-    """Position limits to sample within; an unbounded (continuous) joint gets one turn."""
-    lo, hi = np.array(model.lowerPositionLimit, float), np.array(model.upperPositionLimit, float)
+    """Position limits to sample within (of a pin.Model or Joints); an unbounded (continuous)
+    joint gets one turn."""
+    lo, hi = (np.array(model.lower, float), np.array(model.upper, float)) if isinstance(model, Joints) else (
+        np.array(model.lowerPositionLimit, float), np.array(model.upperPositionLimit, float))
     bad = ~(np.isfinite(lo) & np.isfinite(hi)) | (np.abs(lo) > 1e10) | (np.abs(hi) > 1e10)
     lo[bad], hi[bad] = -np.pi, np.pi
     return lo, hi
@@ -195,173 +274,6 @@ def sample_configurations(lower, upper, samples: int, seed: int) -> np.ndarray:
     lo, hi = np.asarray(lower, float), np.asarray(upper, float)
     u = np.random.Generator(np.random.PCG64(seed)).random((samples, lo.size))
     return lo + (hi - lo) * u
-
-
-_REVOLUTE_AXES = {"JointModelRX": (1.0, 0.0, 0.0), "JointModelRY": (0.0, 1.0, 0.0), "JointModelRZ": (0.0, 0.0, 1.0)}
-
-
-def batch_placements(model, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Forward kinematics of N configurations at once: world rotation (N, njoints, 3, 3) and
-    translation (N, njoints, 3) of every joint frame (index 0 = universe), as pinocchio's
-    data.oMi. Revolute joints are done in numpy; any other joint type falls back to pinocchio."""
-    import pinocchio as pin
-
-    N = Q.shape[0]
-    nj = model.njoints
-    R = np.empty((N, nj, 3, 3))
-    p = np.empty((N, nj, 3))
-    R[:, 0], p[:, 0] = np.eye(3), 0.0
-    kinds = [model.joints[j].shortname() for j in range(1, nj)]
-    if not all(k in _REVOLUTE_AXES or k == "JointModelRevoluteUnaligned" for k in kinds):
-        data = model.createData()
-        for n, q in enumerate(Q):
-            pin.forwardKinematics(model, data, q)
-            for j in range(1, nj):
-                R[n, j], p[n, j] = data.oMi[j].rotation, data.oMi[j].translation
-        return R, p
-    for j in range(1, nj):
-        jm = model.joints[j]
-        known = _REVOLUTE_AXES.get(jm.shortname())
-        axis = np.asarray(jm.extract().axis if known is None else known, float)
-        M = model.jointPlacements[j]
-        parent = model.parents[j]
-        Rpar = R[:, parent].reshape(N * 3, 3)
-        p[:, j] = p[:, parent] + (Rpar @ np.asarray(M.translation)).reshape(N, 3)
-        R0 = Rpar @ np.asarray(M.rotation)  # (N*3, 3): the joint frame at q = 0
-        # R0 @ Rot(axis, q) = R0 + sin q (R0 K) + (1 - cos q) (R0 K^2)   (Rodrigues)
-        k = np.asarray(axis, float) / np.linalg.norm(axis)
-        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-        R0K = R0 @ K
-        angle = Q[:, jm.idx_q]
-        s_, c_ = np.repeat(np.sin(angle), 3)[:, None], np.repeat(1.0 - np.cos(angle), 3)[:, None]
-        R[:, j] = (R0 + s_ * R0K + c_ * (R0K @ K)).reshape(N, 3, 3)
-    return R, p
-
-
-class _Checker:
-    """Broad phase (bounding spheres, all samples at once in numpy) and exact mesh tests of
-    link pairs for one Geometry."""
-
-    def __init__(self, geo: Geometry, pairs: list[tuple[str, str]]):
-        import pinocchio as pin
-
-        self.pin = pin
-        self.geo = geo
-        model, gm = geo.model, geo.geom_model
-        self.data = model.createData()
-        self.pairs = pairs
-        # one small GeometryModel per link pair: all mesh pairs across the two links
-        self.exact = []
-        for a, b in pairs:
-            sub = pin.GeometryModel()
-            ia = [sub.addGeometryObject(gm.geometryObjects[k]) for k in geo.objects[a]]
-            ib = [sub.addGeometryObject(gm.geometryObjects[k]) for k in geo.objects[b]]
-            for i in ia:
-                for j in ib:
-                    sub.addCollisionPair(pin.CollisionPair(i, j))
-            self.exact.append((sub, sub.createData()))
-        # a bounding sphere per mesh and per link, in the frame of the joint that carries it
-        self.spheres: dict[int, tuple[int, np.ndarray, float]] = {}  # geometry index -> sphere
-        self.link_spheres: dict[str, tuple[int, np.ndarray, float]] = {}
-        for link in sorted({name for pr in pairs for name in pr}, key=geo.links.index):
-            pts = []
-            for k in geo.objects[link]:
-                o = gm.geometryObjects[k]
-                v = hull_points(o.geometry) @ np.asarray(o.placement.rotation).T
-                v += np.asarray(o.placement.translation)
-                self.spheres[k] = (o.parentJoint, *enclosing_sphere(v))
-                pts.append(v)
-            assert len({gm.geometryObjects[k].parentJoint for k in geo.objects[link]}) == 1
-            joint = gm.geometryObjects[geo.objects[link][0]].parentJoint
-            self.link_spheres[link] = (joint, *enclosing_sphere(np.vstack(pts)))
-        self.exact_tests = 0
-
-    def broad_phase(self, Q: np.ndarray) -> np.ndarray:
-        """(N, pairs) bool: may the two links touch in sample n? False is certain: every mesh
-        lies in its sphere, spheres closer than SPHERE_MARGIN count as touching. Link spheres
-        first, then the spheres of the meshes in the samples where those touch."""
-        R, p = batch_placements(self.geo.model, Q)
-        N = Q.shape[0]
-
-        def world(spheres: dict) -> tuple[dict, np.ndarray, np.ndarray]:
-            keys = list(spheres)
-            joints = np.array([spheres[k][0] for k in keys])
-            local = np.array([spheres[k][1] for k in keys])
-            c = np.empty((N, len(keys), 3))
-            for j in np.unique(joints):  # world centres: R_j @ local + p_j, per joint
-                sel = np.flatnonzero(joints == j)
-                c[:, sel] = (R[:, j].reshape(N * 3, 3) @ local[sel].T).reshape(N, 3, sel.size).transpose(0, 2, 1)
-                c[:, sel] += p[:, j][:, None, :]
-            return {k: i for i, k in enumerate(keys)}, c, np.array([spheres[k][2] for k in keys])
-
-        lcol, lc, lr = world(self.link_spheres)
-        mcol, mc, mr = world(self.spheres)
-        mask = np.zeros((N, len(self.pairs)), bool)
-        for k, (a, b) in enumerate(self.pairs):
-            d2 = ((lc[:, lcol[a]] - lc[:, lcol[b]]) ** 2).sum(axis=1)
-            rows = np.flatnonzero(d2 < (lr[lcol[a]] + lr[lcol[b]] + SPHERE_MARGIN) ** 2)
-            if rows.size == 0:
-                continue
-            ia = [mcol[m] for m in self.geo.objects[a]]
-            ib = [mcol[m] for m in self.geo.objects[b]]
-            ca, cb = mc[rows][:, ia], mc[rows][:, ib]
-            d2 = ((ca[:, :, None, :] - cb[:, None, :, :]) ** 2).sum(axis=-1)
-            reach = (mr[ia][:, None] + mr[ib][None, :] + SPHERE_MARGIN) ** 2
-            mask[rows, k] = (d2 < reach).any(axis=(1, 2))
-        return mask
-
-    def set_configuration(self, q: np.ndarray) -> None:
-        self.pin.forwardKinematics(self.geo.model, self.data, q)
-
-    def collides(self, k: int) -> bool:
-        """Exact test of link pair k (meshes, stop at the first colliding pair) at the
-        configuration of the last set_configuration."""
-        sub, sub_data = self.exact[k]
-        self.pin.updateGeometryPlacements(self.geo.model, self.data, sub, sub_data)
-        self.exact_tests += 1
-        return bool(self.pin.computeCollisions(sub, sub_data, True))
-
-
-def _sample(checker: _Checker, n: int, active: list[int], Q: np.ndarray, samples: int,
-            stats: dict[str, int]) -> tuple[list[int], list[int], bool]:
-    """Run the sampled configurations, a chunk at a time, over the candidate pairs still active
-    until each one's reason is certain. Per candidate: how many samples collided, and after how
-    many samples its reason was certain (0: it never was); and whether any pair stayed undecided."""
-    coll = [0] * n
-    decided_at = [0] * n  # how many samples a pair saw before its reason was certain (0: all)
-    free_limit = samples * (100 - ALWAYS_PERCENT)  # free * 100 > this -> not Always
-    always_at = samples * ALWAYS_PERCENT  # coll * 100 >= this -> Always
-    pending: list[int] = []  # active pairs seen colliding: they wait for > 5 % free samples
-    for start in range(0, samples, CHUNK):
-        if not active:
-            break
-        mask = checker.broad_phase(Q[start:start + CHUNK])
-        for r in np.flatnonzero(mask.any(axis=1)).tolist():  # samples where some spheres touch
-            i = start + r
-            if not active:
-                break
-            row = mask[r]
-            flagged = [k for k in active if row[k]]
-            if flagged:
-                checker.set_configuration(Q[i])
-            changed = False
-            for k in flagged:
-                stats["broad_phase_hits"] += 1
-                if checker.collides(k):
-                    if not coll[k]:
-                        pending.append(k)
-                    coll[k] += 1
-                    if coll[k] * 100 >= always_at:
-                        decided_at[k] = i + 1
-                        changed = True
-            for k in pending:  # samples 0..i seen: i + 1 - coll[k] of them free
-                if not decided_at[k] and (i + 1 - coll[k]) * 100 > free_limit:
-                    decided_at[k] = i + 1
-                    changed = True
-            if changed:
-                active = [k for k in active if not decided_at[k]]
-                pending = [k for k in pending if not decided_at[k]]
-    return coll, decided_at, bool(active)
 
 
 def _classify(candidates: list[tuple[str, str]], coll: list[int], decided_at: list[int], samples: int,
@@ -389,22 +301,22 @@ def compute(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEFAULT_S
     reasons: dict[tuple[str, str], str] = {p: "Adjacent" for p in all_pairs if frozenset(p) in adjacent}
     candidates = [p for p in all_pairs if p not in reasons]
 
-    model = geo.model
-    lower, upper = joint_limits(model)
+    lower, upper = joint_limits(geo.joints if geo.joints is not None else geo.model)
     q0 = default_configuration(lower, upper)
     counts: dict[tuple[str, str], tuple[int, int]] = {}
     stats = {"pairs": len(all_pairs), "sampled_pairs": 0, "samples_run": 0, "broad_phase_hits": 0, "exact_tests": 0}
 
     if candidates:
-        checker = _Checker(geo, candidates)
+        checker = Checker(geo, candidates)
         checker.set_configuration(q0)
+        near = checker.broad_phase(q0[None])[0]  # pairs whose boxes are apart do not collide there
         for k, p in enumerate(candidates):
-            if checker.collides(k):
+            if near[k] and checker.collides(k):
                 reasons[p] = "Default"
         active = [k for k, p in enumerate(candidates) if p not in reasons]
         stats["sampled_pairs"] = len(active)
         Q = sample_configurations(lower, upper, samples, seed)
-        coll, decided_at, undecided = _sample(checker, len(candidates), active, Q, samples, stats)
+        coll, decided_at, undecided = sample(checker, len(candidates), active, Q, samples, stats)
         stats["samples_run"] = samples if undecided else max(decided_at, default=0)
         if samples:  # else no sampling was asked for
             _classify(candidates, coll, decided_at, samples, reasons, counts)
@@ -491,6 +403,7 @@ def compute_naive(geo: Geometry, samples: int = DEFAULT_SAMPLES, seed: int = DEF
                            {"pairs": len(all_pairs), "mesh_pairs": len(owner)})
 
 
-__all__ = ["ALWAYS_PERCENT", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "UNCHECKED_REASONS", "CollisionMatrix",
-           "Geometry", "Pair", "adjacent_pairs", "batch_placements", "cached_matrix", "compute", "compute_naive",
-           "default_configuration", "geometry", "joint_limits", "load", "sample_configurations"]
+__all__ = ["ALWAYS_PERCENT", "CHUNK", "DEFAULT_SAMPLES", "DEFAULT_SEED", "REASONS", "SPHERE_MARGIN",
+           "UNCHECKED_REASONS", "CollisionMatrix", "Geometry", "Joints", "Mesh", "Pair", "adjacent_pairs",
+           "batch_placements", "cached_matrix", "compute", "compute_naive", "default_configuration", "geometry",
+           "joint_limits", "load", "placements", "sample_configurations"]

@@ -90,12 +90,23 @@ def _revolve(profile: list[list[float]], T: np.ndarray) -> tuple[np.ndarray, np.
     return _merge(vertices, faces)
 
 
+def unique_rows(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first, inverse) of np.unique(a, axis=0, return_index=True, return_inverse=True), the
+    unique rows in another order (callers put them in order of first appearance): rows compared as
+    bytes (a 1-D unique, 5x faster than axis=0 on a mesh), -0.0 made 0.0 first so that equal
+    numbers stay equal. first holds each row's first occurrence."""
+    rows = np.ascontiguousarray(a + 0 if a.dtype.kind == "f" else a)  # + 0: -0.0 -> 0.0 (a new array)
+    keys = rows.view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))).ravel()
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    return first, inverse.reshape(-1)
+
+
 def _merge(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Vertices equal on a 1e-8 m grid become one (the first of them), as trimesh merges them."""
     referenced = np.zeros(len(vertices), dtype=bool)
     referenced[faces] = True
     grid = (vertices * (10 ** _MERGE_DIGITS)).round().astype(np.int64)[referenced]
-    _, first, inverse = np.unique(grid, axis=0, return_index=True, return_inverse=True)
+    first, inverse = unique_rows(grid)
     order = np.argsort(first)  # unique rows in order of first appearance
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))

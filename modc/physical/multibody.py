@@ -23,7 +23,7 @@ from ..kinematics import rpy_matrix
 from ..model import Robot
 from .assembly import Description
 from .constants import GRAVITY_VECTOR
-from .meshes import tessellate
+from .meshes import tessellate, unique_rows
 from .parts import Part
 
 ROOT = "base_link"
@@ -104,11 +104,16 @@ def _mesh_arrays(part: Part) -> tuple[np.ndarray, np.ndarray]:
     corners merged into one vertex in order of first appearance (assimp's JoinIdenticalVertices)."""
     vertices, faces, _ = tessellate(part)
     corners = vertices[faces].reshape(-1, 3).astype(np.float32)
-    unique, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
+    first, inverse = unique_rows(corners)
     order = np.argsort(first)
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
     return corners[first[order]].astype(np.float64), rank[inverse.reshape(-1)].reshape(-1, 3).astype(np.int64)
+
+
+def mesh_vertices(part: Part) -> np.ndarray:
+    """The vertices of bvh(part), scaled as the URDF scales the part (no coal needed)."""
+    return _mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0])
 
 
 @lru_cache(maxsize=512)
@@ -117,8 +122,7 @@ def bvh(part: Part) -> Any:
     as the URDF scales it. Shared by every geometry object that uses the part (read-only)."""
     import coal
 
-    vertices, triangles = _mesh_arrays(part)
-    vertices = vertices * np.array([part.scale_x, 1.0, 1.0])
+    vertices, triangles = mesh_vertices(part), _mesh_arrays(part)[1]
     mesh = coal.BVHModelOBBRSS()
     mesh.beginModel(len(triangles), len(vertices))
     mesh.addVertices(vertices)
@@ -146,7 +150,7 @@ def enclosing_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
 @lru_cache(maxsize=512)
 def bounding_sphere(part: Part) -> tuple[np.ndarray, float]:
     """A sphere containing the part's collision mesh (as scaled), in the part's frame."""
-    return enclosing_sphere(_mesh_arrays(part)[0] * np.array([part.scale_x, 1.0, 1.0]))
+    return enclosing_sphere(mesh_vertices(part))
 
 
 _MESHES: dict[int, tuple[Part, tuple[Any, np.ndarray, float]]] = {}
