@@ -269,10 +269,11 @@ def test_cli_engines_give_the_same_ranking(tmp_path, capsys):
 
 
 def test_static_torque_screen_equals_pinocchio_gravity():
-    """The screen's torques at a pose are the dynamics model's gravity torques (same parts, same masses)."""
+    """The screen's torques at a pose (physical.statics, the compiler's numpy statics) are the
+    dynamics model's gravity torques (same parts, same masses)."""
     from modc import api
-    from modc.design.screen import static_torques
     from modc.dynamics.model import Dynamics
+    from modc.physical.statics import Statics
 
     for name in ("farm", "example_a"):
         robot = api.load(ROOT / "examples" / f"{name}.mod")
@@ -280,7 +281,7 @@ def test_static_torque_screen_equals_pinocchio_gravity():
         dyn = Dynamics(robot, payload)
         qs = np.random.default_rng(0).uniform(-2.0, 2.0, (4, robot.dof))
         want = np.abs([dyn.gravity(q) for q in qs])
-        assert np.abs(static_torques(robot, qs) - want).max() < 1e-4 * max(1.0, want.max())
+        assert np.abs(np.abs(Statics(robot).gravities(qs)) - want).max() < 1e-9 * max(1.0, want.max())
 
 
 def test_no_design_names_the_torque_when_the_payload_is_too_heavy():

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..kinematics import rpy_matrix
-from ..physical.constants import GRAVITY_VECTOR
 
 
 def reach_bound(unit_types, links, tool_xyz) -> float:
@@ -127,47 +126,3 @@ def collides(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: 
     return out
 
 
-def _part_com(part) -> np.ndarray:
-    """A part's centre of mass in its frame: its primitives' centroids weighted by volume (uniform
-    density, as the URDF's inertials are derived)."""
-    vols = np.array([p.volume for p in part.primitives])
-    centres = np.array([p.center for p in part.primitives], float)
-    return (vols[:, None] * centres).sum(0) / vols.sum()
-
-
-def static_torques(robot, qs) -> np.ndarray:
-    """|gravity torque| (N·m) per pose and joint, (len(qs), n), from the library's parts and the
-    payload: exact static torques at these poses. Poses inside the joint limits bound the worst
-    case from below, so a pose over an actuator's peak rules the chain out before any exact check."""
-    from ..kinematics import Chain, rpy_matrix
-    from ..physical.parts import unit_parts
-
-    lib = robot.library
-    chain = Chain(robot)
-    g = rpy_matrix(robot.base.rpy).T @ np.array(GRAVITY_VECTOR)
-    per_unit = [unit_parts(lib, u.variant, u.kind, robot.link_length(u)) for u in robot.units]
-    frame = {"unit": "T_base_unit", "twist1": "T_base_twist1", "joint": "T_base_joint"}
-    # (unit, frame, first joint that carries it) and mass, centre in that frame: the same every pose
-    where = [(i, frame[part.frame], i if part.frame == "joint" else i - 1)
-             for i, parts in enumerate(per_unit) for part in parts]
-    masses = [part.mass for parts in per_unit for part in parts]
-    local = [_part_com(part) for parts in per_unit for part in parts]
-    if robot.payload is not None:  # carried by every joint, at tool0's offset
-        masses.append(robot.payload.mass)
-    carried = np.array([w[2] for w in where] + [robot.dof - 1] * (robot.payload is not None), int)
-    M = np.array(masses, float)
-    out = np.zeros((len(qs), robot.dof))
-    for k, q in enumerate(qs):
-        frames = chain.frames(np.asarray(q, float))
-        centres = [frames[i][f][:3, :3] @ c + frames[i][f][:3, 3] for (i, f, _), c in zip(where, local, strict=True)]
-        if robot.payload is not None:
-            T = (frames[-1]["T_base_end"] if frames else np.eye(4)) @ chain.T_flange_tool
-            centres.append(T[:3, :3] @ np.asarray(robot.payload.com) + T[:3, 3])
-        C = np.array(centres)
-        for i, f in enumerate(frames):
-            p, z = f["T_base_joint"][:3, 3], f["T_base_joint"][:3, 2]
-            on = carried >= i
-            F = M[on] @ (C[on] - p)  # sum of m (c - p): z . sum (c - p) x m g = F . (g x z)
-            gz = (g[1] * z[2] - g[2] * z[1], g[2] * z[0] - g[0] * z[2], g[0] * z[1] - g[1] * z[0])
-            out[k, i] = abs(float(F[0] * gz[0] + F[1] * gz[1] + F[2] * gz[2]))
-    return out

@@ -9,7 +9,6 @@ from ..model import ResolvedProblem
 from . import space
 from .evaluate import Candidate, verify
 from .rank import Design, identity
-from .screen import static_torques
 from .search import ShapeResult
 
 TRIES = 3  # twist settings verified per chain before giving up on it
@@ -44,12 +43,15 @@ class Verifier:
     def _holds(self, res: ShapeResult, variants, f) -> bool:
         """The static torque screen: gravity torques at the poses found for the targets (inside the
         limits, so no more than the worst case) within every actuator's peak."""
+        from ..model import resolved
+        from ..physical.statics import Statics
         from .evaluate import robot_for
 
         lib = self.problem.cell.library
         cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
         robot = robot_for(self.problem, cand, {}, self.problem.name)
-        tau = static_torques(robot, [sols[0] for sols in f.solutions])
+        # the compiler's own static model (pinocchio's g(q) to rounding), batched over the poses
+        tau = np.abs(Statics(resolved(robot, lib)).gravities([sols[0] for sols in f.solutions]))
         peak = np.array([lib.variants[v].actuator.torque_peak for v in variants])
         if np.all(tau <= peak):
             return True
