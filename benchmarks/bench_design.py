@@ -226,7 +226,7 @@ def bench_reference(count: int) -> dict:
     shape = Shape((4, 4, 3), (None, None, None))
     ax = search.axes(spec, shape)
     lo = search.size(spec, shape) // 3
-    piv, por = search._settings(ax, 3, lo, lo + count)
+    piv, por = search.range_settings(ax, 3, lo, lo + count)
     units = [lib.units[k] for k in shape.kinds]
     limit = np.full(3, spec.upper)
     q0 = seeds(3, 4, -limit, limit, 0)

@@ -318,7 +318,7 @@ def test_a_setting_that_reaches_the_target_lies_in_a_family_left_alive():
                            space.port_free(prob, shape, lib), np.eye(4))
         for _ in range(5):
             i = int(rng.integers(ax.count))
-            piv, por = search._settings(ax, len(kinds), i, i + 1)
+            piv, por = search.range_settings(ax, len(kinds), i, i + 1)
             q = rng.uniform(-LIMIT, LIMIT, (1, 1, 1, len(kinds)))
             x = forward(geometry(types, piv, por, links, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), q)[2][0, 0, 0, :3, 3]
             fam = prefix.refine(lv, x[None], np.array([1e-4]), cap=20_000)

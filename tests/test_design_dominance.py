@@ -135,7 +135,7 @@ def test_a_level_over_the_budget_falls_back_to_the_coarse_grid_and_says_so(monke
     assert sum(plan.levels.counts[:done + 1]) <= 5000 < sum(plan.levels.counts[:done + 2])
     assert not res.complete and res.finished and res.dominated == 0
     ax, rest = search._listed(spec, shape, hows[-1])
-    piv, por = search._settings_at(ax, 4, rest)
+    piv, por = search.settings_at(ax, 4, rest)
     assert not ax.full and ((piv != 0).sum(-1) + (por != 0).sum(-1) > done).all()  # only the levels left
     assert res.screened + sum(q.excluded for q in res.parts) == sum(plan.levels.counts[:done + 1]) + len(rest)
 

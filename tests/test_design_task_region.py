@@ -27,7 +27,8 @@ def problem(text: str = TRAY):
 def test_region_points_start_from_the_nearest_point_already_reached(monkeypatch):
     from modc.design import reach, space, tasks
     from modc.design.evaluate import Spec, screen_batch
-    from modc.design.search import _settings, axes
+    from modc.design.settings import axes
+    from modc.design.settings import range_settings as _settings
 
     p, _names = tasks.with_points(problem())
     spec = Spec.of(p)

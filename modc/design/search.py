@@ -20,9 +20,7 @@ lies, then simplest twists first.
 """
 from __future__ import annotations
 
-import functools
 import hashlib
-import math
 import threading
 import time
 import weakref
@@ -36,10 +34,10 @@ from ..kinematics import transform
 from . import bounds, dominance, prefix
 from .batch import geometry
 from .evaluate import Spec, screen_batch
+from .settings import COARSE, Axes, axes, coarse_axes, full_axes, settings_at
 from .space import Shape, port_free, twist_values
 
 COMPLETE = 2_000_000  # settings of a shape searched in full up to this many
-COARSE = 2048  # settings on the coarse grid of a larger shape
 BLOCK = 4096  # settings screened together (numpy amortisation)
 WORK = 65536  # settings per unit of work
 KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
@@ -110,48 +108,6 @@ def order_key(f: Found) -> tuple:
     """Deepest inside the tolerances first (to 1 % of a tolerance: IK runs end ~1e-7 m off a
     reachable target, and such differences mean nothing), then simplest."""
     return _keys([f.worst], np.array([f.pivots]), np.array([f.ports]))[0]
-
-
-def _coarse_index(count: int, i0: int, stride: int) -> list[int]:
-    """Every stride-th index counted from i0 (the value nearest 0 stays in)."""
-    return [i for i in range(count) if (i - i0) % stride == 0]
-
-
-@dataclass(frozen=True)
-class Axes:
-    """The twist values per axis, unit by unit (its pivot, then its port when that matters),
-    which twist each axis sets, and whether they are every realisable value (not a coarse grid)."""
-
-    values: tuple[np.ndarray, ...]
-    roles: tuple[tuple[str, int], ...]  # ("pivot" | "port", position)
-    full: bool
-
-    @property
-    def count(self) -> int:
-        return math.prod(len(a) for a in self.values)
-
-
-def full_axes(spec: Spec, shape: Shape) -> Axes:
-    lib = spec.problem.cell.library
-    pivot_set, port_set = twist_values(lib.twists.pivot), twist_values(lib.twists.port)
-    free = port_free(spec.problem, shape, lib)
-    values: list[np.ndarray] = []
-    roles: list[tuple[str, int]] = []
-    for i in range(shape.n):
-        values.append(pivot_set)
-        roles.append(("pivot", i))
-        if free[i]:
-            values.append(port_set)
-            roles.append(("port", i))
-    return Axes(tuple(values), tuple(roles), True)
-
-
-def coarse_axes(spec: Spec, shape: Shape) -> Axes:
-    ax = full_axes(spec, shape)
-    zero = [int(np.argmin(np.abs(a))) for a in ax.values]
-    strides = _strides(tuple(len(a) for a in ax.values), tuple(zero))
-    return Axes(tuple(a[_coarse_index(len(a), z, s)] for a, z, s in zip(ax.values, zero, strides, strict=True)),
-                ax.roles, False)
 
 
 @dataclass(frozen=True)
@@ -246,25 +202,6 @@ def _plan(spec: Spec, shape: Shape) -> Plan:
     return Plan(coarse, _split([(0, coarse.count)]), coarse.count, 0)
 
 
-def axes(spec: Spec, shape: Shape, full: bool = True) -> Axes:
-    """The axes a unit of work enumerates (cheap: no bound is computed)."""
-    return full_axes(spec, shape) if full else coarse_axes(spec, shape)
-
-
-@functools.lru_cache(maxsize=256)
-def _strides(lengths: tuple[int, ...], zero: tuple[int, ...]) -> tuple[int, ...]:
-    """Strides that thin the axes evenly (the longest first) until at most COARSE settings remain."""
-    strides = [1] * len(lengths)
-
-    def count(j: int) -> int:
-        return (lengths[j] - 1 - zero[j] % strides[j]) // strides[j] + 1
-
-    while math.prod(count(j) for j in range(len(lengths))) > COARSE:
-        k = max(range(len(lengths)), key=lambda j: (count(j), -j))
-        strides[k] += 1
-    return tuple(strides)
-
-
 def size(spec: Spec, shape: Shape) -> int:
     return plan(spec, shape).total
 
@@ -293,24 +230,11 @@ def _listed(spec: Spec, shape: Shape, how) -> tuple[Axes, np.ndarray | None]:
 
     def rest() -> np.ndarray:
         every = np.arange(coarse.count, dtype=np.int64)
-        piv, por = _settings_at(coarse, shape.n, every)
+        piv, por = settings_at(coarse, shape.n, every)
         level = (np.abs(piv) > 1e-9).sum(-1) + (np.abs(por) > 1e-9).sum(-1)
         return every[level > how[1]]
 
     return coarse, dominance.numbers(p, how, rest)
-
-
-def _settings(ax: Axes, n: int, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
-    return _settings_at(ax, n, np.arange(lo, hi))
-
-
-def _settings_at(ax: Axes, n: int, numbers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    idx = np.unravel_index(numbers, [len(a) for a in ax.values])
-    pivots = np.zeros((len(numbers), n))
-    ports = np.zeros((len(numbers), n))
-    for a, i, (role, pos) in zip(ax.values, idx, ax.roles, strict=True):
-        (pivots if role == "pivot" else ports)[:, pos] = a[i]
-    return pivots, ports
 
 
 def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], seed: int,
@@ -339,7 +263,7 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         if STOP.is_set() or (deadline is not None and time.time() > deadline):
             break
         end = min(start + BLOCK, hi)
-        piv, por = _settings_at(ax, shape.n, numbers[start:end])
+        piv, por = settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
         ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
         excluded += int((~ok).sum())
