@@ -215,7 +215,7 @@ def bench_reference(count: int) -> dict:
     """The plain per-candidate screen (see the module's docstring), on the same shape and range."""
     import numpy as np
 
-    from modc.design import search
+    from modc.design import search, settings
     from modc.design.evaluate import Spec
     from modc.design.reach import seeds
     from modc.design.space import Shape
@@ -224,9 +224,9 @@ def bench_reference(count: int) -> dict:
     spec = Spec.of(problem())
     lib = spec.problem.cell.library
     shape = Shape((4, 4, 3), (None, None, None))
-    ax = search.axes(spec, shape)
+    ax = settings.axes(spec, shape)
     lo = search.size(spec, shape) // 3
-    piv, por = search.range_settings(ax, 3, lo, lo + count)
+    piv, por = settings.range_settings(ax, 3, lo, lo + count)
     units = [lib.units[k] for k in shape.kinds]
     limit = np.full(3, spec.upper)
     q0 = seeds(3, 4, -limit, limit, 0)

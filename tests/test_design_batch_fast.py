@@ -251,7 +251,7 @@ def test_ldl_solve_equals_lapack_on_damped_normal_equations():
 
 
 def test_forward_without_rotation_gives_the_same_positions_and_axes():
-    from modc.design import search
+    from modc.design import settings
     from modc.design.batch import Flat, forward_flat, geometry
     from modc.design.evaluate import Spec
     from modc.design.space import Shape
@@ -260,7 +260,7 @@ def test_forward_without_rotation_gives_the_same_positions_and_axes():
     shape = Shape((4, 4, 3), (None, None, None))
     lib, tool = spec.problem.cell.library, spec.problem.cell.tool
     types = [lib.units[k] for k in shape.kinds]
-    piv, por = search.range_settings(search.axes(spec, shape), 3, 5000, 5200)
+    piv, por = settings.range_settings(settings.axes(spec, shape), 3, 5000, 5200)
     g = geometry(types, piv, por, [t.x23 for t in types], tool.xyz, tool.rpy)
     f = Flat.of(g, np.repeat(np.arange(200), 4))
     q = np.random.default_rng(2).uniform(-2.5, 2.5, (3, 800))
@@ -303,7 +303,7 @@ def test_nearest_obstacle_equals_the_plain_distance():
 
 @pytest.mark.parametrize("text", [THREE, ORIENTED])
 def test_collisions_skip_only_samples_their_segment_ends_prove_clear(text):
-    from modc.design import search
+    from modc.design import settings
     from modc.design.batch import forward, geometry
     from modc.design.evaluate import Spec
     from modc.design.screen import collides
@@ -313,7 +313,7 @@ def test_collisions_skip_only_samples_their_segment_ends_prove_clear(text):
     shape = Shape((4, 4, 3), (None, None, None))
     lib, tool = spec.problem.cell.library, spec.problem.cell.tool
     types = [lib.units[k] for k in shape.kinds]
-    piv, por = search.range_settings(search.axes(spec, shape), 3, 9000, 9400)
+    piv, por = settings.range_settings(settings.axes(spec, shape), 3, 9000, 9400)
     g = geometry(types, piv, por, [t.x23 for t in types], tool.xyz, tool.rpy)
     q = np.random.default_rng(8).uniform(-2.9, 2.9, (400, 1, 1, 3))
     frames = forward(g, q, points=True)[3][:, 0, 0]
@@ -341,7 +341,7 @@ def test_order_keys_of_a_block_equal_the_key_of_each_setting():
 def _screen_all(text, kinds, lo, count, links=None):
     """The search's own blocks over a range of a shape's settings: per setting the bound, then the
     screen's decisions."""
-    from modc.design import bounds, search
+    from modc.design import bounds, search, settings
     from modc.design.batch import geometry
     from modc.design.evaluate import Spec, screen_batch
     from modc.design.space import Shape
@@ -350,13 +350,13 @@ def _screen_all(text, kinds, lo, count, links=None):
     shape = Shape(kinds, links or (None,) * len(kinds))
     lib, tool = spec.problem.cell.library, spec.problem.cell.tool
     types = [lib.units[k] for k in shape.kinds]
-    ax = search.axes(spec, shape)
+    ax = settings.axes(spec, shape)
     if lo is None:  # around the farm arm's own twists
         farm = ((0.0,), (-np.pi / 2, np.pi / 4), (0.0, 0.0))
         at = [int(np.argmin(np.abs(a - farm[i][0 if r == "pivot" else 1]))) for a, (r, i) in zip(ax.values, ax.roles,
                                                                                                     strict=True)]
         lo = int(np.ravel_multi_index(at, [len(a) for a in ax.values])) - count // 2
-    piv, por = search.range_settings(ax, shape.n, lo, lo + count)
+    piv, por = settings.range_settings(ax, shape.n, lo, lo + count)
     links_m = [(x if x is not None else t.x23) for t, x in zip(types, shape.links, strict=True)]
     g = geometry(types, piv, por, links_m, tool.xyz, tool.rpy)
     k = np.flatnonzero(bounds.possible(bounds.frames(g), spec.targets.xyz, spec.targets.tol_p).all(-1))

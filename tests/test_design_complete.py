@@ -267,7 +267,7 @@ def test_families_excluded_whole_never_hold_a_reaching_setting():
     free) by one test: for random settings of random shapes, the point their tool0 reaches stays
     possible for every family the setting belongs to, at every depth; and the option lists the
     families are built from multiply to the shape's settings."""
-    from modc.design import bounds, prefix, search, space
+    from modc.design import bounds, prefix, settings, space
     from modc.design.batch import geometry
     from modc.design.evaluate import Spec
 
@@ -278,7 +278,7 @@ def test_families_excluded_whole_never_hold_a_reaching_setting():
     for n in range(1, 7):
         kinds = tuple(int(k) for k in rng.integers(1, 5, n))
         shape = space.Shape(kinds, (None,) * n)
-        ax = search.full_axes(spec, shape)
+        ax = settings.full_axes(spec, shape)
         types = [lib.units[k] for k in kinds]
         units = [library_units()[k] for k in kinds]
         links = [t.x23 for t in types]
@@ -302,7 +302,7 @@ def test_families_excluded_whole_never_hold_a_reaching_setting():
 def test_a_setting_that_reaches_the_target_lies_in_a_family_left_alive():
     """The numbering of families is the search's numbering of settings: for a setting picked at
     random (by its number), a target put where its tool0 gets lies in a range left alive."""
-    from modc.design import prefix, search, space
+    from modc.design import prefix, settings, space
     from modc.design.batch import forward, geometry
     from modc.design.evaluate import Spec
 
@@ -311,14 +311,14 @@ def test_a_setting_that_reaches_the_target_lies_in_a_family_left_alive():
     rng = np.random.default_rng(3)
     for kinds in [(4, 1, 3), (3, 4, 2), (4, 3, 4, 3), (1, 4, 2, 3)]:
         shape = space.Shape(kinds, (None,) * len(kinds))
-        ax = search.full_axes(spec, shape)
+        ax = settings.full_axes(spec, shape)
         types = [lib.units[k] for k in kinds]
         links = [t.x23 for t in types]
         lv = prefix.levels(types, links, ax.values[0], space.twist_values(lib.twists.port),
                            space.port_free(prob, shape, lib), np.eye(4))
         for _ in range(5):
             i = int(rng.integers(ax.count))
-            piv, por = search.range_settings(ax, len(kinds), i, i + 1)
+            piv, por = settings.range_settings(ax, len(kinds), i, i + 1)
             q = rng.uniform(-LIMIT, LIMIT, (1, 1, 1, len(kinds)))
             x = forward(geometry(types, piv, por, links, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), q)[2][0, 0, 0, :3, 3]
             fam = prefix.refine(lv, x[None], np.array([1e-4]), cap=20_000)

@@ -81,14 +81,14 @@ def test_kept_settings_equal_a_brute_force_over_every_setting(monkeypatch, keep)
     first round (levels 1-2: no setting of level 0 is alive), against every setting screened and
     ranked by the test's key. keep=6 needs level 3 too, then closes level 4 by dominance;
     keep=200 needs every level."""
-    from modc.design import dominance, search
+    from modc.design import dominance, search, settings
     from modc.design.evaluate import Spec
     from modc.design.space import Shape
 
     p = _problem(TWO)
     spec = Spec.of(p)
     shape = Shape((1, 1, 1, 1), (None,) * 4)
-    count = search.full_axes(spec, shape).count
+    count = settings.full_axes(spec, shape).count
     assert count == 13 ** 4
     monkeypatch.setattr(search, "KEEP", 10 ** 6)
     brute = search.search_part(spec, shape, ((0, count),), 0)
@@ -117,7 +117,7 @@ def test_a_level_over_the_budget_falls_back_to_the_coarse_grid_and_says_so(monke
     """Kept settings that cannot close the shape (KEEP larger than its feasible settings at
     rounded worst 0.0 among the levels that fit the budget): the levels above the last one
     searched go on the coarse grid and the shape is not complete."""
-    from modc.design import dominance, search
+    from modc.design import dominance, search, settings
     from modc.design.evaluate import Spec
     from modc.design.space import Shape
 
@@ -135,7 +135,7 @@ def test_a_level_over_the_budget_falls_back_to_the_coarse_grid_and_says_so(monke
     assert sum(plan.levels.counts[:done + 1]) <= 5000 < sum(plan.levels.counts[:done + 2])
     assert not res.complete and res.finished and res.dominated == 0
     ax, rest = search._listed(spec, shape, hows[-1])
-    piv, por = search.settings_at(ax, 4, rest)
+    piv, por = settings.settings_at(ax, 4, rest)
     assert not ax.full and ((piv != 0).sum(-1) + (por != 0).sum(-1) > done).all()  # only the levels left
     assert res.screened + sum(q.excluded for q in res.parts) == sum(plan.levels.counts[:done + 1]) + len(rest)
 
