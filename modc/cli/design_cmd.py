@@ -56,6 +56,30 @@ def _sigint_stops():
             signal.signal(signal.SIGINT, old)
 
 
+def _search_all(problems, max_units, top, seed, workers, scheduler, deadline, mode):
+    """Every design block searched in turn (until one stops): the outcomes, a no-design diagnostic
+    per block without a design, and whether Ctrl-C stopped it."""
+    from ..design import run as search
+    from ..diagnostics import codes
+    from .design_progress import progress as show_progress
+
+    outcomes, failed = [], []
+    with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor, \
+            _sigint_stops() as stop:
+        for p in problems:
+            with show_progress(mode, p.name) as bar:
+                o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar,
+                                  deadline=deadline)
+            if not o.designs:
+                hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
+                units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
+                failed.append(codes.NO_DESIGN.at(p.name_span, units=units, name=p.name, closest=o.why_none()))
+            outcomes.append(o)
+            if o.stopped:
+                break
+    return outcomes, failed, stop.is_set()
+
+
 def _cap_workers(_ctx: click.Context, _param: click.Parameter, value: int) -> int:
     """More processes than CPUs only add memory and switching: cap at the CPUs this process may use."""
 
@@ -152,12 +176,10 @@ def design_cmd(
     from dataclasses import replace
 
     from ..compiler import InputError, check_file, inputs_of
-    from ..design import run as search
     from ..design.write import files as design_files
     from ..design.write import ranking, summary_line
     from ..diagnostics import Severity, codes
     from ..outputs import check_output_dir, write_tree
-    from .design_progress import progress as show_progress
 
     try:
         checked = check_file(file, library)
@@ -179,22 +201,13 @@ def design_cmd(
         check_output_dir(out, inputs, force)
     budget = _budget(time_budget)
     deadline = None if budget is None else time.time() + budget
-    outcomes, failed = [], []
     mode = "off" if quiet else "live" if sys.stderr.isatty() else "plain"
-    with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor, \
-            _sigint_stops() as stop:
-        for p in problems:
-            with show_progress(mode, p.name) as bar:
-                o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar,
-                                  deadline=deadline)
-            if not o.designs:
-                hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
-                units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
-                failed.append(codes.NO_DESIGN.at(p.name_span, units=units, name=p.name, closest=o.why_none()))
-            outcomes.append(o)
-            if o.stopped:
-                break
-    interrupted = stop.is_set()
+    try:
+        outcomes, failed, interrupted = _search_all(problems, max_units, top, seed, workers, scheduler, deadline,
+                                                    mode)
+    except KeyboardInterrupt:  # a second Ctrl-C: at once, nothing written
+        _err(f"modc design: interrupted; nothing written to {out}")
+        raise SystemExit(EXIT_INTERRUPTED) from None
     for o in outcomes:
         if o.stopped:
             _err(f"modc design: {o.problem.name}: {_stopped_text(o)}")

@@ -16,7 +16,7 @@ from ..model import ResolvedProblem
 from . import space
 from .evaluate import Spec, _sub_targets
 from .screen import reach_bound
-from .search import parts_of, search_part
+from .search import STOP, parts_of, search_part
 
 PROBE_SECONDS = 10.0  # per target not yet tried alone
 
@@ -83,6 +83,10 @@ def diagnose(problem: ResolvedProblem, spec: Spec, names, blocked, hit, clear, c
         if stopped and not h:
             entry.update(detail="not reached by the settings screened before the search stopped")
             continue
+        if not h and (STOP.is_set() or (deadline is not None and time.time() >= deadline)):
+            entry.update(detail="not reached by the settings screened; the time ran out before it was "
+                                "searched alone")
+            continue
         if not h:
             until = time.time() + PROBE_SECONDS if deadline is None else min(deadline, time.time() + PROBE_SECONDS)
             p = _probe(problem, spec, i, seed, until, free=False)
@@ -112,6 +116,25 @@ def diagnose(problem: ResolvedProblem, spec: Spec, names, blocked, hit, clear, c
     return out
 
 
+NAMED = 5  # targets named per reason; the rest counted (a 100 x 100 region is 10,000 points)
+
+
+def _grouped(bad: list[tuple[str, dict]]) -> str:
+    """Per reason, in the order first met, the targets it rules out: "target 'a': …" or
+    "targets 'a', 'b' and 3 more: …"."""
+    why: dict[str, list[str]] = {}
+    for n, t in bad:
+        said = t["detail"] + (f" ({t['ruled_out_by']})" if t["ruled_out_by"] and t["ruled_out_by"] not in t["detail"]
+                              else "")
+        why.setdefault(said, []).append(n)
+    parts = []
+    for said, names in why.items():
+        shown = ", ".join(f"'{n}'" for n in names[:NAMED])
+        more = f" and {len(names) - NAMED:,} more" if len(names) > NAMED else ""
+        parts.append(f"{'targets' if len(names) > 1 else 'target'} {shown}{more}: {said}")
+    return "; ".join(parts)
+
+
 def screened_any(probe: dict | None) -> bool:
     return probe is None or bool(probe["screened"])
 
@@ -131,9 +154,7 @@ def why_none(o) -> str:
                        f"the longest arm in the bounds (by {_length(far)} at least)")
     bad = [(n, t) for n, t in o.targets.items() if not t["reached_alone"]]
     if bad:
-        return head + "; ".join(f"target '{n}': {t['detail']}" + (f" ({t['ruled_out_by']})"
-                                if t["ruled_out_by"] and t["ruled_out_by"] not in t["detail"] else "")
-                                for n, t in bad)
+        return head + _grouped(bad)
     torque = [r for r in o.rejections if "torque" in r]
     if torque:
         return head + (f"every target can be reached alone, but torque rules out {len(torque)} chains "

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -88,10 +89,11 @@ def _sub_targets(tg: reach.Targets, t: int) -> reach.Targets:
 
 
 def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray, seed: int,
-                 g: Geometry | None = None) -> Screened:
+                 g: Geometry | None = None, interrupted: Callable[[], bool] | None = None) -> Screened | None:
     """Targets one at a time, farthest from the base first: a candidate leaves the batch at the
     first target it cannot reach (most twist settings miss the hardest one), so the rest of the
-    work is spent on candidates that may pass."""
+    work is spent on candidates that may pass. interrupted() is asked before each target (a
+    region of thousands of points makes one batch long): True abandons the batch (None)."""
     lib = spec.problem.cell.library
     if g is None:
         types = [lib.units[k] for k in shape.kinds]
@@ -115,6 +117,8 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     for t in np.argsort(-np.linalg.norm(tg.xyz, axis=1), kind="stable"):
         if live.size == 0:
             break
+        if interrupted is not None and interrupted():
+            return None
         tried[live, t] = True
         # seeds one after the other: a candidate stops at its first run that reaches the target
         # clear of the cell (whether any seed does is the same as running them all). First a

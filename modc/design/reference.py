@@ -187,6 +187,7 @@ def _evaluate(problem: ResolvedProblem, seed: int) -> Reference | None:
         closest, hit, sols = np.inf, False, []
         for k in range(RESTARTS):
             s = screen_batch(one, shape, pivots, ports, seed + k)
+            assert s is not None  # (never interrupted: no callback)
             closest, hit = min(closest, float(s.closest[0, 0])), hit or bool(s.hit[0, 0])
             if s.feasible[0]:
                 sols = [tuple(float(x) for x in q) for q in s.solutions[0][0]]

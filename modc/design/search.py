@@ -133,10 +133,23 @@ _PLANS: dict[int, tuple[weakref.ref, dict[Shape, Plan], str]] = {}
 _BY_CONTENT: OrderedDict[tuple[str, Shape], Plan] = OrderedDict()
 
 
+_PROBLEM_TEXT: list[tuple[object, bytes]] = []  # the last few problems and their repr (thousands of region
+# points make a repr cost milliseconds, and a diagnosis asks it per target)
+
+
+def _problem_text(problem) -> bytes:
+    for p, text in _PROBLEM_TEXT:
+        if p is problem:
+            return text
+    text = repr(problem).encode()
+    _PROBLEM_TEXT[:] = [(problem, text), *_PROBLEM_TEXT[:3]]
+    return text
+
+
 def _digest(spec: Spec) -> str:
     """What a plan depends on: the problem (its library, tool and targets) and the targets screened."""
     tg = spec.targets
-    return hashlib.sha256(repr(spec.problem).encode() + tg.xyz.tobytes() + tg.tol_p.tobytes()
+    return hashlib.sha256(_problem_text(spec.problem) + tg.xyz.tobytes() + tg.tol_p.tobytes()
                           + np.asarray(tg.oriented).tobytes()).hexdigest()
 
 
@@ -259,6 +272,12 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
     hit, clear = np.zeros(T, bool), np.zeros(T, bool)
     screened = excluded = 0
     upto = lo
+
+    def interrupted() -> bool:  # between the targets of a block: the heartbeat, Ctrl-C and the budget
+        for tick in TICK:
+            tick()
+        return STOP.is_set() or (deadline is not None and time.time() > deadline)
+
     for start in range(lo, hi, BLOCK):
         if STOP.is_set() or (deadline is not None and time.time() > deadline):
             break
@@ -274,7 +293,11 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
             continue
         k = np.flatnonzero(ok)
         sub = g.take(k)
-        s = screen_batch(spec, shape, piv[k], por[k], s0, g=sub)
+        s = screen_batch(spec, shape, piv[k], por[k], s0, g=sub, interrupted=interrupted)
+        if s is None:  # stopped inside the block: it counts as not searched
+            upto = start
+            excluded -= int((~ok).sum())
+            break
         screened += len(k)
         closest = np.minimum(closest, s.closest.min(0))
         hit |= s.hit.any(0)
