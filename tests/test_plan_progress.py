@@ -52,7 +52,7 @@ def test_task_progress_on_stderr_and_quiet(tmp_path):
     r = _plan(tmp_path, "--task", "serve", "--json")
     assert r.returncode == 0, r.stderr
     lines = [ln for ln in r.stderr.splitlines() if ln.startswith("modc plan: task 'serve'")]
-    assert lines and lines[-1].startswith("modc plan: task 'serve': the approach and 1 segment(s) planned and timed")
+    assert lines and lines[-1].startswith("modc plan: task 'serve': 1 segment(s) planned and timed")
     assert r.stdout.lstrip().startswith("{")  # the trajectory alone on stdout
     q = _plan(tmp_path, "--task", "serve", "--json", "-q")
     assert q.returncode == 0 and "modc plan:" not in q.stderr and q.stdout == r.stdout
@@ -73,7 +73,7 @@ def test_plain_progress_ticks_while_a_segment_is_planned(monkeypatch):
     lines = err.getvalue().splitlines()
     ticks = [ln for ln in lines if "planning the segment 1 of 2 (a -> b)" in ln]
     assert len(ticks) >= 3, lines
-    assert lines[-1].startswith("modc plan: task 'serve': the approach and 2 segment(s) planned and timed")
+    assert lines[-1].startswith("modc plan: task 'serve': 2 segment(s) planned and timed")
     with plan_progress.progress("off", "serve") as hook:
         assert hook is None
 

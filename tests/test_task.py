@@ -473,3 +473,35 @@ def test_written_robot_file_keeps_the_task():
     again = design.robots[0]
     for a, b in ((robot.regions, again.regions), (robot.tasks, again.tasks), (robot.paths, again.paths)):
         assert [x.model_dump() for x in a] == [x.model_dump() for x in b]
+
+
+CEILING = """robot ceiling {
+    chain H1 - L4(pivot=-45deg, port=-45deg) - L3
+    tool at (0.05, 0, 0) m
+    box ceiling size (1.2, 1.2, 0.02) m at (0, 0, 0.62) m
+    target rest at (0.22, 0.18, 0.25) m
+    target low at (0.30, 0.0, 0.10) m
+    task pick { visit rest, low, rest }
+}
+"""
+
+
+@pytest.mark.slow
+def test_a_home_pose_that_touches_the_cell_does_not_veto_the_task():
+    """A ceiling over the arm catches its upright home pose: the task, clear of it, starts at its
+    first waypoint (no approach, which is not counted anyway) instead of failing."""
+    from modc.plan.collision import CollisionChecker
+    from modc.plan.task import plan_task_robot
+
+    c = check_text(CEILING, "ceiling.mod")
+    assert c.ok, [d.message for d in c.diagnostics]
+    robot = c.design.resolved_robots()[0]
+    checker = CollisionChecker(robot)
+    assert not checker.valid(np.asarray(robot.home(), float))  # the premise: home hits the ceiling
+    plan = plan_task_robot(robot, "pick", seed=0)
+    assert [(s.kind, s.start, s.end) for s in plan.segments] == [("motion", "rest", "low"), ("motion", "low", "rest")]
+    t, q = _samples(plan)
+    assert np.linalg.norm(checker.tool_position(q[0]) - np.array(robot.task_target("rest").xyz)) <= 1e-3
+    assert all(not checker.contacts(row, 0.0) for row in q)
+    assert plan.cycle_time == pytest.approx(t[-1], abs=1e-6)  # nothing before the task's own segments
+    assert "no approach" in plan.summary() and " 1 motion" in plan.summary()

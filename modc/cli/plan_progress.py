@@ -34,7 +34,7 @@ class Status:
         if total == 0:
             return f"task '{self.task}': reading the file, {spent}"
         if kind == "done":
-            return f"task '{self.task}': the approach and {total - 1} segment(s) planned and timed, {spent}"
+            return f"task '{self.task}': {total - 1} segment(s) planned and timed, {spent}"
         what = "approach" if kind == "approach" else f"segment {number} of {total - 1}"
         return f"task '{self.task}': planning the {what} ({a} -> {b}), {spent}"
 

@@ -13,27 +13,15 @@ from ..model import ResolvedRobot, Robot
 
 def reached(robot: ResolvedRobot, seed: int) -> tuple[set[str], int]:
     """The names of the region points the robot reaches clear of the cell, and how many there are."""
-    from ..kinematics import rpy_matrix
     from ..physical.checker import CollisionChecker
-    from ..plan import IK_BATCHES, IK_SEEDS_PER_JOINT, start_pose
-    from ..plan import ik as plan_ik
+    from ..plan import clear_solution, start_pose
 
     points = [p for r in robot.regions for p in r.points()]
     if not points:
         return set(), 0
     checker = CollisionChecker(robot)
     _where, home, _span = start_pose(robot, None)
-    out: set[str] = set()
-    for t in points:
-        rotation = None if t.rpy is None else rpy_matrix(t.rpy)
-        solver = plan_ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper,
-                                    rotation, t.pointing)
-        tol = t.tolerance
-        sols, _best = plan_ik.solve(solver, t.xyz, home, IK_SEEDS_PER_JOINT * robot.dof, seed,
-                                    batches=IK_BATCHES, enough=checker.valid, tolerance=tol)
-        if any(checker.valid(s.q) for s in sols):
-            out.add(t.name)
-    return out, len(points)
+    return {t.name for t in points if clear_solution(robot, checker, t, home, seed) is not None}, len(points)
 
 
 def served(robot: ResolvedRobot, points: set[str]) -> ResolvedRobot:

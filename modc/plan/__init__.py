@@ -106,6 +106,21 @@ def start_pose(robot: ResolvedRobot, name: str | None):
     return ("home", robot.home(), p.span if p is not None else robot.name_span)
 
 
+def clear_solution(robot: ResolvedRobot, checker, target, start, seed: int):
+    """A joint vector within the limits that puts tool0 on the target (a Target: its position,
+    orientation or pointing, and tolerances) clear of the cell and of the arm itself, from
+    seeded starts around `start`; None when none is found."""
+    from ..kinematics import rpy_matrix
+    from . import ik as plan_ik
+
+    rotation = None if target.rpy is None else rpy_matrix(target.rpy)
+    solver = plan_ik.PositionIK(checker.model, checker.data, checker.tool_frame, checker.lower, checker.upper,
+                                rotation, target.pointing)
+    sols, _best = plan_ik.solve(solver, target.xyz, start, IK_SEEDS_PER_JOINT * robot.dof, seed,
+                                batches=IK_BATCHES, enough=checker.valid, tolerance=target.tolerance)
+    return next((s.q for s in sols if checker.valid(s.q)), None)
+
+
 def _known(kind: str, names) -> str:
     names = list(names)
     if not names:

@@ -109,11 +109,13 @@ class TaskPlan:
         out = [f"robot {self.robot}: {self.kind} '{self.task}', {len(self.counted)} segment(s): cycle time "
                f"{self.cycle_time:.3f} s, energy {self.energy:.2f} J, peak torque {self.peak_share:.0%} of peak"]
         width = max(len(f"{s.start} -> {s.end}") for s in self.segments)
-        for i, s in enumerate(self.segments):
+        first = int(not self.segments or self.segments[0].kind != "approach")  # no approach: home touches the cell
+        for i, s in enumerate(self.segments, start=first):
             label = "approach" if s.kind == "approach" else f"{i:>2} {s.kind}"
             out.append(f"  {label:<11} {f'{s.start} -> {s.end}':<{width}}  {s.duration:7.3f} s  {s.energy:7.2f} J  "
                        f"torque {s.peak_share:4.0%}  speed {s.speed_share:4.0%}")
-        out.append(f"  trajectory  {len(self.t)} points, {self.t[-1]:.3f} s with the approach; "
+        start = "with the approach" if not first else "from the first waypoint (home touches the cell: no approach)"
+        out.append(f"  trajectory  {len(self.t)} points, {self.t[-1]:.3f} s {start}; "
                    "each segment time-optimal from rest to rest (speed: library RPM, torque: peak, with the payload)")
         return "\n".join(out)
 
@@ -155,7 +157,7 @@ def plan_task_robot(robot: ResolvedRobot, task: str, seed: int = 0, sources=None
     """Plan and time one checked robot's task or path. Raises PlanError. progress(k, n, kind, a,
     b) is called as segment k of n (0: the approach) starts, and (n, n, "done", "", "") at the end."""
     from ..physical.checker import CollisionChecker
-    from . import start_pose
+    from . import clear_solution, start_pose
     from .retime import Limits, TimingError, join
 
     sources = sources or {}
@@ -171,12 +173,21 @@ def plan_task_robot(robot: ResolvedRobot, task: str, seed: int = 0, sources=None
     q = np.array(q_home, float)
     pieces, segments, t0 = [], [], 0.0
     steps = [("approach", where, visits[0])]
+    if len(visits) > 1 and not checker.valid(q):
+        # home touches the cell (a ceiling over the arm): the task starts at its first waypoint,
+        # reached clear of the cell - the approach is not part of the task, so it cannot veto it
+        first = clear_solution(robot, checker, job.target(visits[0]), q, seed)
+        if first is not None:
+            q, steps = np.array(first, float), []
     steps += [("motion" if kind == "task" else "straight", a, b) for a, b in zip(visits, visits[1:], strict=False)]
-    for number, (what, a, b) in enumerate(steps):
+    # segment numbers: 0 is the approach (even when there is none), the task's own from 1
+    skipped = int(steps[0][0] != "approach")
+    total = len(steps) + skipped
+    for number, (what, a, b) in enumerate(steps, start=skipped):
         if what != "approach" and a == b:
             continue
         if progress is not None:
-            progress(number, len(steps), what, a, b)
+            progress(number, total, what, a, b)
         try:
             if what == "straight":
                 path, timed = job.straight(number, a, b, q)
@@ -191,7 +202,7 @@ def plan_task_robot(robot: ResolvedRobot, task: str, seed: int = 0, sources=None
         q = np.array(path[-1], float)
     whole = join(pieces, limits, q)
     if progress is not None:
-        progress(len(steps), len(steps), "done", "", "")
+        progress(total, total, "done", "", "")
     t_rows = tuple(round(float(t), 9) for t in whole.t)
     q_rows = tuple(tuple(round(float(v), 12) + 0.0 for v in row) for row in whole.q)
     return TaskPlan(robot.name, task, kind, tuple(f"joint_{i}" for i in range(1, robot.dof + 1)), t_rows, q_rows,
