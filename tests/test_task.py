@@ -505,3 +505,22 @@ def test_a_home_pose_that_touches_the_cell_does_not_veto_the_task():
     assert all(not checker.contacts(row, 0.0) for row in q)
     assert plan.cycle_time == pytest.approx(t[-1], abs=1e-6)  # nothing before the task's own segments
     assert "no approach" in plan.summary() and " 1 motion" in plan.summary()
+
+
+def test_energy_counts_the_short_torque_limited_ramps():
+    """Joint 1 (vertical) alone, from rest through its speed limit back to rest: ∫|τ·q̇| dt is
+    exactly M11 v² (speeding up, then braking), however short the ramps are - they last about
+    2 ms, less than the 10 ms between samples, and were missed (0 J reported)."""
+    from modc import api
+    from modc.plan.retime import Limits, time_polyline
+
+    robot = api.load(ROOT / "examples" / "farm.mod")
+    limits = Limits.of(robot)
+    z = np.zeros(robot.dof)
+    q1, e1 = z.copy(), z.copy()
+    q1[0], e1[0] = 1.0, 1.0
+    timed = time_polyline([z, q1], limits)
+    inertia = float((limits.rnea(z, z, e1) - limits.rnea(z, z, z))[0])
+    v = float(np.abs(timed.qd[:, 0]).max())
+    assert v > 0.5 * limits.velocity[0]  # it does cruise near its speed limit
+    assert timed.energy == pytest.approx(inertia * v**2, rel=0.02)

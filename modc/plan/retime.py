@@ -14,7 +14,8 @@ timed in one go, from rest to rest.
 toppra holds the constraints at its grid points; between them the constant-acceleration
 parametrisation may exceed them slightly, so the limits handed to it are LIMIT_SHARE of the
 real ones. Every sample of the result carries q, q̇, q̈ and τ = RNEA(q, q̇, q̈) with the payload:
-energy = ∫|τ·q̇| dt (trapezoidal rule over the samples), peak share = max |τ_i| / τ_peak,i.
+energy = ∫|τ·q̇| dt (trapezoidal rule over the samples), peak share = max |τ_i| / τ_peak,i. The
+samples are every SAMPLE_PERIOD and at toppra's knots (where the acceleration switches).
 """
 from __future__ import annotations
 
@@ -64,6 +65,9 @@ class Timed:
     qdd: np.ndarray
     tau: np.ndarray
     limits: Limits
+    # over toppra's knot intervals (_knot_figures), when known: its ramps can be shorter than a sample
+    exact_energy: float | None = None
+    exact_peak: float | None = None
 
     @property
     def duration(self) -> float:
@@ -72,13 +76,16 @@ class Timed:
     @property
     def energy(self) -> float:
         """∫|τ·q̇| dt, J."""
+        if self.exact_energy is not None:
+            return self.exact_energy
         power = np.abs(np.einsum("ij,ij->i", self.tau, self.qd))
         return float(np.sum((power[1:] + power[:-1]) * np.diff(self.t)) / 2.0) if len(self.t) > 1 else 0.0
 
     @property
     def peak_share(self) -> float:
         """max over samples and joints of |τ_i| / τ_peak,i."""
-        return float(np.max(np.abs(self.tau) / self.limits.torque)) if len(self.t) else 0.0
+        sampled = float(np.max(np.abs(self.tau) / self.limits.torque)) if len(self.t) else 0.0
+        return sampled if self.exact_peak is None else max(sampled, self.exact_peak)
 
     @property
     def speed_share(self) -> float:
@@ -129,11 +136,38 @@ def _static(timed: Timed) -> np.ndarray:
 def _at_scale(traj, limits: Limits, k: float) -> Timed:
     T = float(traj.duration) * k
     n = max(2, int(np.ceil(T / SAMPLE_PERIOD)) + 1)
-    t = np.linspace(0.0, T, n)
+    # every SAMPLE_PERIOD, and at toppra's knots, where its piecewise-constant path acceleration
+    # switches: a torque-limited start or stop can last ~2 ms, between two periodic samples, and
+    # the energy, the peak torque and the written trajectory would all miss it (toppra keeps the
+    # knots in `_ts`, with no public accessor: without them, the periodic samples alone)
+    knots = np.asarray(getattr(traj, "_ts", None) if getattr(traj, "_ts", None) is not None else [], float) * k
+    t = np.union1d(np.linspace(0.0, T, n), knots[(knots > 0.0) & (knots < T)])
+    t = t[np.concatenate([[True], np.diff(t) > 1e-6])]  # (a knot on a periodic sample: once)
     q, qd, qdd = (np.atleast_2d(traj(t / k, o)) / k**o for o in (0, 1, 2))
     qd[0] = qd[-1] = 0.0  # from rest to rest: the spline's end derivatives are 0 up to rounding
     tau = np.array([limits.rnea(a, b, c) for a, b, c in zip(q, qd, qdd, strict=True)])
-    return Timed(t, q, qd, qdd, tau, limits)
+    energy, peak = _knot_figures(traj, limits, k)
+    return Timed(t, q, qd, qdd, tau, limits, energy, peak)
+
+
+def _knot_figures(traj, limits: Limits, k: float) -> tuple[float | None, float | None]:
+    """∫|τ·q̇| dt and the peak torque share, knot interval by knot interval of toppra's
+    trajectory (its path acceleration is constant on each): Simpson's rule on the interval's
+    inside (its ends a millionth of it in, so each takes the interval's own acceleration)."""
+    knots = getattr(traj, "_ts", None)
+    if knots is None or len(knots) < 2:
+        return None, None
+    a, b = np.asarray(knots[:-1], float), np.asarray(knots[1:], float)
+    keep = b - a > 1e-12
+    a, b = a[keep], b[keep]
+    d = 1e-6 * (b - a)
+    ts = np.stack([a + d, (a + b) / 2, b - d], axis=1).reshape(-1)  # in toppra's time
+    q, qd, qdd = (np.atleast_2d(traj(ts, o)) / k**o for o in (0, 1, 2))
+    tau = np.array([limits.rnea(x, v, w) for x, v, w in zip(q, qd, qdd, strict=True)])
+    power = np.abs(np.einsum("ij,ij->i", tau, qd)).reshape(-1, 3)
+    width = k * (b - a - 2 * d)
+    energy = float(np.sum(width / 6.0 * (power[:, 0] + 4 * power[:, 1] + power[:, 2])))
+    return energy, float(np.max(np.abs(tau) / limits.torque))
 
 
 def _concat(pieces: list[Timed], limits: Limits, q0) -> Timed:
@@ -150,7 +184,10 @@ def _concat(pieces: list[Timed], limits: Limits, q0) -> Timed:
         qdds.append(p.qdd[1:])
         taus.append(p.tau[1:])
         offset += p.duration
-    return Timed(np.concatenate(ts), np.vstack(qs), np.vstack(qds), np.vstack(qdds), np.vstack(taus), limits)
+    exact = all(p.exact_energy is not None for p in pieces)
+    return Timed(np.concatenate(ts), np.vstack(qs), np.vstack(qds), np.vstack(qdds), np.vstack(taus), limits,
+                 sum(p.energy for p in pieces) if exact else None,
+                 max(p.peak_share for p in pieces) if exact else None)
 
 
 def time_polyline(path, limits: Limits) -> Timed:
