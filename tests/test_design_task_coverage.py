@@ -88,3 +88,31 @@ def test_rank_coverage_ranks_a_design_that_serves_part_of_the_region(tmp_path):
                 tgt = robot.task_target(seg["to"])
                 assert np.linalg.norm(chain.T_base_tool(q)[:3, 3] - tgt.xyz) <= tgt.position_tolerance + 1e-6
                 assert checker.contacts(q, 0.0) == []
+
+
+PAIR = """design cov {
+    tool at (0.05, 0, 0) m
+    box table size (0.16, 0.30, 0.02) m at (0.32, 0, -0.02) m
+    target rest at (0.22, 0.18, 0.25) m
+    region pair box size (0.16, 0, 0) m at (0.38, 0, 0.06) m grid 2 x 1 x 1 pointing (0, 0, -1) within 5 mm, 5 deg
+    task pick { visit rest, pair, rest }
+    units 3
+    modules H1, L3, L4
+    rank coverage, modules
+}
+"""
+
+
+@pytest.mark.slow
+def test_coverage_finds_an_arm_serving_some_points_when_none_serves_all(tmp_path):
+    """No arm of the bounds serves both points pointing down; the arms that reach `rest` by the
+    simplest twists serve neither. The candidates come from the points one at a time, so a design
+    serving one of the two is found (it was "no design": every candidate reached no point)."""
+    r = modc_design(tmp_path, PAIR, "--top", "1")
+    assert r.returncode == 0, r.stderr
+    d = json.loads((tmp_path / "out" / "ranking.json").read_text())["designs"][0]
+    assert d["coverage"] == 0.5
+    robot = check_file(tmp_path / "out" / d["file"]).design.robots[0]
+    visits = next(t for t in robot.tasks if t.name == "pick").visits
+    served = [v for v in visits if v.startswith("pair[")]
+    assert len(served) == 1  # the point it reaches, and only that one, is visited

@@ -214,10 +214,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     t0 = time.perf_counter()
     tasked = tasks.has_tasks(problem) or "coverage" in problem.rank
     screen, points = tasks.with_points(problem)  # every region point required: screened as a target
-    # the static search only picks the candidates to plan and time: fewest modules, then least mass
-    # (the torque margin along the motion is judged by the planning, not by a static tie-break)
-    screen = screen.model_copy(update={"rank": tuple(k for k in static(problem.rank) if k != "margin")
-                                       or ("modules", "mass")}) if tasked else screen
+    screen = _static_screen(screen, problem) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
 
     enough = [top]  # designs after which a round may stop (more when the first candidates all fail planning)
@@ -244,6 +241,8 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         tasks.restore(out, points)
         if not tasked:
             break
+        if _optional_points(problem) and not out.stopped:
+            out = _covering(problem, out, one, max_units, n, top, seed)
         found = len(out.designs)
         tasks.plan_all(out, top, seed, deadline, _stopping, rejected)
         # every candidate failed its tasks: search on for more of them while there may be more (the
@@ -258,6 +257,37 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     out.reference = reference.evaluate(problem, seed, deadline, grid)
     out.seconds = time.perf_counter() - t0
     return out
+
+
+def _covering(problem: ResolvedProblem, out: Outcome, one, max_units: int | None, n: int, top: int,
+              seed: int) -> Outcome:
+    """`rank coverage`: the candidates to plan are those that serve every region point when some
+    do (coverage 1, the most there is), else those serving at least one (tasks.by_points), and
+    only when none serves any, out's (the cell's targets alone: they are then told what they miss)."""
+    from . import tasks
+
+    every, names = tasks.with_points(problem, every=True)
+    whole = one(_static_screen(every, problem), max_units, n, diagnosing=False)
+    tasks.restore(whole, names)
+    picked = whole if whole.designs or whole.stopped else tasks.by_points(
+        problem, lambda s: one(_static_screen(s, problem), max_units, top, diagnosing=False), n, seed)
+    if picked is None or not picked.designs:
+        return out
+    picked.problem = problem
+    return picked
+
+
+def _static_screen(screen: ResolvedProblem, problem: ResolvedProblem) -> ResolvedProblem:
+    """The problem the static search runs on for a cell with tasks: it only picks the candidates
+    to plan and time, fewest modules then least mass (the torque margin along the motion is judged
+    by the planning, not by a static tie-break)."""
+    return screen.model_copy(update={"rank": tuple(k for k in static(problem.rank) if k != "margin")
+                                     or ("modules", "mass")})
+
+
+def _optional_points(problem: ResolvedProblem) -> bool:
+    """`rank coverage` with regions, no base grid: the static search screened no region point."""
+    return "coverage" in problem.rank and bool(problem.cell.regions) and problem.base_grid is None
 
 
 def longest_reach(problem: ResolvedProblem, hi: int) -> float:

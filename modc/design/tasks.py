@@ -31,12 +31,13 @@ def task_names(robot) -> list[str]:
     return [t.name for t in (*robot.tasks, *robot.paths)]
 
 
-def with_points(problem):
+def with_points(problem, every: bool = False, only: str | None = None):
     """The problem whose cell also holds every region point as a target when every point is
-    required (no `rank coverage`), so that the static search screens them; and the names given
-    to them (a point's own name, `tray[1,0,0]`, is no identifier), new name -> point name."""
+    required (no `rank coverage`, or `every`), so that the static search screens them; and the
+    names given to them (a point's own name, `tray[1,0,0]`, is no identifier), new name -> point
+    name. only: that one point (its name, as `tray[1,0,0]`) of the regions, no other."""
     cell = problem.cell
-    if "coverage" in problem.rank or not cell.regions:
+    if ("coverage" in problem.rank and not every and only is None) or not cell.regions:
         return problem, {}
     taken = {t.name for t in cell.targets} | {r.name for r in cell.regions} | set(task_names(cell))
     names: dict[str, str] = {}
@@ -47,6 +48,8 @@ def with_points(problem):
             name, k = stem, 2
             while name in taken:
                 name, k = f"{stem}_{k}", k + 1
+            if only is not None and r.point_name(ix) != only:
+                continue
             taken.add(name)
             names[name] = r.point_name(ix)
             extra.append(r.point(ix).model_copy(update={"name": name}))
@@ -73,6 +76,42 @@ def told(v, names: dict[str, str]):
     robot = v.robot.model_copy(update={"targets": tuple(t for t in v.robot.targets if t.name not in drop),
                                        "poses": tuple(p for p in v.robot.poses if p.name not in drop)})
     return replace(v, robot=robot, targets={names.get(k, k): x for k, x in v.targets.items()})
+
+
+def by_points(problem, search, n: int, seed: int):
+    """`rank coverage` when no design serves every region point: the static designs that reach
+    the cell's targets and at least one point - searched point by point (`search(screen)`: the
+    static search's Outcome), merged one per chain - most points reached first (modc.plan's IK,
+    clear of the cell: coverage.reached), then fewest modules and least mass; the first n of
+    them, to be planned. An outcome of the last search carries them (its counts summed)."""
+    from dataclasses import replace as _replace
+
+    from . import coverage as cov
+
+    points = [p.name for r in problem.cell.regions for p in r.points()]
+    seen: dict[str, Design] = {}
+    out = None
+    for name in points:
+        screen, names = with_points(problem, only=name)
+        o = search(screen)
+        restore(o, names)
+        if out is not None:
+            o.evaluated, o.excluded = o.evaluated + out.evaluated, o.excluded + out.excluded
+            o.rejections = out.rejections + o.rejections
+        out = o
+        for d in o.designs:
+            seen.setdefault(d.chain(), d)
+        if o.stopped:
+            break
+    if out is None:
+        return None
+    scored = []
+    for d in seen.values():
+        got, total = cov.reached(d.verified.robot, seed)
+        share = len(got) / max(total, 1)
+        scored.append((-len(got), d.modules, round(d.mass, 9), d.chain(), _replace(d, coverage=share)))
+    out.designs = [x[-1] for x in sorted(scored, key=lambda x: x[:4]) if x[0] < 0][:n]
+    return out
 
 
 def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = False) -> Design | str:
