@@ -162,4 +162,7 @@ def why_none(o) -> str:
     if o.rejections:
         return head + (f"every target can be reached alone; {len(o.rejections)} chains reach every target, "
                        f"but none passes the checks (first: {o.rejections[0]})")
+    if not o.problem.cell.obstacles:
+        return head + ("every target can be reached alone, but no chain reaches all of them with one arm "
+                       "(within its joint limits, clear of itself)")
     return head + "every target can be reached alone, but no chain reaches all of them without touching the cell"
