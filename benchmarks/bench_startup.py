@@ -10,9 +10,9 @@ Commands, each round in turn: the anchor `python -c pass`; `modc --version` and 
 with modc's cache warm and empty (a fresh install, a CI runner without a cache: the validated
 library is made again; the parse's tables are exported from Lark once more);
 `modc examples/farm.mod -o OUT` as the first compile of a new arm (the install has run modc
-before: the caches keyed by modc's install alone, INSTALL_CACHES (grammar tables, validated
-built-in library, compiled templates), are warm; every cache keyed by an arm is empty: builds,
-meshes, collision matrix, worst-case torques: issue 25's "first compile"), as the first run
+before: the caches keyed by modc's install alone, INSTALL_CACHES (grammar tables, the records'
+compiled __init__s, validated built-in library, compiled templates), are warm; every cache keyed
+by an arm is empty: builds, meshes, collision matrix, worst-case torques: issue 25's "first compile"), as the first run
 after install (every cache empty: shown with its ratio, no goal) and cached (the same compile
 again);
 and the peers: `yamllint` on the farm's YAML form (benchmarks/data/farm.yaml, about the .mod
@@ -56,7 +56,7 @@ AFTER_INSTALL = "modc farm.mod -o OUT (first run after install)"
 EMPTY_CACHE = (AFTER_INSTALL, "modc lint examples/farm.mod (empty cache)")
 # modc's cache kinds keyed by modc's own files alone (grammar tables, validated built-in library,
 # compiled templates): warm on an install that has run modc once, whatever arm it compiled
-INSTALL_CACHES = ("grammar", "library", "jinja")
+INSTALL_CACHES = ("grammar", "library", "jinja", "records")
 # (modc command, peer, at most this many times the peer's CPU time): issue 25's start-up goals
 GOALS = [
     ("modc lint examples/farm.mod", "yamllint farm.yaml", 2.0),

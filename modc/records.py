@@ -123,10 +123,67 @@ def _make_init(cls: type[Record], positional: bool) -> Callable[..., None]:
     signature = f"def __init__(self{', ' if head else ''}{head}):\n"
     # (locals start with _record_ or _d_/_f_: a field may be called d, as DH's is)
     source = f"{signature}    _record_dict = self.__dict__\n{''.join(body)}    self.__post_init__()\n"
-    exec(source, scope)  # noqa: S102 - parameter names are the class's own field names (identifiers)
+    exec(_compiled(source), scope)  # noqa: S102 - parameter names are the class's own field names (identifiers)
     init = scope["__init__"]
     init.__qualname__ = f"{cls.__qualname__}.__init__"
     return init
+
+
+_CODE: dict[str, Any] | None = None  # generated __init__ source -> its compiled code, this Python's
+_CODE_KIND = "records"
+
+
+def _compiled(source: str):
+    """The code of a generated __init__: compiling the ~110 of them cost ~35 ms of every command, so
+    their code objects are kept in modc's cache (marshal, this Python's version in the key, a
+    digest checked on reading) and written back once at exit when new ones were made."""
+    global _CODE
+    if _CODE is None:
+        _CODE = _load_codes()
+    code = _CODE.get(source)
+    if code is None:
+        if not any(isinstance(v, str) for v in _CODE.values()):  # first new one: save at exit
+            import atexit
+
+            atexit.register(_save_codes)
+            _CODE["\0new"] = "new"
+        code = _CODE[source] = compile(source, "<modc.records>", "exec")
+    return code
+
+
+def _codes_name() -> str:
+    import sys
+
+    from . import cache
+
+    return cache.key(_CODE_KIND, sys.version, str(sys.implementation.cache_tag)) + ".marshal"
+
+
+def _load_codes() -> dict[str, Any]:
+    import marshal
+
+    from . import cache
+
+    try:
+        payload = cache.get_checked(_CODE_KIND, _codes_name())
+        codes = marshal.loads(payload) if payload is not None else {}
+    except (OSError, ValueError, EOFError, TypeError):
+        return {}
+    return codes if isinstance(codes, dict) else {}
+
+
+def _save_codes() -> None:
+    import marshal
+
+    from . import cache
+
+    if _CODE is None:
+        return
+    try:
+        cache.put_checked(_CODE_KIND, _codes_name(),
+                          marshal.dumps({k: v for k, v in _CODE.items() if not isinstance(v, str)}))
+    except (OSError, ValueError):
+        pass  # no cache: the next command compiles them again
 
 
 def fields(r: Record) -> tuple[str, ...]:

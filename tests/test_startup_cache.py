@@ -251,3 +251,24 @@ def test_the_formatter_s_own_tables_are_cached_and_format_alike(cache_dir):
     fmt._lark.cache_clear()
     assert fmt.format_text(text, "farm.mod") == built and built[0] is not None and "\n    chain" in built[0]
     fmt._lark.cache_clear()
+
+
+def test_the_records_code_cache_is_written_once_and_a_damaged_one_is_ignored(tmp_path):
+    """The generated __init__ of every record is compiled once per Python and kept in modc's
+    cache; a damaged entry is never used (its digest fails): the command compiles them again."""
+    env = dict(os.environ, MODC_CACHE_DIR=str(tmp_path), PYTHONPATH=str(ROOT))
+
+    def lint() -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "modc", "lint", str(ROOT / "examples" / "farm.mod")],
+                              capture_output=True, text=True, env=env, cwd=ROOT)
+
+    assert lint().returncode == 0
+    entries = list((tmp_path / "records").iterdir())
+    assert len(entries) == 1 and entries[0].stat().st_size > 1000
+    stamp = entries[0].stat().st_mtime_ns
+    assert lint().returncode == 0 and entries[0].stat().st_mtime_ns == stamp  # warm: nothing new to write
+    blob = bytearray(entries[0].read_bytes())
+    blob[-10] ^= 0xFF
+    entries[0].write_bytes(bytes(blob))
+    r = lint()
+    assert r.returncode == 0 and "Traceback" not in r.stderr and "0 errors" in r.stderr
