@@ -13,13 +13,11 @@ from ..objectives import REGISTRY, TASK
 from .evaluate import Candidate, Verified
 
 
-@dataclass(frozen=True)
-class Design:
-    candidate: Candidate
-    verified: Verified
-    alternatives: tuple[Design, ...] = ()  # the same arm with other H/L variants, best first
-    plans: tuple[Any, ...] = ()  # modc.plan.task.TaskPlan per task and path of the cell, once planned
-    coverage: float = 1.0  # share of the cell's region points reached (modc.design.coverage)
+class Planned:
+    """The task figures of an arm whose cell's tasks and paths are planned (`plans`: a
+    modc.plan.task.TaskPlan each): a design, or the block's reference arm."""
+
+    plans: tuple[Any, ...]
 
     @property
     def cycle_time(self) -> float:
@@ -30,6 +28,15 @@ class Design:
     def energy(self) -> float:
         """J, summed over the cell's tasks and paths."""
         return sum(p.energy for p in self.plans)
+
+
+@dataclass(frozen=True)
+class Design(Planned):
+    candidate: Candidate
+    verified: Verified
+    alternatives: tuple[Design, ...] = ()  # the same arm with other H/L variants, best first
+    plans: tuple[Any, ...] = ()  # modc.plan.task.TaskPlan per task and path of the cell, once planned
+    coverage: float = 1.0  # share of the cell's region points reached (modc.design.coverage)
 
     @property
     def modules(self) -> int:

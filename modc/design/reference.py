@@ -15,14 +15,14 @@ import numpy as np
 
 from ..model import ResolvedProblem, Robot, Transform
 from .evaluate import Candidate, Spec, Verified, _sub_targets, screen_batch, verify
-from .rank import target_share
+from .rank import Planned, target_share
 from .space import Shape
 
 RESTARTS = 8  # IK seed sets tried per target: a reference is one arm, it may have more starts than the search
 
 
 @dataclass(frozen=True)
-class Reference:
+class Reference(Planned):
     chain: str
     modules: int
     mass: float | None  # kg, the arm without payload
@@ -33,14 +33,6 @@ class Reference:
     candidate: Candidate | None = None
     plans: tuple = ()  # modc.plan.task.TaskPlan per task and path of the cell, once planned
     coverage: float = 1.0  # share of the region points reached (`rank coverage`)
-
-    @property
-    def cycle_time(self) -> float:
-        return sum(p.cycle_time for p in self.plans)
-
-    @property
-    def energy(self) -> float:
-        return sum(p.energy for p in self.plans)
 
     @property
     def feasible(self) -> bool:
