@@ -131,22 +131,23 @@ def _make_init(cls: type[Record], positional: bool) -> Callable[..., None]:
 
 _CODE: dict[str, Any] | None = None  # generated __init__ source -> its compiled code, this Python's
 _CODE_KIND = "records"
+_DIRTY = False  # code compiled by this process that the cache does not hold yet
 
 
 def _compiled(source: str):
     """The code of a generated __init__: compiling the ~110 of them cost ~35 ms of every command, so
     their code objects are kept in modc's cache (marshal, this Python's version in the key, a
     digest checked on reading) and written back once at exit when new ones were made."""
-    global _CODE
+    global _CODE, _DIRTY
     if _CODE is None:
         _CODE = _load_codes()
     code = _CODE.get(source)
     if code is None:
-        if not any(isinstance(v, str) for v in _CODE.values()):  # first new one: save at exit
+        if not _DIRTY:  # the first new one: save them all at exit
             import atexit
 
             atexit.register(_save_codes)
-            _CODE["\0new"] = "new"
+            _DIRTY = True
         code = _CODE[source] = compile(source, "<modc.records>", "exec")
     return code
 
@@ -169,7 +170,10 @@ def _load_codes() -> dict[str, Any]:
         codes = marshal.loads(payload) if payload is not None else {}
     except (OSError, ValueError, EOFError, TypeError):
         return {}
-    return codes if isinstance(codes, dict) else {}
+    if not isinstance(codes, dict):
+        return {}
+    code_type = type(_load_codes.__code__)
+    return {k: v for k, v in codes.items() if isinstance(k, str) and isinstance(v, code_type)}
 
 
 def _save_codes() -> None:
@@ -181,7 +185,7 @@ def _save_codes() -> None:
         return
     try:
         cache.put_checked(_CODE_KIND, _codes_name(),
-                          marshal.dumps({k: v for k, v in _CODE.items() if not isinstance(v, str)}))
+                          marshal.dumps(_CODE))
     except (OSError, ValueError):
         pass  # no cache: the next command compiles them again
 

@@ -10,6 +10,17 @@ import pytest
 from modc.compiler import Checked, build, check_file, check_text, write_tree
 
 ROOT = Path(__file__).resolve().parent.parent
+# the small design cell several design tests search: two targets around a post, 3 units of H1/L3
+SMALL_CELL = """\
+design small {
+    payload 100 g
+    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    units 3
+    modules H1, L3
+}
+"""
 EXAMPLES = sorted((ROOT / "examples").glob("*.mod"))
 # examples with at least one arm (farm_cell.mod holds only a `design` problem)
 ARM_EXAMPLES = [

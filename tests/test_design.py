@@ -11,22 +11,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import SMALL_CELL
 
 from modc.compiler import check_text
 from modc.syntax.format import format_text
 
 ROOT = Path(__file__).resolve().parent.parent
 
-SMALL = """\
-design small {
-    payload 100 g
-    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    units 3
-    modules H1, L3
-}
-"""
+SMALL = SMALL_CELL
 
 
 def problem(text: str = SMALL):

@@ -13,6 +13,7 @@ import warnings
 
 import numpy as np
 import pytest
+from conftest import SMALL_CELL
 
 from modc.compiler import check_text
 
@@ -47,15 +48,7 @@ ORIENTED = """design ori {
 """  # the farm arm's tool0 at three poses: 6-D, pointing and position-only targets it reaches
 
 
-SMALL = """design small {
-    payload 100 g
-    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    units 3
-    modules H1, L3
-}
-"""  # tests/test_design.py's cell
+SMALL = SMALL_CELL
 
 
 def problem(text: str):

@@ -116,3 +116,25 @@ def test_coverage_finds_an_arm_serving_some_points_when_none_serves_all(tmp_path
     visits = next(t for t in robot.tasks if t.name == "pick").visits
     served = [v for v in visits if v.startswith("pair[")]
     assert len(served) == 1  # the point it reaches, and only that one, is visited
+
+
+def test_coverage_searches_at_most_a_few_points_one_at_a_time():
+    """The point-by-point candidate search of `rank coverage` runs at most POINT_SEARCHES static
+    searches, spread over the region (a 100 x 100 region would be 10,000 searches)."""
+    from modc.design import tasks
+    from modc.design.run import Outcome
+
+    text = PAIR.replace("grid 2 x 1 x 1", "grid 100 x 100 x 1").replace("(0.16, 0, 0) m", "(0.16, 0.16, 0) m")
+    c = check_text(text, "cell.mod")
+    assert c.ok, [d.message for d in c.diagnostics]
+    problem = c.design.resolved_problems()[0]
+    asked: list[str] = []
+
+    def search(screen):
+        asked.extend(t.name for t in screen.cell.targets if t.name.startswith("pair_"))
+        return Outcome(screen, [])
+
+    out = tasks.by_points(problem, search, 5, seed=0)
+    assert out is not None and out.designs == []
+    assert 1 < len(asked) <= tasks.POINT_SEARCHES and len(set(asked)) == len(asked)
+    assert asked[0] == "pair_0_0_0" and asked[-1] > "pair_90"  # from the first point to the far end

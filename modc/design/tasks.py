@@ -15,6 +15,7 @@ PLAN_FACTOR = 3  # designs the static search returns per design asked for when a
 # tray: 2.2 s to 11.8 s), and planning one costs about 2 s once the search stops at the shape
 # where they are found
 MIN_PLANNED = 6
+POINT_SEARCHES = 16  # `rank coverage` with no design serving every point: points searched one at a time
 
 
 def has_tasks(problem) -> bool:
@@ -81,14 +82,17 @@ def told(v, names: dict[str, str]):
 def by_points(problem, search, n: int, seed: int):
     """`rank coverage` when no design serves every region point: the static designs that reach
     the cell's targets and at least one point - searched point by point (`search(screen)`: the
-    static search's Outcome), merged one per chain - most points reached first (modc.plan's IK,
-    clear of the cell: coverage.reached), then fewest modules and least mass; the first n of
-    them, to be planned. An outcome of the last search carries them (its counts summed)."""
-    from dataclasses import replace as _replace
-
+    static search's Outcome; at most POINT_SEARCHES points), merged one per chain - most points
+    reached first (modc.plan's IK, clear of the cell: coverage.reached), then fewest modules and
+    least mass; the first n of them, to be planned. An outcome of the last search carries them
+    (its counts summed)."""
     from . import coverage as cov
 
-    points = [p.name for r in problem.cell.regions for p in r.points()]
+    every = [p.name for r in problem.cell.regions for p in r.points()]
+    # one static search each: at most POINT_SEARCHES of them, spread evenly over the points (a
+    # region may hold 10,000)
+    step = max(1, -(-len(every) // POINT_SEARCHES))
+    points = every[::step]
     seen: dict[str, Design] = {}
     out = None
     for name in points:
@@ -109,7 +113,7 @@ def by_points(problem, search, n: int, seed: int):
     for d in seen.values():
         got, total = cov.reached(d.verified.robot, seed)
         share = len(got) / max(total, 1)
-        scored.append((-len(got), d.modules, round(d.mass, 9), d.chain(), _replace(d, coverage=share)))
+        scored.append((-len(got), d.modules, round(d.mass, 9), d.chain(), replace(d, coverage=share)))
     out.designs = [x[-1] for x in sorted(scored, key=lambda x: x[:4]) if x[0] < 0][:n]
     return out
 

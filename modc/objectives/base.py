@@ -5,12 +5,12 @@ objective module imports nothing of the search."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import Record
 
-@dataclass(frozen=True)
-class Objective:
+
+class Objective(Record, kw_only=False):
     name: str  # as `rank` names it: an identifier
     summary: str  # one line for editors (completion, hover) and the YAML schema
     words: str  # how a sentence or a column heading names it
