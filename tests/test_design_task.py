@@ -193,3 +193,63 @@ def test_a_reference_arm_that_passes_is_planned_timed_and_written(tmp_path):
     view = Ranking(out / "ranking.json")  # the viewer lists it after the designs
     assert view.designs[-1]["rank"] is None and view.file(len(view.designs) - 1) == out / "small_reference.mod"
     assert "reference" in view.choice(len(view.designs) - 1)
+
+
+# two targets on either side of the base: every arm that stands at both swings around between
+# them, none keeps tool0 on the straight segment through the base's column
+UNFOLLOWABLE = """design badpath {
+    payload 50 g
+    target a at (0.30, 0.0, 0.20) m
+    target b at (-0.30, 0.0, 0.20) m
+    path seam from a to b straight
+    units 2 to 3
+    modules H1, L3
+    rank cycle_time
+}
+"""
+
+
+@pytest.mark.slow
+def test_no_design_for_a_path_no_arm_can_follow_points_at_the_path(tmp_path):
+    """Every chain reaching both targets fails the straight path: the diagnostic points at the
+    `path` line, not at the design's name, and says so."""
+    r = _design(tmp_path, UNFOLLOWABLE)
+    assert r.returncode == 1, r.stderr
+    assert "cell.mod:5:5: error[no-design]" in r.stderr, r.stderr
+    assert "none can be planned on path 'seam'" in r.stderr
+    assert "path 'seam' cannot be planned" in r.stderr
+
+
+@pytest.mark.slow
+def test_coverage_measurement_stops_at_the_budget():
+    """A design's coverage is an IK run per region point (10,000 in a large region): the time
+    budget and Ctrl-C are honoured between points, and the planning step stops with them."""
+    from dataclasses import replace
+
+    from modc.design import coverage, run, tasks
+    from modc.design.run import Outcome
+
+    covering = problem(TASKED.replace("    task serve { visit a, b }\n",
+                                      "    region tray box size (0.1, 0.1, 0) m at (0.3, 0, 0.2) m grid 10 x 10 x 1\n"
+                                      "    task serve { visit a, tray }\n").replace("rank modules, cycle_time",
+                                                                                "rank coverage"))
+    found = run.design(problem(), top=1, seed=0)
+    assert found.designs, found.why_none()
+    d = found.designs[0]
+    robot = d.verified.robot.model_copy(update={"regions": covering.cell.regions})
+    asked: list[int] = []
+
+    def stopping(after: int):
+        def stop(*_deadline):
+            asked.append(1)
+            return "time budget" if len(asked) > after else None
+        return stop
+
+    assert coverage.reached(robot, 0, stopping(3)) is None and len(asked) == 4  # stopped at the 4th point
+    got = coverage.reached(robot, 0, lambda: None)
+    assert got is not None and got[1] == 100
+    asked.clear()
+    o = Outcome(covering, [replace(d, verified=replace(d.verified, robot=robot))])
+    tasks.plan_all(o, 1, 0, None, stopping(5))
+    assert o.stopped == "time budget" and o.designs == [] and not o.rejections
+    assert len(asked) == 7  # once before the design, five times measuring it (4 points tried), once for why

@@ -8,11 +8,16 @@ others are dropped from the visits of its robot file, which keeps the regions wh
 design is ranked by the share, larger first (modc.objectives.coverage)."""
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ..model import ResolvedRobot, Robot
 
 
-def reached(robot: ResolvedRobot, seed: int) -> tuple[set[str], int]:
-    """The names of the region points the robot reaches clear of the cell, and how many there are."""
+def reached(robot: ResolvedRobot, seed: int,
+            stopping: Callable[[], str | None] | None = None) -> tuple[set[str], int] | None:
+    """The names of the region points the robot reaches clear of the cell, and how many there are;
+    None when stopping() says to stop (the time budget, Ctrl-C) before every point is tried: a
+    region may hold 10,000 points, each an IK run."""
     from ..physical.checker import CollisionChecker
     from ..plan import clear_solution, start_pose
 
@@ -21,7 +26,13 @@ def reached(robot: ResolvedRobot, seed: int) -> tuple[set[str], int]:
         return set(), 0
     checker = CollisionChecker(robot)
     _where, home, _span = start_pose(robot, None)
-    return {t.name for t in points if clear_solution(robot, checker, t, home, seed) is not None}, len(points)
+    got = set()
+    for t in points:
+        if stopping is not None and stopping():
+            return None
+        if clear_solution(robot, checker, t, home, seed) is not None:
+            got.add(t.name)
+    return got, len(points)
 
 
 def served(robot: ResolvedRobot, points: set[str]) -> ResolvedRobot:

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..model import ResolvedProblem
+from ..model.robot import StraightPath, Task
 from . import space
 from .evaluate import Spec, _sub_targets
 from .screen import reach_bound
@@ -143,6 +144,16 @@ def _finite(x: float) -> float | None:
     return round(float(x), 9) if math.isfinite(x) else None
 
 
+def blamed_task(o) -> Task | StraightPath | None:
+    """The task or path to point a no-design diagnostic at: when every chain that passed the
+    static checks failed planning, the one most of them failed on (the first written on a tie)."""
+    if o.designs or o.stopped or not o.unplanned or sum(o.unplanned.values()) != len(o.rejections):
+        return None
+    cell = o.problem.cell
+    written = [t for t in (*cell.tasks, *cell.paths) if t.name in o.unplanned]
+    return max(written, key=lambda t: o.unplanned[t.name], default=None)
+
+
 def why_none(o) -> str:
     head = f"the search stopped ({o.stopped}) before finding one; " if o.stopped else ""
     if o.bases_searched == 0 and o.bases_touching:
@@ -159,6 +170,11 @@ def why_none(o) -> str:
     if torque:
         return head + (f"every target can be reached alone, but torque rules out {len(torque)} chains "
                        f"(first: {torque[0]})")
+    blamed = blamed_task(o)
+    if blamed is not None:
+        kind = "path" if isinstance(blamed, StraightPath) else "task"
+        return head + (f"every target can be reached alone; {len(o.rejections)} chains reach every target, "
+                       f"but none can be planned on {kind} '{blamed.name}' (first: {o.rejections[0]})")
     if o.rejections:
         return head + (f"every target can be reached alone; {len(o.rejections)} chains reach every target, "
                        f"but none passes the checks (first: {o.rejections[0]})")

@@ -159,6 +159,7 @@ def _planned(out: Reference, seed: int, deadline: float | None, coverage: bool) 
     d = plan_design(Design(out.candidate, out.verified), seed, deadline, coverage)
     if isinstance(d, str):
         return replace(out, fails=(*out.fails, d))
+    assert d is not None  # None only when stopped, and no stopping is given
     return replace(out, plans=d.plans, coverage=d.coverage, verified=d.verified)
 
 

@@ -57,6 +57,7 @@ class Outcome:
     complete: bool = True  # every setting of every shape in the bounds screened or excluded
     stopped: str | None = None  # "time budget" or "interrupted"
     unfinished: list[str] = field(default_factory=list)  # shapes whose search did not run to the end
+    unplanned: dict[str, int] = field(default_factory=dict)  # per task or path: chains not plannable on it
     coarse: list[str] = field(default_factory=list)  # shapes searched on a coarse grid
     targets: dict[str, dict] = field(default_factory=dict)  # per target: hit, clear, closest, excluded_by
     reference: Any = None  # modc.design.reference.Reference: the block's `compare with` arm, evaluated
@@ -227,7 +228,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         return _search(p, units, k, seed, executor, progress, deadline, enough=enough[0], ceiling=ceiling,
                        diagnosing=diagnosing, swaps=swaps)
 
-    rejected: dict[str, str] = {}  # chain -> why its tasks could not be planned (planned once only)
+    rejected: dict[str, tuple[str, str | None]] = {}  # chain -> why (and which task) it could not be planned: once only
     while True:
         if problem.base_grid is None:
             out = one(screen, max_units, n)
@@ -242,7 +243,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         if not tasked:
             break
         if _optional_points(problem) and not out.stopped:
-            out = _covering(problem, out, one, max_units, n, top, seed)
+            out = _covering(problem, out, one, max_units, n, top, seed, deadline)
         found = len(out.designs)
         tasks.plan_all(out, top, seed, deadline, _stopping, rejected)
         # every candidate failed its tasks: search on for more of them while there may be more (the
@@ -260,7 +261,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
 
 
 def _covering(problem: ResolvedProblem, out: Outcome, one, max_units: int | None, n: int, top: int,
-              seed: int) -> Outcome:
+              seed: int, deadline: float | None) -> Outcome:
     """`rank coverage`: the candidates to plan are those that serve every region point when some
     do (coverage 1, the most there is), else those serving at least one (tasks.by_points), and
     only when none serves any, out's (the cell's targets alone: they are then told what they miss)."""
@@ -270,7 +271,8 @@ def _covering(problem: ResolvedProblem, out: Outcome, one, max_units: int | None
     whole = one(_static_screen(every, problem), max_units, n, diagnosing=False)
     tasks.restore(whole, names)
     picked = whole if whole.designs or whole.stopped else tasks.by_points(
-        problem, lambda s: one(_static_screen(s, problem), max_units, top, diagnosing=False), n, seed)
+        problem, lambda s: one(_static_screen(s, problem), max_units, top, diagnosing=False), n, seed,
+        lambda: _stopping(deadline))
     if picked is None or not picked.designs:
         return out
     picked.problem = problem

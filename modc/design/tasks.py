@@ -79,7 +79,7 @@ def told(v, names: dict[str, str]):
     return replace(v, robot=robot, targets={names.get(k, k): x for k, x in v.targets.items()})
 
 
-def by_points(problem, search, n: int, seed: int):
+def by_points(problem, search, n: int, seed: int, stopping=None):
     """`rank coverage` when no design serves every region point: the static designs that reach
     the cell's targets and at least one point - searched point by point (`search(screen)`: the
     static search's Outcome; at most POINT_SEARCHES points), merged one per chain - most points
@@ -111,23 +111,32 @@ def by_points(problem, search, n: int, seed: int):
         return None
     scored = []
     for d in seen.values():
-        got, total = cov.reached(d.verified.robot, seed)
+        measured = cov.reached(d.verified.robot, seed, stopping)
+        if measured is None:  # out of time: rank the designs measured so far
+            out.stopped = out.stopped or stopping()
+            break
+        got, total = measured
         share = len(got) / max(total, 1)
         scored.append((-len(got), d.modules, round(d.mass, 9), d.chain(), replace(d, coverage=share)))
     out.designs = [x[-1] for x in sorted(scored, key=lambda x: x[:4]) if x[0] < 0][:n]
     return out
 
 
-def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = False) -> Design | str:
-    """d with its plans, or why one of its tasks cannot be planned. With `coverage`, the region
-    points it does not reach are dropped from its tasks and its coverage recorded."""
+def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = False, stopping=None,
+                failed: list[str] | None = None) -> Design | str | None:
+    """d with its plans, or why one of its tasks cannot be planned (its name appended to `failed`),
+    or None when stopping() said to stop while its coverage was measured. With `coverage`, the
+    region points it does not reach are dropped from its tasks and its coverage recorded."""
     from ..plan.errors import PlanError
     from ..plan.task import plan_task_robot
     from . import coverage as cov
 
     robot = d.verified.robot
     if coverage and robot.regions:
-        points, total = cov.reached(robot, seed)
+        measured = cov.reached(robot, seed, stopping)
+        if measured is None:
+            return None
+        points, total = measured
         if not points:
             return "reaches no point of the cell's regions"
         missing = cov.missing_ends(robot, points)
@@ -141,15 +150,19 @@ def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = F
         try:
             plans.append(plan_task_robot(robot, name, seed=seed, timeout=left))
         except PlanError as e:
-            return f"task '{name}' cannot be planned ({e.code}: {e.message})"
+            if failed is not None:
+                failed.append(name)
+            kind = "path" if any(p.name == name for p in robot.paths) else "task"
+            return f"{kind} '{name}' cannot be planned ({e.code}: {e.message})"
     return replace(d, plans=tuple(plans))
 
 
 def plan_all(out, top: int, seed: int, deadline: float | None, stopping,
-             rejected: dict[str, str] | None = None) -> None:
+             rejected: dict[str, tuple[str, str | None]] | None = None) -> None:
     """Plan every design of the outcome, drop those that fail, rank by the problem's objectives
-    (the task objectives now known) and keep `top`. rejected: chain -> why, for chains already
-    planned in vain (not planned again; filled here)."""
+    (the task objectives now known) and keep `top`. rejected: chain -> (why, the task that could
+    not be planned), for chains already planned in vain (not planned again; filled here).
+    out.unplanned counts, per task, the chains that could not be planned on it."""
     rejected = {} if rejected is None else rejected
     kept = []
     for d in out.designs:
@@ -157,13 +170,18 @@ def plan_all(out, top: int, seed: int, deadline: float | None, stopping,
         if why:
             out.stopped = out.stopped or why
             break
-        if d.chain() in rejected:  # planned in vain in an earlier round: the same reason again
-            out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {rejected[d.chain()]}")
-            continue
-        p = plan_design(d, seed, deadline, "coverage" in out.problem.rank)
-        if isinstance(p, str):
-            rejected[d.chain()] = p
-            out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {p}")
-            continue
-        kept.append(p)
+        if d.chain() not in rejected:
+            failed: list[str] = []
+            p = plan_design(d, seed, deadline, "coverage" in out.problem.rank, lambda: stopping(deadline), failed)
+            if p is None:
+                out.stopped = out.stopped or stopping(deadline)
+                break
+            if not isinstance(p, str):
+                kept.append(p)
+                continue
+            rejected[d.chain()] = (p, failed[0] if failed else None)
+        why, task = rejected[d.chain()]  # planned in vain, now or in an earlier round (not planned again)
+        out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {why}")
+        if task is not None:
+            out.unplanned[task] = out.unplanned.get(task, 0) + 1
     out.designs = order(kept, out.problem.rank)[:top]
