@@ -85,14 +85,7 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
     errors: list[str] = []
     if not isinstance(doc, dict):
         return None, [f"the top level must be an object with joint_names and points, not {type(doc).__name__}"]
-    names = doc.get("joint_names")
-    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
-        errors.append("joint_names: expected a non-empty list of joint names")
-        names = None
-    else:
-        dup = sorted({n for n in names if names.count(n) > 1})
-        if dup:
-            errors.append(f"joint_names: {', '.join(dup)} listed more than once")
+    names = _joint_names(doc.get("joint_names"), errors)
     robot = doc.get("robot")
     if robot is not None and not isinstance(robot, str):
         errors.append("robot: expected a robot name")
@@ -104,32 +97,51 @@ def parse(doc) -> tuple[Trajectory | None, list[str]]:
     ts: list[float | None] = []  # None: not a valid time (an error says why)
     qs: list[tuple[float, ...] | None] = []
     for k, pt in enumerate(points):
-        where = f"points[{k}]"
         if not isinstance(pt, dict):
-            errors.append(f"{where}: expected an object {{\"t\": …, \"q\": […]}}")
+            errors.append(f"points[{k}]: expected an object {{\"t\": …, \"q\": […]}}")
             continue
-        t, q = pt.get("t"), pt.get("q")
-        if not _number(t):
-            errors.append(f"{where}.t: expected a finite number of seconds, got {json.dumps(t)}")
-        elif t < 0:
-            errors.append(f"{where}.t: {t:g} s is negative")
-        elif ts and ts[-1] is not None and t <= ts[-1]:
-            errors.append(
-                f"{where}.t: {t:g} s does not come after points[{k - 1}].t = {ts[-1]:g} s (times must increase)"
-            )
-        ts.append(t if _number(t) else None)
-        if not isinstance(q, list) or not all(_number(x) for x in q):
-            errors.append(f"{where}.q: expected a list of finite numbers (radians)")
-            qs.append(None)
-            continue
-        if names is not None and len(q) != len(names):
-            errors.append(f"{where}.q: {len(q)} value(s) for {len(names)} joint name(s)")
-        qs.append(tuple(float(x) for x in q))
+        ts.append(_time(k, pt.get("t"), ts, errors))
+        qs.append(_joints(k, pt.get("q"), names, errors))
     if errors or names is None:
         return None, errors
     # no errors: every time and every q is valid
     times = tuple(float(t) for t in ts if t is not None)
     return Trajectory(tuple(names), times, tuple(q for q in qs if q is not None), robot), []
+
+
+def _joint_names(names, errors: list[str]) -> list[str] | None:
+    if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+        errors.append("joint_names: expected a non-empty list of joint names")
+        return None
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        errors.append(f"joint_names: {', '.join(dup)} listed more than once")
+    return names
+
+
+def _time(k: int, t, before: list[float | None], errors: list[str]) -> float | None:
+    """points[k].t, or None when it is not a number (errors says why)."""
+    where = f"points[{k}].t"
+    if not _number(t):
+        errors.append(f"{where}: expected a finite number of seconds, got {json.dumps(t)}")
+        return None
+    if t < 0:
+        errors.append(f"{where}: {t:g} s is negative")
+    elif before and before[-1] is not None and t <= before[-1]:
+        errors.append(f"{where}: {t:g} s does not come after points[{k - 1}].t = {before[-1]:g} s "
+                      "(times must increase)")
+    return t
+
+
+def _joints(k: int, q, names: list[str] | None, errors: list[str]) -> tuple[float, ...] | None:
+    """points[k].q, or None when it is not a list of finite numbers (errors says why)."""
+    where = f"points[{k}].q"
+    if not isinstance(q, list) or not all(_number(x) for x in q):
+        errors.append(f"{where}: expected a list of finite numbers (radians)")
+        return None
+    if names is not None and len(q) != len(names):
+        errors.append(f"{where}: {len(q)} value(s) for {len(names)} joint name(s)")
+    return tuple(float(x) for x in q)
 
 
 def validate_for(traj: Trajectory, robot) -> list[str]:

@@ -49,3 +49,20 @@ def test_a_pass_never_imports_the_physics_itself():
 
     check_torque.run(checked.design, Context(analyses=frozenset({"torque"}), torque_analysis=analyse))
     assert calls == ["farm"]
+
+
+MAX_COMPLEXITY = 25
+
+
+def test_no_function_is_more_complex_than_the_limit():
+    """radon's cyclomatic complexity (it counts boolean operators too, which ruff's C901 does
+    not): every function and method of the package at most MAX_COMPLEXITY."""
+    from radon.complexity import cc_visit
+
+    over = set()
+    for path in sorted((ROOT / "modc").rglob("*.py")):
+        for block in cc_visit(path.read_text(encoding="utf-8")):
+            for f in (block, *getattr(block, "methods", ())):  # a class's methods are listed again alone
+                if f.complexity > MAX_COMPLEXITY:
+                    over.add(f"{path.relative_to(ROOT)}:{f.lineno} {f.fullname} {f.complexity}")
+    assert not over, "split these functions:\n" + "\n".join(sorted(over))

@@ -42,9 +42,6 @@ def check_cmd(file: str, payload: str | None, json_out: bool, traj: str | None, 
     """Torque feasibility: the worst static gravity torque of every joint over its range, against
     the actuator's nominal and peak torque, and with --traj the peak torques along a motion.
     Exit 1 if a joint can exceed its peak torque."""
-    import json
-    import math
-
     from ..compiler import COMPILE_ANALYSES, InputError, check_file
     from ..diagnostics import Span, codes
 
@@ -62,45 +59,57 @@ def check_cmd(file: str, payload: str | None, json_out: bool, traj: str | None, 
     robots = [r for r in checked.design.robots if r.torque is not None]
     along = _along(traj, checked.design, robots, mass) if traj is not None and checked.ok else {}
     if json_out:
-        doc = {
-            "robots": [
-                {
-                    "name": r.name,
-                    "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
-                    "joints": [j.to_json() for j in r.torque or ()],
-                    **(
-                        {"trajectory": {"file": traj, "joints": [j.to_json() for j in along[r.name]]}}
-                        if r.name in along
-                        else {}
-                    ),
-                }
-                for r in robots
-            ]
-        }
-        print(json.dumps(doc, indent=2))
+        _torque_json(robots, mass, traj, along)
     else:
-        for r in robots:
-            shown = mass if mass is not None else (r.payload.mass if r.payload else 0.0)
-            print(f"robot {r.name} ({r.sequence}), payload {shown:g} kg")
-            head = f"  {'joint':<9}{'unit':<6}{'worst |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}"
-            print(f"{head}  worst pose (deg)")
-            for j in r.torque or ():
-                pose = ", ".join(f"{math.degrees(x):.0f}" for x in j.q)
-                row = f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}"
-                print(f"{row}  ({pose})  {j.level}")
-            if r.name in along:
-                print(f"  along {traj} (inverse dynamics):")
-                head = f"  {'joint':<9}{'unit':<6}{'peak |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}"
-                print(f"{head}  at t (s)")
-                for j in along[r.name]:
-                    row = f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}"
-                    print(f"{row}  {j.t:.3f}  {j.level}")
+        _torque_table(robots, mass, traj, along)
     _print_diagnostics(checked.diagnostics, checked.sources)
     over = [j for peaks in along.values() for j in peaks if j.level == "over-peak"]
     for j in over:
         _err(f"modc check: {j.name} ({j.variant}) needs {j.tau:.3g} N·m at t = {j.t:.3f} s of {traj}, "
              f"above its peak {j.tau_max:g} N·m")
     raise SystemExit(EXIT_OK if checked.ok and not over else EXIT_ERRORS)
+
+
+def _torque_json(robots, mass: float | None, traj: str | None, along: dict) -> None:
+    import json
+
+    doc = {
+        "robots": [
+            {
+                "name": r.name,
+                "payload": mass if mass is not None else (r.payload.mass if r.payload else 0.0),
+                "joints": [j.to_json() for j in r.torque or ()],
+                **(
+                    {"trajectory": {"file": traj, "joints": [j.to_json() for j in along[r.name]]}}
+                    if r.name in along
+                    else {}
+                ),
+            }
+            for r in robots
+        ]
+    }
+    print(json.dumps(doc, indent=2))
+
+
+def _torque_table(robots, mass: float | None, traj: str | None, along: dict) -> None:
+    import math
+
+    for r in robots:
+        shown = mass if mass is not None else (r.payload.mass if r.payload else 0.0)
+        print(f"robot {r.name} ({r.sequence}), payload {shown:g} kg")
+        head = f"  {'joint':<9}{'unit':<6}{'worst |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}"
+        print(f"{head}  worst pose (deg)")
+        for j in r.torque or ():
+            pose = ", ".join(f"{math.degrees(x):.0f}" for x in j.q)
+            row = f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}"
+            print(f"{row}  ({pose})  {j.level}")
+        if r.name in along:
+            print(f"  along {traj} (inverse dynamics):")
+            head = f"  {'joint':<9}{'unit':<6}{'peak |tau| N·m':>16}{'nominal':>9}{'peak':>7}{'margin':>8}"
+            print(f"{head}  at t (s)")
+            for j in along[r.name]:
+                row = f"  {j.name:<9}{j.variant:<6}{j.tau:>16.3f}{j.tau_nom:>9g}{j.tau_max:>7g}{j.margin:>8.0%}"
+                print(f"{row}  {j.t:.3f}  {j.level}")
 
 
 def _along(traj_path: str, design, robots, mass) -> dict:

@@ -175,26 +175,10 @@ def design_cmd(
     force: bool,
 ) -> None:
     """Find the best module chains for the cells and targets of FILE's design blocks."""
-    import json
-    from dataclasses import replace
+    from ..compiler import inputs_of
+    from ..outputs import check_output_dir
 
-    from ..compiler import InputError, check_file, inputs_of
-    from ..design.write import files as design_files
-    from ..design.write import ranking, summary_line
-    from ..diagnostics import Severity, codes
-    from ..outputs import check_output_dir, write_tree
-
-    try:
-        checked = check_file(file, library)
-    except InputError as e:
-        _print_diagnostics([e.diagnostic], {})
-        raise SystemExit(EXIT_USAGE) from None
-    # a statement the search would ignore is refused here, where ignoring it would mislead
-    refused = [replace(d, severity=Severity.ERROR) if d.code == codes.DESIGN_UNSUPPORTED.name else d
-               for d in checked.diagnostics]
-    _print_diagnostics(refused, checked.sources)
-    if not checked.ok or any(d.is_error for d in refused):
-        raise SystemExit(EXIT_ERRORS)
+    checked = _checked(file, library)
     problems = checked.design.resolved_problems()
     if not problems:
         _err(f"modc design: {file} has no `design NAME {{ … }}` block")
@@ -218,6 +202,40 @@ def design_cmd(
         _print_diagnostics(failed, checked.sources)
         _err(f"modc design: no design found; nothing written to {out}")
         raise SystemExit(EXIT_INTERRUPTED if interrupted else EXIT_ERRORS)
+    _write(outcomes, out, render, json_out, force, inputs)
+    if interrupted:
+        raise SystemExit(EXIT_INTERRUPTED)
+
+
+def _checked(file: str, library: str | None):
+    """FILE checked, its diagnostics printed; exit here when it has errors or a statement the
+    search would ignore (refused: ignoring it would mislead)."""
+    from dataclasses import replace
+
+    from ..compiler import InputError, check_file
+    from ..diagnostics import Severity, codes
+
+    try:
+        checked = check_file(file, library)
+    except InputError as e:
+        _print_diagnostics([e.diagnostic], {})
+        raise SystemExit(EXIT_USAGE) from None
+    refused = [replace(d, severity=Severity.ERROR) if d.code == codes.DESIGN_UNSUPPORTED.name else d
+               for d in checked.diagnostics]
+    _print_diagnostics(refused, checked.sources)
+    if not checked.ok or any(d.is_error for d in refused):
+        raise SystemExit(EXIT_ERRORS)
+    return checked
+
+
+def _write(outcomes, out: str, render: bool, json_out: bool, force: bool, inputs) -> None:
+    """The designs' files (and pictures) written to DIR by the one output-safety rule."""
+    import json
+
+    from ..design.write import files as design_files
+    from ..design.write import ranking, summary_line
+    from ..outputs import write_tree
+
     tree = design_files(outcomes)
     if render:
         names = [f for f in tree if f.endswith(".mod")]
@@ -230,8 +248,6 @@ def design_cmd(
     for o in outcomes:
         _err(f"modc design: {summary_line(o)}")
     _err(f"modc design: {len(tree)} files written to {out}")
-    if interrupted:
-        raise SystemExit(EXIT_INTERRUPTED)
 
 
 def _stopped_text(o) -> str:

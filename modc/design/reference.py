@@ -163,6 +163,19 @@ def _planned(out: Reference, seed: int, deadline: float | None, coverage: bool) 
     return replace(out, plans=d.plans, coverage=d.coverage, verified=d.verified)
 
 
+def _screened(one: Spec, shape: Shape, pivots, ports, seed: int) -> tuple[tuple, float, bool]:
+    """The design screen on one target, RESTARTS seeds at most: (its joint solutions, the closest
+    tool0 came in m, whether it came within tolerance at all, in collision or not)."""
+    closest, hit = np.inf, False
+    for k in range(RESTARTS):
+        s = screen_batch(one, shape, pivots, ports, seed + k)
+        assert s is not None  # (never interrupted: no callback)
+        closest, hit = min(closest, float(s.closest[0, 0])), hit or bool(s.hit[0, 0])
+        if s.feasible[0]:
+            return tuple(tuple(float(x) for x in q) for q in s.solutions[0][0]), closest, hit
+    return (), closest, hit
+
+
 def _evaluate(problem: ResolvedProblem, seed: int) -> Reference | None:
     ref = problem.reference
     lib = problem.cell.library
@@ -176,23 +189,17 @@ def _evaluate(problem: ResolvedProblem, seed: int) -> Reference | None:
     targets: dict[str, dict] = {}
     solutions, fails = [], []
     for t, target in enumerate(problem.cell.targets):
-        one = replace(spec, targets=_sub_targets(spec.targets, t))
-        closest, hit, sols = np.inf, False, []
-        for k in range(RESTARTS):
-            s = screen_batch(one, shape, pivots, ports, seed + k)
-            assert s is not None  # (never interrupted: no callback)
-            closest, hit = min(closest, float(s.closest[0, 0])), hit or bool(s.hit[0, 0])
-            if s.feasible[0]:
-                sols = [tuple(float(x) for x in q) for q in s.solutions[0][0]]
-                break
-        solutions.append(tuple(sols))
+        sols, closest, hit = _screened(replace(spec, targets=_sub_targets(spec.targets, t)), shape, pivots, ports,
+                                       seed)
+        solutions.append(sols)
         tol = target.position_tolerance
-        targets[target.name] = {"reached": bool(sols), "position_error_m": round(closest, 9) if np.isfinite(closest)
-                                else None, "error_share": round(closest / tol, 6) if np.isfinite(closest) else None}
+        finite = bool(np.isfinite(closest))
+        targets[target.name] = {"reached": bool(sols), "position_error_m": round(closest, 9) if finite else None,
+                                "error_share": round(closest / tol, 6) if finite else None}
         if not sols:
             fails.append(f"target '{target.name}' is reached only in collision with the cell" if hit else
                          f"target '{target.name}' missed by {closest * 1000:.3g} mm "
-                         f"(tolerance {tol * 1000:g} mm)" if np.isfinite(closest) else
+                         f"(tolerance {tol * 1000:g} mm)" if finite else
                          f"target '{target.name}' not reached")
     text = chain_text(ref)
     verified = None

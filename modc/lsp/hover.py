@@ -78,6 +78,17 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
     tok = an.name_at(offset)
     if tok is None:
         return None
+    md = _markdown(an, tok)
+    if md is None:
+        return None
+    return types.Hover(
+        contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=md), range=an.index.range(tok.start, tok.end)
+    )
+
+
+def _markdown(an: Analysis, tok) -> str | None:
+    """What the token under the cursor is, by its neighbours: a declared name, a unit parameter,
+    a library, a diagnostic code, a joint, a unit, a keyword, a unit of measure."""
     prev, nxt = an.neighbours(tok)
     text = tok.text
     robot = an.robot_at(tok.start)
@@ -104,11 +115,7 @@ def hover(an: Analysis, offset: int) -> types.Hover | None:
         decl = next((d for d in an.decls if d.name == text and (d.robot == robot or d.kind == "robot")), None)
         if decl is not None:
             md = _decl_markdown(an, text, decl.robot, decl.kind)
-    if md is None:
-        return None
-    return types.Hover(
-        contents=types.MarkupContent(kind=types.MarkupKind.Markdown, value=md), range=an.index.range(tok.start, tok.end)
-    )
+    return md
 
 
 def _decl_markdown(an: Analysis, name: str, robot: str | None, kind: str) -> str | None:

@@ -117,11 +117,7 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
         return []
     prev, _ = an.neighbours(tok)
     robot = an.robot_at(tok.start)
-    if (
-        prev is not None
-        and prev.text == "library"
-        or (an.is_yaml and prev is not None and prev.text == ":" and _yaml_key_before(an, tok) == "library")
-    ):
+    if _names_library(an, tok, prev):
         path = resolve_library(tok.text.strip('"'), Path(an.path).parent)
         if path is None:
             return []
@@ -131,6 +127,18 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
         if 1 <= n <= len(units):
             return [convert.location(uri, an.index.range(*units[n - 1][1]))]
         return []
+    return [convert.location(uri, an.index.range(*d.name_range)) for d in _declarations(an, tok, prev, robot)]
+
+
+def _names_library(an: Analysis, tok: Tok, prev: Tok | None) -> bool:
+    """The token is a `library` statement's reference (or the YAML form's `library:` value)."""
+    if prev is None:
+        return False
+    return prev.text == "library" or (an.is_yaml and prev.text == ":" and _yaml_key_before(an, tok) == "library")
+
+
+def _declarations(an: Analysis, tok: Tok, prev: Tok | None, robot: str | None) -> list:
+    """The declarations of the name under the cursor: the same robot's first, then any."""
     matches = [d for d in an.decls if d.name == tok.text]
     if prev is not None and prev.text == "robot" or not any(d.robot == robot for d in matches):
         pool = matches
@@ -138,7 +146,7 @@ def definition(an: Analysis, offset: int, uri: str) -> list[types.Location]:
         pool = [d for d in matches if d.robot == robot]
     if robot is not None and any(d.kind == "robot" and d.name_range[0] <= tok.start < d.name_range[1] for d in pool):
         pool = [d for d in pool if d.kind == "robot"]
-    return [convert.location(uri, an.index.range(*d.name_range)) for d in pool]
+    return pool
 
 
 def _yaml_key_before(an: Analysis, tok: Tok) -> str | None:

@@ -176,6 +176,13 @@ class _Lowerer:
                 self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=block))
                 return
             seen[kind] = st
+        if kind is not None:
+            self._robot_field(st, fields, acc)
+        else:
+            self._cell_item(st, acc)
+
+    def _robot_field(self, st, fields: dict, acc: dict) -> None:
+        """A statement that sets one field of the robot: chain, dh, library, placements, payload."""
         match st:
             case ast.Chain():
                 units = [self.unit(u) for u in st.units]
@@ -196,6 +203,11 @@ class _Lowerer:
                 com = self.vec3(st.at, "a length", "payload centre of mass") if st.at else (0.0, 0.0, 0.0)
                 if mass is not None and com is not None:
                     fields["payload"] = Payload(mass=mass, com=com, span=st.span)
+
+    def _cell_item(self, st, acc: dict) -> None:
+        """A statement that adds to one of the cell's lists: poses, limits, obstacles, targets,
+        regions, tasks and paths, base placement, allowed codes."""
+        match st:
             case ast.Pose():
                 q = self.vector(st.values, "an angle", f"pose '{_say(st.name)}'", n=None)
                 if self.name(st.name, "pose") and q is not None:

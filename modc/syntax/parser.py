@@ -289,7 +289,13 @@ def _diagnose(e, text: str, file: str) -> Diagnostic:
         )
 
     assert isinstance(e, UnexpectedToken) and token is not None
-    found = f"'{token}'" if token.type not in ("$END",) else "end of file"
+    return _unexpected_token(e, token, text, file, line, col)
+
+
+def _unexpected_token(e, token, text: str, file: str, line: int, col: int) -> Diagnostic:
+    """A token the grammar does not allow here: the commonest mistakes by name, else a syntax
+    error listing what was expected."""
+    found = f"'{token}'"
     span = Span(
         file, line, col, token.end_line or line, token.end_column or col + 1, token.start_pos or 0, token.end_pos or 0
     )
