@@ -172,11 +172,6 @@ class Chain:
         self.T_flange_tool = transform(robot.tool.xyz, robot.tool.rpy)
         self.dof = len(self.units)
 
-    # Fixed parts between joints, used for URDF joint origins (q = 0 at each joint).
-    def T_unit_twist1(self, i: int) -> np.ndarray:
-        u = self.units[i]
-        return A_t1(u.pivot, u.x01, u.z01)
-
     def T_joint_end(self, i: int) -> np.ndarray:
         """Joint frame of unit i -> its last frame (twist2 for units 3/4, itself for 1/2)."""
         u = self.units[i]

@@ -39,11 +39,6 @@ def _ry(a: float) -> _Mat:
     return ((c, 0.0, s), (0.0, 1.0, 0.0), (-s, 0.0, c))
 
 
-def _rz(a: float) -> _Mat:
-    c, s = math.cos(a), math.sin(a)
-    return ((c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0))
-
-
 def _mul(A: _Mat, B: _Mat) -> _Mat:
     def row(i: int) -> _Vec:
         return (A[i][0] * B[0][0] + A[i][1] * B[1][0] + A[i][2] * B[2][0],
