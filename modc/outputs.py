@@ -19,6 +19,7 @@ import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
+from . import names
 from .diagnostics import Span, codes
 
 PathLike = str | os.PathLike
@@ -103,6 +104,29 @@ def check_output_dir(out: PathLike, inputs: Sequence[PathLike] = (), force: bool
     _check_rule(out, inputs, force)
     if not force and Path(out).is_dir() and not Path(out).is_symlink():
         _refuse_foreign(out, foreign_now(Path(os.path.abspath(out))))
+    _check_writable(out)
+
+
+def _check_writable(out: PathLike) -> None:
+    """OUT's folder may be created and written (the tree is written beside OUT, then renamed):
+    tried with an empty folder made and removed in the nearest folder that exists, so a search of
+    minutes is not lost to a read-only disk, an immutable folder or a file on the way."""
+    import tempfile
+
+    from .diagnostics.errors import InputError
+
+    where = os.fspath(out)
+    parent = Path(os.path.abspath(out)).parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        why = f"'{names.shown(parent.name, 60)}' on its way is not a directory"
+        raise InputError(codes.OUTPUT_UNWRITABLE.at(Span.point(where), path=where, why=why))
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".modc-probe-", dir=parent))
+    except OSError as e:
+        raise InputError(codes.OUTPUT_UNWRITABLE.at(Span.point(where), path=where,
+                                                    why=e.strerror or type(e).__name__)) from None
 
 
 def _check_rule(out: PathLike, inputs: Sequence[PathLike], force: bool) -> None:

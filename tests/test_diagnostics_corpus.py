@@ -78,6 +78,7 @@ FUNCTION_CASES = {
     "file-not-found": "test_file_not_found",
     "output-not-modc": "test_output_not_modc",
     "output-unsafe": "test_output_unsafe",
+    "output-unwritable": "test_output_unwritable",
     "unsupported-input": "test_unsupported_input",
     "input-too-large": "test_input_too_large",
     "bad-payload": "test_bad_payload",

@@ -307,6 +307,8 @@ OUTPUT_NOT_MODC = _register("output-not-modc", E, "an output directory that modc
     "empty directory, or pass --force to replace it and everything in it")
 OUTPUT_UNSAFE = _register("output-unsafe", E, "an output directory modc never replaces, even with --force",
     "'{path}' is {what}; replacing it would delete it", "{hint}")
+OUTPUT_UNWRITABLE = _register("output-unwritable", E, "an output directory modc cannot create or write",
+    "cannot write '{path}': {why}", "choose a directory you may write, e.g. -o out/ under your working directory")
 UNSUPPORTED_INPUT = _register("unsupported-input", E, "an input file type modc cannot read",
     "'{path}' is neither .mod nor .yaml/.yml", "pass a .mod file or its YAML form")
 
