@@ -751,3 +751,45 @@ def test_task_plan_errors(tmp_path, capsys):
         assert rc == rc_want, (args, err)
         assert f"{where}: error[{code}]" in err and words in err, err
         assert "= hint:" in err and "Traceback" not in err and out == ""
+
+
+def test_output_unwritable(tmp_path):
+    """An output folder that cannot be made (a file on its way, a folder that may not be
+    written) is refused before any work, with where and why; nothing is left behind."""
+    from modc.outputs import check_output_dir
+
+    plain = tmp_path / "afile"
+    plain.write_text("mine", encoding="utf-8")
+    with pytest.raises(InputError) as e:
+        check_output_dir(plain / "sub")
+    d = e.value.diagnostic
+    assert d.code == "output-unwritable" and "not a directory" in d.message and d.hint
+    assert plain.read_text(encoding="utf-8") == "mine"
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        if os.access(locked, os.W_OK):  # root writes anyway: nothing to refuse then
+            check_output_dir(locked / "out")
+        else:
+            with pytest.raises(InputError) as e:
+                check_output_dir(locked / "out")
+            assert e.value.diagnostic.code == "output-unwritable"
+        assert list(locked.iterdir()) == []
+    finally:
+        locked.chmod(0o755)
+    check_output_dir(tmp_path / "new" / "deeper")  # folders still to make: fine
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "locked"]
+
+
+def test_design_refuses_an_unwritable_folder_before_searching(tmp_path):
+    """`modc design -o afile/sub` fails at once (exit 2, located, coded), not after the search."""
+    src = tmp_path / "cell.mod"
+    src.write_text("design d {\n    target a at (0.3, 0.1, 0.25) m\n    units 6\n}\n", encoding="utf-8")
+    (tmp_path / "afile").write_text("mine", encoding="utf-8")
+    p = subprocess.run([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "afile" / "sub"),
+                        "--no-render"], capture_output=True, text=True, timeout=300,
+                       env={**os.environ, "MODC_CACHE_DIR": str(tmp_path / "cache")})
+    assert p.returncode == 2, p.stderr
+    assert "error[output-unwritable]" in p.stderr and "shapes" not in p.stderr  # no search ran
+    assert (tmp_path / "afile").read_text(encoding="utf-8") == "mine"
