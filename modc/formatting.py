@@ -46,4 +46,9 @@ def angle_text(rad: float) -> str:
     return f"{math.degrees(rad):.1f}°"
 
 
-__all__ = ["angle", "angle_text", "degrees", "fixed", "json_number", "num", "vec"]
+def counted(n: int, thing: str, many: str | None = None) -> str:
+    """'1 design', '2 designs', '5,120 shapes': a count with its noun in the right number."""
+    return f"{n:,} {thing if n == 1 else many or thing + 's'}"
+
+
+__all__ = ["angle", "angle_text", "counted", "degrees", "fixed", "json_number", "num", "vec"]

@@ -98,12 +98,15 @@ def test_bad_duration_is_a_usage_error(tmp_path):
 
 
 @pytest.mark.slow
-def test_ctrl_c_stops_with_exit_130(tmp_path):
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_ctrl_c_stops_with_exit_130(tmp_path, workers):
+    """Ctrl-C keeps what was found and exits 130, also with a process pool (whose workers are
+    ended, not waited for)."""
     src = tmp_path / "cell.mod"
     src.write_text(BIG, encoding="utf-8")
     proc = subprocess.Popen([sys.executable, "-m", "modc", "design", str(src), "-o", str(tmp_path / "out"),
-                             "--no-render"], stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
-                            env=_env(tmp_path), cwd=tmp_path)
+                             "--no-render", "--workers", workers], stderr=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                            text=True, env=_env(tmp_path), cwd=tmp_path)
     try:
         assert proc.stderr is not None
         first = proc.stderr.readline()  # blocks until the first progress line: the search has started
@@ -116,3 +119,56 @@ def test_ctrl_c_stops_with_exit_130(tmp_path):
             proc.kill()
     assert rc == 130, rest
     assert "interrupted" in rest and "Traceback" not in rest
+
+
+@pytest.mark.slow
+def test_a_block_the_budget_leaves_unsearched_is_said(tmp_path):
+    """Two design blocks, the first far larger than the budget: the second is named as not
+    searched (on stderr and in ranking.json), not skipped in silence; a target beyond every arm
+    of the bounds is still proven out of reach though the time ran out."""
+    far = BIG.replace("    units 5 to 6\n", "    target far at (3.0, 0, 0.2) m\n    units 5 to 6\n")
+    out = tmp_path / "out"
+    # no shape reaches `far`: nothing to search, and the time runs out probing a, b and c alone
+    p = _run(tmp_path, far, "-o", str(out), "--no-render", "--time-budget", "1s", "-q")
+    assert p.returncode == 1, p.stderr
+    assert "target 'far': no design gets closer than" in p.stderr and "(reach)" in p.stderr, p.stderr
+    p = _run(tmp_path, BIG + CELL, "-o", str(out), "--no-render", "--time-budget", "1s", "-q")
+    assert "two: not searched: the time budget ran out" in p.stderr
+    if p.returncode == 0:  # the first block found a design within the second
+        ranking = json.loads((out / "ranking.json").read_text(encoding="utf-8"))
+        assert ranking["not_searched"] == ["two"] and ranking["complete"] is False
+    else:
+        assert p.returncode == 1 and not out.exists()
+
+
+@pytest.mark.slow
+def test_max_units_bounds_the_diagnosis_too(tmp_path):
+    """--max-units replaces the design's upper bound everywhere: the no-design reason is the
+    one the file would get with `units 2` written, and a bound below the design's least units is
+    a usage error, not an empty search."""
+    text = "design f {\n    target far at (0.55, 0, 0.2) m\n    units 2 to 3\n    modules H1, L3\n}\n"
+    p = _run(tmp_path, text, "-o", str(tmp_path / "out"), "--no-render", "-q", "--max-units", "2")
+    assert p.returncode == 1, p.stderr
+    assert "no design of 2 units" in p.stderr and "no design gets closer than" in p.stderr, p.stderr
+    p = _run(tmp_path, text, "-o", str(tmp_path / "out"), "--no-render", "-q", "--max-units", "1")
+    assert p.returncode == 2 and "--max-units 1 is below" in p.stderr, p.stderr
+
+
+def test_plain_progress_repeats_itself_when_nothing_new_comes(monkeypatch, capsys):
+    """A CI log never goes quiet: with no new status (a design being planned, a long block), the
+    last line is said again, with the time spent on it."""
+    import time
+
+    from modc.cli import design_progress
+    from modc.design.run import Status
+
+    monkeypatch.setattr(design_progress, "PLAIN_EVERY", 0.05)
+    with design_progress.progress("plain", "cell") as say:
+        assert say is not None
+        say(Status(1, 4, 10, 0, "", None), True)
+        deadline = time.monotonic() + 30
+        while "still at it" not in capsys.readouterr().err and time.monotonic() < deadline:
+            time.sleep(0.05)
+        say(Status(4, 4, 40, 1, "H1 - L3", None, "planning and timing design 1 of 2"), True)
+    err = capsys.readouterr().err
+    assert "planning and timing design 1 of 2 (H1 - L3)" in err

@@ -62,24 +62,27 @@ def _search_all(problems, max_units, top, seed, workers, scheduler, deadline, mo
     from ..design import run as search
     from ..design.diagnose import blamed_task
     from ..diagnostics import codes
+    from ..formatting import counted
     from .design_progress import progress as show_progress
 
-    outcomes, failed = [], []
+    outcomes: list[search.Outcome] = []
+    failed = []
     with usage_errors("design", usage=(ValueError, OSError)), _executor(workers, scheduler) as executor, \
             _sigint_stops() as stop:
         for p in problems:
+            if outcomes and outcomes[-1].stopped:  # out of time or interrupted: said, not searched
+                outcomes.append(search.Outcome(p, [], stopped=outcomes[-1].stopped, complete=False, searched=False))
+                continue
             with show_progress(mode, p.name) as bar:
                 o = search.design(p, max_units=max_units, top=top, seed=seed, executor=executor, progress=bar,
                                   deadline=deadline)
             if not o.designs:
                 hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
-                units = f"{p.min_units} to {hi}" if hi > p.min_units else f"{hi}"
+                units = f"{p.min_units} to {hi} units" if hi > p.min_units else counted(hi, "unit")
                 blamed = blamed_task(o)  # every candidate failed planning on it: point there
                 failed.append(codes.NO_DESIGN.at(p.name_span if blamed is None else blamed.span, units=units,
                                                  name=p.name, closest=o.why_none()))
             outcomes.append(o)
-            if o.stopped:
-                break
     return outcomes, failed, stop.is_set()
 
 
@@ -115,12 +118,30 @@ def _executor(workers: int, scheduler: str | None):
     elif workers > 1:
         from concurrent.futures import ProcessPoolExecutor
 
+        from ..design.search import STOP
+
         # workers ignore Ctrl-C: the main process stops the search and keeps what was found
-        with ProcessPoolExecutor(max_workers=workers, initializer=signal.signal,
-                                 initargs=(signal.SIGINT, signal.SIG_IGN)) as pool:
+        pool = ProcessPoolExecutor(max_workers=workers, initializer=signal.signal,
+                                   initargs=(signal.SIGINT, signal.SIG_IGN))
+        try:
             yield pool
+        finally:
+            if STOP.is_set():  # Ctrl-C: what the workers are still screening is not wanted
+                _end_workers(pool)
+            pool.shutdown(wait=True, cancel_futures=True)
     else:
         yield None
+
+
+def _end_workers(pool) -> None:
+    """End a process pool's workers at once: a shutdown waits for the ranges they are screening
+    (seconds each), and the pool has no public way to stop them before Python 3.14."""
+    end = getattr(pool, "terminate_workers", None)
+    if end is not None:
+        end()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
 
 
 def _renders(files: dict, names: list[str]) -> dict[str, bytes]:
@@ -251,7 +272,18 @@ def _write(outcomes, out: str, render: bool, json_out: bool, force: bool, inputs
 
 
 def _stopped_text(o) -> str:
+    from ..formatting import counted
+
     why = "the time budget ran out" if o.stopped == "time budget" else "interrupted (Ctrl-C)"
-    shown = ", ".join(o.unfinished[:8]) + (f" and {len(o.unfinished) - 8} more" if len(o.unfinished) > 8 else "")
-    return (f"{why}; {len(o.unfinished)} shapes not finished" + (f": {shown}" if o.unfinished else "")
-            + f"; best designs so far: {len(o.designs)}")
+    if not o.searched:
+        return f"not searched: {why} before this design block"
+    shown = ", ".join(o.unfinished[:8]) + (f" and {len(o.unfinished) - 8:,} more" if len(o.unfinished) > 8 else "")
+    said = f"{why}; {counted(len(o.unfinished), 'shape')} not finished" + (f": {shown}" if o.unfinished else "")
+    if o.not_planned:
+        listed = ", ".join(o.not_planned[:5]) + (f" and {len(o.not_planned) - 5} more" if len(o.not_planned) > 5
+                                                 else "")
+        said += f"; {counted(len(o.not_planned), 'design')} found but not planned and timed: {listed}"
+    return said + f"; best designs so far: {len(o.designs)}"
+
+
+

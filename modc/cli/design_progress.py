@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 import time
 from contextlib import contextmanager
+from typing import Any
 
 PLAIN_EVERY = 10.0  # s between plain lines (at most; the first comes at once)
 
@@ -17,8 +18,49 @@ def _duration(s: float | None) -> str:
 
 
 def line(name: str, st) -> str:
+    if st.doing:
+        return f"{name}: {st.doing} ({st.best}); {st.shapes_done} shapes searched"
     return (f"{name}: {st.shapes_done}/{st.shapes_total} shapes, {st.screened:,} settings screened or excluded, "
             f"{st.feasible} feasible, best {st.best or '—'}, ETA {_duration(st.eta)}")
+
+
+@contextmanager
+def _plain(name: str):
+    """Plain lines: each status when PLAIN_EVERY has passed since the last line, and the last
+    status again (with the time spent on it) when nothing new came for PLAIN_EVERY - a design's
+    planning or a large block of settings can take longer - so a CI log never goes quiet."""
+    import threading
+
+    lock = threading.Lock()
+    last: dict[str, Any] = {"at": -1e9, "text": "", "since": time.monotonic()}
+    done = threading.Event()
+
+    def say(text: str) -> None:
+        print(f"modc design: {text}", file=sys.stderr, flush=True)
+        last["at"] = time.monotonic()
+
+    def plain(st, force: bool = False) -> None:
+        with lock:
+            text = line(name, st)
+            if text != last["text"]:
+                last["text"], last["since"] = text, time.monotonic()
+            if force or time.monotonic() - last["at"] >= PLAIN_EVERY:
+                say(text)
+
+    def heartbeat() -> None:
+        while not done.wait(min(1.0, PLAIN_EVERY / 4)):
+            with lock:
+                now = time.monotonic()
+                if last["text"] and now - last["at"] >= PLAIN_EVERY:
+                    say(f"{last['text']} (still at it, {_duration(now - last['since'])})")
+
+    beat = threading.Thread(target=heartbeat, name="modc-design-progress", daemon=True)
+    beat.start()
+    try:
+        yield plain
+    finally:
+        done.set()
+        beat.join()
 
 
 @contextmanager
@@ -28,15 +70,8 @@ def progress(mode: str, name: str):
         yield None
         return
     if mode == "plain":
-        last = [-1e9]
-
-        def plain(st, force: bool = False) -> None:
-            now = time.monotonic()
-            if force or now - last[0] >= PLAIN_EVERY:
-                last[0] = now
-                print(f"modc design: {line(name, st)}", file=sys.stderr, flush=True)
-
-        yield plain
+        with _plain(name) as plain:
+            yield plain
         return
     from rich.console import Console
     from rich.live import Live

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..formatting import counted
 from ..model import ResolvedProblem
 from ..model.robot import StraightPath, Task
 from . import space
@@ -81,6 +82,12 @@ def diagnose(problem: ResolvedProblem, spec: Spec, names, blocked, hit, clear, c
         if clear[name]:
             continue
         h, c = hit[name], closest[name]
+        if not h and math.isfinite(c) and c > problem.cell.targets[i].position_tolerance:
+            # closest is at most every shape's sound reach bound (run._tiers bounds every shape
+            # before any IK; an IK distance is never below its shape's bound): beyond the tolerance
+            # for every shape is a proof, whether or not the search ran to its end
+            entry.update(ruled_out_by="reach", closest_m=_finite(c), detail=f"no design gets closer than {_length(c)}")
+            continue
         if stopped and not h:
             entry.update(detail="not reached by the settings screened before the search stopped")
             continue
@@ -147,11 +154,11 @@ def _finite(x: float) -> float | None:
 def blamed_task(o) -> Task | StraightPath | None:
     """The task or path to point a no-design diagnostic at: when every chain that passed the
     static checks failed planning, the one most of them failed on (the first written on a tie)."""
-    if o.designs or o.stopped or not o.unplanned or sum(o.unplanned.values()) != len(o.rejections):
+    if o.designs or o.stopped or not o.failed_on or sum(o.failed_on.values()) != len(o.rejections):
         return None
     cell = o.problem.cell
-    written = [t for t in (*cell.tasks, *cell.paths) if t.name in o.unplanned]
-    return max(written, key=lambda t: o.unplanned[t.name], default=None)
+    written = [t for t in (*cell.tasks, *cell.paths) if t.name in o.failed_on]
+    return max(written, key=lambda t: o.failed_on[t.name], default=None)
 
 
 def why_none(o) -> str:
@@ -168,16 +175,16 @@ def why_none(o) -> str:
         return head + _grouped(bad)
     torque = [r for r in o.rejections if "torque" in r]
     if torque:
-        return head + (f"every target can be reached alone, but torque rules out {len(torque)} chains "
+        return head + (f"every target can be reached alone, but torque rules out {counted(len(torque), 'chain')} "
                        f"(first: {torque[0]})")
     blamed = blamed_task(o)
     if blamed is not None:
         kind = "path" if isinstance(blamed, StraightPath) else "task"
-        return head + (f"every target can be reached alone; {len(o.rejections)} chains reach every target, "
-                       f"but none can be planned on {kind} '{blamed.name}' (first: {o.rejections[0]})")
+        return head + (f"every target can be reached alone; {counted(len(o.rejections), 'chain')} reach every "
+                       f"target, but none can be planned on {kind} '{blamed.name}' (first: {o.rejections[0]})")
     if o.rejections:
-        return head + (f"every target can be reached alone; {len(o.rejections)} chains reach every target, "
-                       f"but none passes the checks (first: {o.rejections[0]})")
+        return head + (f"every target can be reached alone; {counted(len(o.rejections), 'chain')} reach every "
+                       f"target, but none passes the checks (first: {o.rejections[0]})")
     if not o.problem.cell.obstacles:
         return head + ("every target can be reached alone, but no chain reaches all of them with one arm "
                        "(within its joint limits, clear of itself)")

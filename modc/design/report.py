@@ -8,6 +8,7 @@ from __future__ import annotations
 import base64
 from html import escape
 
+from ..formatting import counted
 from ..objectives import REGISTRY
 from .rank import TASK, pareto, shown, static, versus, why, worst_share
 from .run import Outcome
@@ -147,11 +148,17 @@ def _reference_text(o: Outcome) -> str:
 
 
 def _coverage(o: Outcome) -> str:
+    if not o.searched:
+        return f"Not searched: the search stopped ({o.stopped}) before this design block."
+    if o.not_planned:
+        return (f"Not complete: the search stopped ({o.stopped}) before {len(o.not_planned)} of the designs found "
+                "were planned and timed; a better design may exist.")
     if o.stopped:
-        return (f"Not complete: the search stopped ({o.stopped}) with {len(o.unfinished)} shapes not finished; "
-                "a better design may exist.")
+        return (f"Not complete: the search stopped ({o.stopped}) with {counted(len(o.unfinished), 'shape')} "
+                "not finished; a better design may exist.")
     if o.coarse:
-        return f"Not complete: {len(o.coarse)} shapes too large to enumerate were searched on a coarse twist grid."
+        return (f"Not complete: {counted(len(o.coarse), 'shape')} too large to enumerate were searched on a coarse "
+                "twist grid.")
     return "Complete within the bounds: every twist setting of every shape was screened or excluded by a sound bound."
 
 
@@ -173,8 +180,8 @@ def report_html(outcomes: list[Outcome], renders: dict[str, bytes]) -> str:
     for o in outcomes:
         name = escape(o.problem.name)
         body.append(f"<h2>design {name}</h2>")
-        body.append(f"<p>{len(o.designs)} designs; {o.evaluated:,} twist settings screened over {o.shapes} shapes "
-                    f"in {o.seconds:.1f} s ({o.excluded:,} excluded by sound bounds). "
+        body.append(f"<p>{counted(len(o.designs), 'design')}; {o.evaluated:,} twist settings screened over "
+                    f"{counted(o.shapes, 'shape')} in {o.seconds:.1f} s ({o.excluded:,} excluded by sound bounds). "
                     f"Ranked by {escape(', '.join(o.problem.rank))}, in that order; a tie on every objective is "
                     f"broken by the chain's name. {escape(_coverage(o))}</p>")
         if not o.designs:

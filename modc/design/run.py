@@ -39,7 +39,8 @@ class Status:
     screened: int  # settings screened or excluded so far
     feasible: int  # chains the screens passed
     best: str
-    eta: float | None  # seconds, None while unknown
+    eta: float | None  # seconds, None while unknown (or when stopped)
+    doing: str = ""  # after the search: the design being planned and timed
 
 
 @dataclass
@@ -57,7 +58,9 @@ class Outcome:
     complete: bool = True  # every setting of every shape in the bounds screened or excluded
     stopped: str | None = None  # "time budget" or "interrupted"
     unfinished: list[str] = field(default_factory=list)  # shapes whose search did not run to the end
-    unplanned: dict[str, int] = field(default_factory=dict)  # per task or path: chains not plannable on it
+    failed_on: dict[str, int] = field(default_factory=dict)  # per task or path: chains not plannable on it
+    not_planned: list[str] = field(default_factory=list)  # designs found, not planned: the search stopped first
+    searched: bool = True  # False: a design block not searched, an earlier block used up the budget
     coarse: list[str] = field(default_factory=list)  # shapes searched on a coarse grid
     targets: dict[str, dict] = field(default_factory=dict)  # per target: hit, clear, closest, excluded_by
     reference: Any = None  # modc.design.reference.Reference: the block's `compare with` arm, evaluated
@@ -213,6 +216,11 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     from . import placement, reference, tasks
 
     t0 = time.perf_counter()
+    if max_units is not None:  # --max-units: the design's bound for everything below, the diagnosis too
+        if max_units < problem.min_units:
+            raise ValueError(f"--max-units {max_units} is below the {problem.min_units} units design "
+                             f"'{problem.name}' asks for at least")
+        problem = problem.model_copy(update={"max_units": max_units})
     tasked = tasks.has_tasks(problem) or "coverage" in problem.rank
     screen, points = tasks.with_points(problem)  # every region point required: screened as a target
     screen = _static_screen(screen, problem) if tasked else screen
@@ -245,7 +253,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         if _optional_points(problem) and not out.stopped:
             out = _covering(problem, out, one, max_units, n, top, seed, deadline)
         found = len(out.designs)
-        tasks.plan_all(out, top, seed, deadline, _stopping, rejected)
+        tasks.plan_all(out, top, seed, deadline, _stopping, rejected, _planning(out, progress))
         # every candidate failed its tasks: search on for more of them while there may be more (the
         # search stopped once `enough` designs ranked first, or it returned as many as asked)
         exhausted = found < n and enough[0] >= n
@@ -258,6 +266,18 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     out.reference = reference.evaluate(problem, seed, deadline, grid)
     out.seconds = time.perf_counter() - t0
     return out
+
+
+def _planning(out: Outcome, progress: Callable[..., None] | None) -> Callable[[int, int, str], None] | None:
+    """The progress callback told which design is being planned and timed (k of n)."""
+    if progress is None:
+        return None
+
+    def tick(k: int, n: int, chain: str) -> None:
+        status = Status(out.shapes, out.shapes, out.evaluated, out.screened, chain, None,
+                        f"planning and timing design {k} of {n}")
+        progress(status, True)
+    return tick
 
 
 def _covering(problem: ResolvedProblem, out: Outcome, one, max_units: int | None, n: int, top: int,
@@ -343,7 +363,7 @@ def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int
         # the share of every shape's settings done: an upper bound on what is left (the search
         # may stop early once the top designs are found)
         frac = state["settings"] / max(total_settings, 1)
-        eta = 0.0 if final else spent * (1 - frac) / frac if frac > 0.01 else None
+        eta = (None if out.stopped else 0.0) if final else spent * (1 - frac) / frac if frac > 0.01 else None
         status = Status(state["done"], total_shapes, out.evaluated, out.screened, state["best"], eta)
         if force:
             progress(status, True)

@@ -158,23 +158,28 @@ def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = F
 
 
 def plan_all(out, top: int, seed: int, deadline: float | None, stopping,
-             rejected: dict[str, tuple[str, str | None]] | None = None) -> None:
+             rejected: dict[str, tuple[str, str | None]] | None = None, tick=None) -> None:
     """Plan every design of the outcome, drop those that fail, rank by the problem's objectives
     (the task objectives now known) and keep `top`. rejected: chain -> (why, the task that could
     not be planned), for chains already planned in vain (not planned again; filled here).
-    out.unplanned counts, per task, the chains that could not be planned on it."""
+    out.failed_on counts, per task, the chains that could not be planned on it; tick(k, n, chain)
+    is told each design before it is planned (progress)."""
     rejected = {} if rejected is None else rejected
     kept = []
-    for d in out.designs:
+    for k, d in enumerate(out.designs):
+        if tick is not None:
+            tick(k + 1, len(out.designs), d.chain())
         why = stopping(deadline)
         if why:
             out.stopped = out.stopped or why
+            out.not_planned = [x.chain() for x in out.designs[k:]]
             break
         if d.chain() not in rejected:
             failed: list[str] = []
             p = plan_design(d, seed, deadline, "coverage" in out.problem.rank, lambda: stopping(deadline), failed)
             if p is None:
                 out.stopped = out.stopped or stopping(deadline)
+                out.not_planned = [x.chain() for x in out.designs[k:]]
                 break
             if not isinstance(p, str):
                 kept.append(p)
@@ -183,5 +188,6 @@ def plan_all(out, top: int, seed: int, deadline: float | None, stopping,
         why, task = rejected[d.chain()]  # planned in vain, now or in an earlier round (not planned again)
         out.rejections.append(f"{'-'.join(u.name for u in d.verified.robot.units)}: {why}")
         if task is not None:
-            out.unplanned[task] = out.unplanned.get(task, 0) + 1
+            out.failed_on[task] = out.failed_on.get(task, 0) + 1
     out.designs = order(kept, out.problem.rank)[:top]
+    out.complete = out.complete and not out.not_planned

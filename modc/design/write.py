@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 
+from ..formatting import counted
 from ..objectives import REGISTRY
 from .evaluate import pose_name
 from .rank import Design, why, worst_share
@@ -111,6 +112,10 @@ def ranking(outcomes: list[Outcome]) -> dict:
             "complete": all(o.complete for o in outcomes),
             "stopped": next((o.stopped for o in outcomes if o.stopped), None),
             "unfinished_shapes": [s for o in outcomes for s in shapes(o, o.unfinished)],
+            # designs the search found but could not plan and time before it stopped
+            "not_planned": [s for o in outcomes for s in shapes(o, o.not_planned)],
+            # design blocks not searched at all: an earlier one used up the time budget (or Ctrl-C)
+            "not_searched": [o.problem.name for o in outcomes if not o.searched],
             "coarse_shapes": [s for o in outcomes for s in shapes(o, o.coarse)],
             # `compare with chain …`: per design block naming one, its arm evaluated on the cell
             **({"reference": refs} if (refs := {o.problem.name: o.reference.to_json(o.problem.name)
@@ -144,8 +149,11 @@ def files(outcomes: list[Outcome], renders: dict[str, bytes] | None = None) -> d
 
 
 def summary_line(o: Outcome) -> str:
+    if not o.designs:
+        return f"{o.problem.name}: no design" + ("" if o.searched else " (not searched)")
     best = o.designs[0]
     timed = f", cycle time {best.cycle_time:.3f} s, {best.energy:.2f} J" if best.plans else ""
-    return (f"{o.problem.name}: {len(o.designs)} designs from {o.evaluated:,} evaluated in {o.seconds:.1f} s; "
+    return (f"{o.problem.name}: {counted(len(o.designs), 'design')} from {o.evaluated:,} evaluated in "
+            f"{o.seconds:.1f} s; "
             f"best {best.chain()} ({best.modules} modules, {best.mass:.3f} kg, "
             f"margin {math.floor(best.margin * 100)} %{timed})")

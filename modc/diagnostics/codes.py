@@ -295,7 +295,7 @@ DESIGN_UNSUPPORTED = _register("design-unsupported", W,
 DESIGN_NO_TARGETS = _register("design-no-targets", E, "a design block without any target",
     "design '{name}' has no targets: nothing to design the arm for", "add `target NAME at (x, y, z) m` to the block")
 NO_DESIGN = _register("no-design", E, "`modc design` found no chain that does every task of the cell",
-    "no design of {units} units does every task of '{name}': {closest}",
+    "no design of {units} does every task of '{name}': {closest}",
     "widen the search (more units, more module types, other link lengths) or move the targets")
 
 # --- command line / IO (rendered like the others, exit code 2) ---------------------------------
