@@ -101,17 +101,19 @@ def test_lsp_works_from_the_light_install(light):
     [
         ["sim", str(FARM)],
         ["plan", str(FARM), "--to", "plant"],
+        ["design", str(ROOT / "examples" / "farm_cell.mod"), "-o", "OUT", "-q"],
     ],
 )
 def test_a_command_that_needs_the_full_extra_says_so(light, tmp_path, command):
-    """sim and plan need pybullet/pinocchio/OMPL: a light install says how to get them, exit 2."""
+    """sim and plan need pybullet/pinocchio/OMPL, design coal and pinocchio: a light install says
+    how to get them, exit 2 (design before its search: no progress line)."""
     command = [str(tmp_path / "out") if a == "OUT" else a for a in command]
     r = modc(*command, light=light)
     assert r.returncode == 2, r.stderr
     assert "Traceback" not in r.stderr
     line = r.stderr.strip().splitlines()[-1]
     assert "pip install 'CHECKOUT[full]'" in line and "light install" in line
-    assert not (tmp_path / "out").exists()
+    assert not (tmp_path / "out").exists() and "shapes" not in r.stderr
 
 
 def test_pyproject_light_and_full():

@@ -200,6 +200,7 @@ def design_cmd(
     from ..outputs import check_output_dir
 
     checked = _checked(file, library)
+    _needs_full()
     problems = checked.design.resolved_problems()
     if not problems:
         _err(f"modc design: {file} has no `design NAME {{ … }}` block")
@@ -226,6 +227,16 @@ def design_cmd(
     _write(outcomes, out, render, json_out, force, inputs)
     if interrupted:
         raise SystemExit(EXIT_INTERRUPTED)
+
+
+def _needs_full() -> None:
+    """The search checks every design with coal's meshes and plans tasks with pinocchio (the full
+    extra): say so before the search, not when its first design is checked."""
+    from importlib.util import find_spec
+
+    for name in ("coal", "pinocchio"):
+        if find_spec(name) is None:
+            raise ModuleNotFoundError(f"No module named '{name}'", name=name)
 
 
 def _checked(file: str, library: str | None):
