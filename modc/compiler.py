@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from .diagnostics import Diagnostic, Span, codes
@@ -11,6 +10,7 @@ from .diagnostics.errors import InputError, SourceError
 from .model import Design
 from .model.lower import lower
 from .passes import Context, run_all
+from .records import Record, field
 from .syntax import ast
 
 YAML_SUFFIXES = (".yaml", ".yml")
@@ -18,8 +18,7 @@ YAML_SUFFIXES = (".yaml", ".yml")
 COMPILE_ANALYSES = frozenset({"torque"})
 
 
-@dataclass
-class Checked:
+class Checked(Record, kw_only=False, frozen=False):
     """A checked design, its diagnostics and the source texts they point into."""
 
     design: Design
