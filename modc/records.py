@@ -11,7 +11,6 @@ gets one small generated __init__. Type checkers see dataclasses (dataclass_tran
 """
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -96,9 +95,13 @@ class Record:
         raise TypeError("Record is a base class")
 
     def __setattr__(self, name: str, value: Any) -> None:
+        import dataclasses  # dataclasses' own error, imported when raised: its import is ~5 ms of start-up
+
         raise dataclasses.FrozenInstanceError(f"cannot assign to field '{name}'")
 
     def __delattr__(self, name: str) -> None:
+        import dataclasses
+
         raise dataclasses.FrozenInstanceError(f"cannot delete field '{name}'")
 
     def _values(self) -> tuple:

@@ -173,13 +173,13 @@ def design_cmd(
 ) -> None:
     """Find the best module chains for the cells and targets of FILE's design blocks."""
     import json
-    from dataclasses import replace
 
     from ..compiler import InputError, check_file, inputs_of
     from ..design.write import files as design_files
     from ..design.write import ranking, summary_line
     from ..diagnostics import Severity, codes
     from ..outputs import check_output_dir, write_tree
+    from ..records import replace
 
     try:
         checked = check_file(file, library)
