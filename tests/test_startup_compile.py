@@ -326,3 +326,48 @@ def test_a_plain_compile_imports_no_click_and_writes_what_click_s_command_writes
     assert refused == {"exit": 2, "click": False} and "Traceback" not in err, err
     missing, err = run(tmp_path / "none.mod", "-o", tmp_path / "c")
     assert missing == {"exit": 2, "click": False} and "none.mod" in err and "Traceback" not in err
+
+
+# --- the end of the command: no interpreter finalization ---------------------------------------------
+
+def _python_m_modc(tmp_path, *args, cache=None):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, MODC_CACHE_DIR=str(cache or tmp_path / "cache"), PYTHONPATH=str(ROOT))
+    env.pop("MODC_NO_CACHE", None)
+    return subprocess.run([sys.executable, "-m", "modc", *map(str, args)], capture_output=True, text=True, env=env,
+                          cwd=tmp_path)
+
+
+def test_python_m_modc_ends_with_the_command_s_exit_code_its_whole_output_and_its_exit_handlers_run(tmp_path):
+    import json
+
+    lint = _python_m_modc(tmp_path, "lint", FARM, "--format", "json")  # an empty cache: the records' codes are new
+    assert lint.returncode == 0 and json.loads(lint.stdout)["diagnostics"] == []  # stdout flushed, all of it
+    assert list((tmp_path / "cache" / "records").glob("*.marshal"))  # written by the exit handler
+    ok = _python_m_modc(tmp_path, FARM, "-o", tmp_path / "out")
+    assert ok.returncode == 0 and "files written" in ok.stderr and (tmp_path / "out" / "report.json").is_file()
+    bad = tmp_path / "bad.mod"
+    bad.write_text("robot bad {\n    chain H1 - Q9\n}\n", encoding="utf-8")
+    failed = _python_m_modc(tmp_path, bad, "-o", tmp_path / "out2")
+    assert failed.returncode == 1 and "bad.mod:2" in failed.stderr and not (tmp_path / "out2").exists()
+    assert _python_m_modc(tmp_path, "nonsense").returncode == 2
+    assert _python_m_modc(tmp_path, "--version").stdout.startswith("modc ")
+
+
+def test_a_thread_still_running_or_an_exit_message_ends_the_usual_way():
+    import threading
+
+    from modc.cli import _end
+
+    _end("modc: a message")  # returns: Python prints it and exits 1
+    stop = threading.Event()
+    t = threading.Thread(target=stop.wait)
+    t.start()
+    try:
+        _end(0)  # returns: Python joins the thread before it ends
+    finally:
+        stop.set()
+        t.join()

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from .app import app
 
-__all__ = ["app", "main"]
+__all__ = ["app", "command", "main"]
 
 
 class _Package(types.ModuleType):
@@ -58,6 +58,36 @@ def main(argv: list[str] | None = None) -> None:
     from .app import run
 
     run(args)
+
+
+def command() -> None:
+    """The installed `modc` command and `python -m modc`: main(), then, once every exit handler
+    has run and the output is flushed, the process ends without Python's finalization, which
+    tore down numpy, jinja2 and modc's modules object by object: ~45 ms of CPU after a compile's
+    work was done (benchmarks/bench_startup.py). A command that leaves a thread running, a
+    non-numeric exit, or output that cannot be flushed ends the usual way."""
+    try:
+        main()
+    except SystemExit as e:
+        _end(e.code)
+        raise
+
+
+def _end(code: object) -> None:
+    import threading
+
+    if not (code is None or isinstance(code, int)) or threading.active_count() > 1:
+        return
+    import atexit
+    import os
+
+    atexit._run_exitfuncs()  # the caches written at exit (the records' compiled __init__s), as at a normal exit
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):  # a closed pipe: Python reports it as it always did
+        return
+    os._exit(code or 0)
 
 
 def _compile_plain(args: list[str]) -> None:
