@@ -12,11 +12,10 @@ This is not DH of either kind: each unit has three frames. Names read T_<from>_<
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from .model import ResolvedRobot
+from .records import Record
 
 
 def Rx(a: float) -> np.ndarray:
@@ -142,8 +141,7 @@ def target_errors(target, T_base_tool: np.ndarray) -> tuple[float, float | None]
     return position, None
 
 
-@dataclass(frozen=True)
-class UnitGeometry:
+class UnitGeometry(Record, kw_only=False):
     """The numbers eqs. (4)-(6) need for one unit, resolved from the library."""
 
     x01: float

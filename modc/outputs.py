@@ -19,9 +19,6 @@ import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
-from . import names
-from .diagnostics import Span, codes
-
 PathLike = str | os.PathLike
 DIR_HINT = "write the output into a new directory, e.g. -o build/out"
 _protected: list[str] = []  # the inputs of the running command (for the caches)
@@ -72,6 +69,7 @@ def holds(directory: PathLike, path: PathLike) -> bool:
 
 
 def _unsafe(out: PathLike, what: str, hint: str):
+    from .diagnostics import Span, codes  # here: the records' code cache (modc.cache) reads this module
     from .diagnostics.errors import InputError
 
     shown = os.fspath(out)
@@ -113,6 +111,8 @@ def _check_writable(out: PathLike) -> None:
     minutes is not lost to a read-only disk, an immutable folder or a file on the way."""
     import tempfile
 
+    from . import names
+    from .diagnostics import Span, codes
     from .diagnostics.errors import InputError
 
     where = os.fspath(out)
@@ -144,6 +144,7 @@ def _check_rule(out: PathLike, inputs: Sequence[PathLike], force: bool) -> None:
 
 
 def _refuse_foreign(out: PathLike, entries: list[str]) -> None:
+    from .diagnostics import Span, codes  # here: the records' code cache (modc.cache) reads this module
     from .diagnostics.errors import InputError
 
     if not entries:

@@ -5,12 +5,12 @@ defaults, equality and hash over the fields, a repr, no assignment after __init_
 dataclasses' code generation: that cost ~0.7 ms a class at import, about 40 ms of every command
 for the AST's, the model's and the library's ~60 classes (benchmarks/bench_startup.py). Fields
 are keyword-only, as the model's are, unless the class says `kw_only=False` (the AST's nodes,
-built positionally by the parser). Each class gets one small generated __init__. Type checkers
-see dataclasses (dataclass_transform).
+built positionally by the parser). A class saying `frozen=False` takes assignments and has no
+hash, as a plain dataclass; a field(compare=False) is left out of equality and hash. Each class
+gets one small generated __init__. Type checkers see dataclasses (dataclass_transform).
 """
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -24,16 +24,20 @@ _MISSING: Any = object()
 
 
 class Field:
-    """A field's default (or factory), and whether repr and dumps leave it out (spans, caches)."""
+    """A field's default (or factory), whether repr and dumps leave it out (spans, caches),
+    whether equality and hash read it, and whether __init__ takes it (else __post_init__ sets it)."""
 
-    __slots__ = ("default", "default_factory", "hidden")
+    __slots__ = ("default", "default_factory", "hidden", "compare", "init")
 
-    def __init__(self, default: Any, default_factory: Callable[[], Any] | None, hidden: bool):
+    def __init__(self, default: Any, default_factory: Callable[[], Any] | None, hidden: bool, compare: bool = True,
+                 init: bool = True):
         self.default, self.default_factory, self.hidden = default, default_factory, hidden
+        self.compare, self.init = compare, init
 
 
-def field(*, default: Any = _MISSING, default_factory: Callable[[], Any] | None = None, hidden: bool = False) -> Any:
-    return Field(default, default_factory, hidden)
+def field(*, default: Any = _MISSING, default_factory: Callable[[], Any] | None = None, hidden: bool = False,
+          compare: bool = True, init: bool = True) -> Any:
+    return Field(default, default_factory, hidden, compare, init)
 
 
 @dataclass_transform(kw_only_default=True, frozen_default=True, field_specifiers=(field,))
@@ -42,11 +46,14 @@ class Record:
     _defaults: ClassVar[dict[str, Any]] = {}
     _factories: ClassVar[dict[str, Callable[[], Any]]] = {}
     _hidden: ClassVar[frozenset[str]] = frozenset()
+    _uncompared: ClassVar[frozenset[str]] = frozenset()
+    _compared: ClassVar[tuple[str, ...]] = ()
+    _not_init: ClassVar[frozenset[str]] = frozenset()
 
-    def __init_subclass__(cls, kw_only: bool = True, **kwargs: Any) -> None:
+    def __init_subclass__(cls, kw_only: bool = True, frozen: bool = True, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         fields, defaults, factories = list(cls._fields), dict(cls._defaults), dict(cls._factories)
-        hidden = set(cls._hidden)
+        hidden, uncompared, not_init = set(cls._hidden), set(cls._uncompared), set(cls._not_init)
         for name, annotation in cls.__dict__.get("__annotations__", {}).items():
             if str(annotation).startswith(("ClassVar", "typing.ClassVar")):
                 continue
@@ -61,12 +68,22 @@ class Record:
                 delattr(cls, name)
                 if value.hidden:
                     hidden.add(name)
+                if not value.compare:
+                    uncompared.add(name)
+                if not value.init:
+                    not_init.add(name)
                 if value.default_factory is not None:
                     factories[name] = value.default_factory
                 value = value.default
             if value is not _MISSING:
                 defaults[name] = value
         cls._fields, cls._defaults, cls._factories, cls._hidden = tuple(fields), defaults, factories, frozenset(hidden)
+        cls._uncompared, cls._not_init = frozenset(uncompared), frozenset(not_init)
+        cls._compared = tuple(n for n in fields if n not in uncompared)
+        if not frozen:  # a plain (mutable) dataclass's behaviour: assignments, and no hash
+            cls.__setattr__ = object.__setattr__  # type: ignore[method-assign,assignment]
+            cls.__delattr__ = object.__delattr__  # type: ignore[method-assign]
+            cls.__hash__ = None  # type: ignore[assignment]
         cls.__init__ = _make_init(cls, not kw_only)  # type: ignore[method-assign]
         if not kw_only:
             setattr(cls, "__match_args__", cls._fields)  # noqa: B010 - mypy reads __match_args__ as fixed
@@ -78,14 +95,18 @@ class Record:
         raise TypeError("Record is a base class")
 
     def __setattr__(self, name: str, value: Any) -> None:
+        import dataclasses  # dataclasses' own error, imported when raised: its import is ~5 ms of start-up
+
         raise dataclasses.FrozenInstanceError(f"cannot assign to field '{name}'")
 
     def __delattr__(self, name: str) -> None:
+        import dataclasses
+
         raise dataclasses.FrozenInstanceError(f"cannot delete field '{name}'")
 
     def _values(self) -> tuple:
         d = self.__dict__
-        return tuple(d[name] for name in self._fields)
+        return tuple(d[name] for name in self._compared)
 
     def __eq__(self, other: object) -> bool:
         if other.__class__ is not self.__class__:
@@ -106,6 +127,12 @@ def _make_init(cls: type[Record], positional: bool) -> Callable[..., None]:
     params, body = [], []
     scope: dict[str, Any] = {"_MISSING": _MISSING}
     for n in cls._fields:
+        if n in cls._not_init:  # set by __post_init__, or its default's
+            if n in cls._defaults or n in cls._factories:
+                scope[f"_d_{n}"], scope[f"_f_{n}"] = cls._defaults.get(n), cls._factories.get(n)
+                body.append(f"    _record_dict[{n!r}] = _f_{n}()\n" if n in cls._factories
+                            else f"    _record_dict[{n!r}] = _d_{n}\n")
+            continue
         if n in cls._defaults:
             scope[f"_d_{n}"] = cls._defaults[n]
             params.append(f"{n}=_d_{n}")

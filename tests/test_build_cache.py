@@ -73,3 +73,28 @@ def test_old_builds_are_pruned(cache_dir, monkeypatch, tmp_path):
         src.write_text(text.replace("robot farm", f"robot arm{k}"), encoding="utf-8")
         build_cached(_checked(src), only=["urdf"])
     assert len(list((cache_dir / "builds").glob("*.build"))) == 2
+
+
+def test_the_code_stamp_names_every_file_of_modc_with_its_size_and_time(tmp_path, monkeypatch):
+    """modc's own code is in the key: every file (templates too, not bytecode), and a change of one
+    file's size or time changes the stamp."""
+    import os
+
+    stamp = compiler._code_stamp().splitlines()
+    root = os.path.dirname(compiler.__file__)
+    expected = sorted(os.path.relpath(os.path.join(d, n), root).replace(os.sep, "/")
+                      for d, dirs, names in os.walk(root) if "__pycache__" not in d.split(os.sep)
+                      for n in names if not n.endswith((".pyc", ".pyo")))
+    assert sorted(line.rsplit(":", 2)[0] for line in stamp) == expected
+    st = os.stat(compiler.__file__)
+    assert f"compiler.py:{st.st_size}:{st.st_mtime_ns}" in stamp
+    tree = tmp_path / "modc"
+    (tree / "backends" / "__pycache__").mkdir(parents=True)
+    (tree / "backends" / "urdf.py").write_text("x = 1\n")
+    (tree / "backends" / "__pycache__" / "urdf.cpython-311.pyc").write_bytes(b"code")
+    (tree / "templates").mkdir()
+    (tree / "templates" / "a.j2").write_text("{{ x }}")
+    before = compiler._code_stamp(str(tree))
+    assert [line.rsplit(":", 2)[0] for line in before.splitlines()] == ["backends/urdf.py", "templates/a.j2"]
+    os.utime(tree / "templates" / "a.j2", ns=(0, 12345))
+    assert compiler._code_stamp(str(tree)) != before

@@ -70,3 +70,80 @@ def test_a_keyword_record_takes_any_field_name_and_fills_defaults_and_factories(
         Row(0.1)  # type: ignore[misc]  # keyword-only
     with pytest.raises(dataclasses.FrozenInstanceError):
         r.d = 0.2  # type: ignore[misc]
+
+
+def test_a_mutable_record_takes_assignments_and_has_no_hash_as_a_plain_dataclass():
+    """frozen=False: what @dataclass (not frozen) was for the compile's mutable values (Build,
+    Description, Link)."""
+    from modc.records import Record, field
+
+    class Box(Record, kw_only=False, frozen=False):
+        name: str
+        items: list = field(default_factory=list)
+
+    b = Box("a")
+    b.name = "b"
+    b.items.append(1)
+    assert b == Box("b", [1]) and b != Box("b")
+    with pytest.raises(TypeError):
+        hash(b)
+    del b.items
+    assert not hasattr(b, "items")
+
+
+def test_uncompared_and_not_init_fields_as_in_dataclasses():
+    """field(compare=False) is outside equality and hash; field(init=False) is set by
+    __post_init__ (or its default), never an __init__ parameter."""
+    from modc.records import Record, field
+
+    class Matrix(Record, kw_only=False):
+        links: tuple
+        stats: dict = field(default_factory=dict, compare=False)
+
+    assert Matrix(("a",), {"n": 1}) == Matrix(("a",), {"n": 2})
+    assert hash(Matrix(("a",))) == hash(Matrix(("a",), {"x": 0}))
+    assert Matrix(("a",)) != Matrix(("b",))
+
+    class Built(Record, kw_only=False, frozen=False):
+        design: str
+        count: int = field(default=3, init=False)
+        robots: tuple = field(init=False)
+
+        def __post_init__(self) -> None:
+            self.robots = (self.design,) * self.count
+
+    b = Built("arm")
+    assert (b.robots, b.count) == (("arm",) * 3, 3) and fields(b) == ("design", "count", "robots")
+    with pytest.raises(TypeError):
+        Built("arm", robots=())  # type: ignore[call-arg]
+
+
+def test_the_compile_path_builds_no_dataclass(tmp_path):
+    """The first compile of a new arm builds records, not dataclasses (issue 25: each
+    dataclass cost ~0.7 ms of start-up), and does not even import the dataclasses module."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    run = ("from modc.cli import main\n"
+           "try:\n"
+           "    main(sys.argv[1:])\n"
+           "except SystemExit:\n"
+           "    pass\n")
+    spy = ("import dataclasses, sys\n"
+           "made = []\n"
+           "orig = dataclasses._process_class\n"
+           "def spy(cls, *a, **k):\n"
+           "    made.append(cls.__module__ + '.' + cls.__qualname__)\n"
+           "    return orig(cls, *a, **k)\n"
+           "dataclasses._process_class = spy\n" + run + "print('MADE', *made)\n")
+    plain = "import sys\n" + run + "print('MODULE', 'dataclasses' in sys.modules)\n"
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": str(root), "MODC_CACHE_DIR": str(tmp_path / "cache")}
+    args = [str(root / "examples" / "farm.mod"), "-o", str(tmp_path / "o")]
+    out = [subprocess.run([sys.executable, "-c", probe, *args], env=env, capture_output=True, text=True,
+                          cwd=tmp_path, check=True).stdout for probe in (spy, plain)]
+    made = out[0].split("MADE", 1)[1].split()
+    assert [m for m in made if m.startswith("modc.")] == []
+    assert out[1].split("MODULE", 1)[1].split() == ["False"]

@@ -263,3 +263,111 @@ def test_the_benchmarks_install_caches_are_every_cache_a_compile_keys_by_modc_al
     assert out.returncode == 0, out.stderr
     kinds = {p.name for p in (tmp_path / "cache").iterdir()}
     assert kinds == set(INSTALL_CACHES) | ARM_CACHES and not set(INSTALL_CACHES) & ARM_CACHES
+
+
+# --- the compile's command line without click -------------------------------------------------------
+
+def test_the_plain_compile_command_line_means_what_click_reads_in_it():
+    from modc.cli.compile import compile_cmd
+    from modc.cli.compile_run import plain_args
+
+    for args in (["a.mod", "-o", "out"], ["-o", "out", "a.mod", "-q"], ["a.mod", "--out=o", "--library", "lib.yaml"],
+                 ["a.mod", "-o", "o", "--force", "--only", "urdf,srdf", "--torque=warning", "-v"],
+                 ["a.mod", "-o", "o", "--no-force", "--ros-distro", "humble", "--ik-solver=kdl", "--smoke",
+                  "--ros-package", "p", "--command-interface", "effort", "--package-license", "MIT",
+                  "--maintainer", "A <a@b.c>", "--quiet", "--verbose"]):
+        ours = plain_args(args)
+        assert ours is not None, args
+        theirs = compile_cmd.make_context("compile", list(args)).params
+        assert {**theirs, **ours} == theirs, args  # the same values; the rest are click's defaults
+        import inspect
+
+        from modc.cli.compile_run import run
+
+        defaults = {k: p.default for k, p in inspect.signature(run).parameters.items()
+                    if p.default is not inspect.Parameter.empty}
+        assert {**defaults, **ours} == theirs, args  # run()'s defaults are the command's
+    for args in ([], ["a.mod"], ["-o", "o"], ["a.mod", "b.mod", "-o", "o"], ["a.mod", "-oo"], ["a.mod", "-o"],
+                 ["a.mod", "-o", "o", "-o", "p"], ["a.mod", "-o", "-x"], ["a.mod", "-o", "o", "--seed", "1"],
+                 ["a.mod", "-o", "o", "--torque", "loud"], ["a.mod", "-o", "o", "--force=1"],
+                 ["a.mod", "-o", "o", "-h"], ["a.mod", "-o", "o", "--help"], ["a.mod", "-o", "o", "--"],
+                 ["a.mod", "-o", "o", "--collision-samples=5"]):
+        assert plain_args(args) is None, args
+
+
+def test_a_plain_compile_imports_no_click_and_writes_what_click_s_command_writes(tmp_path):
+    import json
+    import os
+    import subprocess
+    import sys
+
+    probe = ("import json, sys\nfrom modc.cli import main\ntry:\n    main(sys.argv[1:])\n"
+             "except SystemExit as e:\n    code = e.code\nelse:\n    code = 'returned'\n"
+             "sys.stderr.write(json.dumps({'exit': code, 'click': 'click' in sys.modules}))\n")
+    env = dict(os.environ, MODC_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
+    env.pop("MODC_NO_CACHE", None)
+
+    def run(*args):
+        p = subprocess.run([sys.executable, "-c", probe, *map(str, args)], capture_output=True, text=True, env=env,
+                           cwd=tmp_path)
+        return json.loads(p.stderr.strip().splitlines()[-1]), p.stderr
+
+    plain, err = run(FARM, "-o", tmp_path / "a", "-v")
+    assert plain == {"exit": 0, "click": False}, err
+    assert err.count("files written") == 1  # the compile ran once
+    clicked, _ = run("compile", FARM, "-o", tmp_path / "b", "--seed", "0")  # a number: click reads it
+    assert clicked == {"exit": 0, "click": True}
+    a, b = sorted((tmp_path / "a").rglob("*")), sorted((tmp_path / "b").rglob("*"))
+    assert [p.relative_to(tmp_path / "a") for p in a] == [p.relative_to(tmp_path / "b") for p in b]
+    assert all(x.read_bytes() == y.read_bytes() for x, y in zip(a, b, strict=True) if x.is_file())
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d" / "mine.txt").write_text("not modc's")
+    refused, err = run(FARM, "-o", tmp_path / "d")  # OUT holds a file modc did not write: a usage error
+    assert refused == {"exit": 2, "click": False} and "Traceback" not in err, err
+    missing, err = run(tmp_path / "none.mod", "-o", tmp_path / "c")
+    assert missing == {"exit": 2, "click": False} and "none.mod" in err and "Traceback" not in err
+
+
+# --- the end of the command: no interpreter finalization ---------------------------------------------
+
+def _python_m_modc(tmp_path, *args, cache=None):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, MODC_CACHE_DIR=str(cache or tmp_path / "cache"), PYTHONPATH=str(ROOT))
+    env.pop("MODC_NO_CACHE", None)
+    return subprocess.run([sys.executable, "-m", "modc", *map(str, args)], capture_output=True, text=True, env=env,
+                          cwd=tmp_path)
+
+
+def test_python_m_modc_ends_with_the_command_s_exit_code_its_whole_output_and_its_exit_handlers_run(tmp_path):
+    import json
+
+    lint = _python_m_modc(tmp_path, "lint", FARM, "--format", "json")  # an empty cache: the records' codes are new
+    assert lint.returncode == 0 and json.loads(lint.stdout)["diagnostics"] == []  # stdout flushed, all of it
+    assert list((tmp_path / "cache" / "records").glob("*.marshal"))  # written by the exit handler
+    ok = _python_m_modc(tmp_path, FARM, "-o", tmp_path / "out")
+    assert ok.returncode == 0 and "files written" in ok.stderr and (tmp_path / "out" / "report.json").is_file()
+    bad = tmp_path / "bad.mod"
+    bad.write_text("robot bad {\n    chain H1 - Q9\n}\n", encoding="utf-8")
+    failed = _python_m_modc(tmp_path, bad, "-o", tmp_path / "out2")
+    assert failed.returncode == 1 and "bad.mod:2" in failed.stderr and not (tmp_path / "out2").exists()
+    assert _python_m_modc(tmp_path, "nonsense").returncode == 2
+    assert _python_m_modc(tmp_path, "--version").stdout.startswith("modc ")
+
+
+def test_a_thread_still_running_or_an_exit_message_ends_the_usual_way():
+    import threading
+
+    from modc.cli import _end
+
+    _end("modc: a message")  # returns: Python prints it and exits 1
+    stop = threading.Event()
+    t = threading.Thread(target=stop.wait)
+    t.start()
+    try:
+        _end(0)  # returns: Python joins the thread before it ends
+    finally:
+        stop.set()
+        t.join()

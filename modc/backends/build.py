@@ -1,16 +1,15 @@
 """What backends share during one compile: the checked design and per-robot descriptions."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..diagnostics import Diagnostic
 from ..model import Design, ResolvedRobot
 from ..physical.assembly import Description, describe
+from ..records import Record, field
 
 
-@dataclass
-class Build:
+class Build(Record, kw_only=False, frozen=False):
     design: Design
     diagnostics: list[Diagnostic] = field(default_factory=list)  # warnings that survived the passes
     files: dict[str, str | bytes] = field(default_factory=dict)  # what earlier backends produced

@@ -9,8 +9,9 @@ another's outputs from the build (ros installs mjcf/ when the mjcf backend ran) 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+from ..records import Record
 
 if TYPE_CHECKING:  # the physical description (numpy) loads with the first backend, not the registry
     from .build import Build
@@ -18,8 +19,7 @@ if TYPE_CHECKING:  # the physical description (numpy) loads with the first backe
 Files = dict[str, "str | bytes"]
 
 
-@dataclass(frozen=True)
-class Backend:
+class Backend(Record, kw_only=False):
     name: str
     summary: str
     emit: Callable[[Build], Files]

@@ -32,12 +32,12 @@ templates only lay them out. Output is deterministic and does not depend on the 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from .._version import __version__
 from ..kinematics import rpy_matrix
 from ..physical.assembly import kdl_root
 from ..physical.constants import ACCEL_RAMP_TIME  # the acceleration limits
+from ..records import Record
 from .build import Build
 from .common import BASE_LINK, GROUP, urdf_context
 from .format import num
@@ -110,8 +110,7 @@ def quaternion(rpy) -> tuple[float, float, float, float]:
 
 # --- per-robot data ------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
-class JointData:
+class JointData(Record, kw_only=False):
     """Everything ROS needs about one actuated joint, in SI units (rad, rad/s, rad/s², N·m)."""
 
     name: str

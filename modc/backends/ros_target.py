@@ -13,9 +13,9 @@ Distro facts (which IK plugins are released, from the rosdistro distribution fil
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from .. import names
+from ..records import Record
 
 # name -> (MoveIt kinematics_solver plugin, the package that provides it)
 IK_PLUGINS = {
@@ -25,8 +25,7 @@ IK_PLUGINS = {
 }
 
 
-@dataclass(frozen=True)
-class Distro:
+class Distro(Record, kw_only=False):
     name: str
     ros: int  # 1 or 2
     ik_solvers: tuple[str, ...]  # released in this distro, the default first
@@ -131,8 +130,7 @@ def distro_for(ros_version: int | None = None, ros_distro: str | None = None,
     return DEFAULT_DISTRO
 
 
-@dataclass(frozen=True)
-class Target:
+class Target(Record, kw_only=False):
     """The resolved ROS options of one compile."""
 
     distro: Distro

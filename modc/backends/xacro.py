@@ -22,7 +22,6 @@ from __future__ import annotations
 import keyword
 import math
 import re
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -34,6 +33,7 @@ from ..model import ResolvedRobot
 from ..model.library import Library
 from ..physical.inertia import Inertial, combine, part_inertial
 from ..physical.parts import Part, Primitive, unit_parts
+from ..records import Record
 from .build import Build
 from .common import MATERIALS
 from .format import num, vec
@@ -218,8 +218,7 @@ def unit_data(lib: Library, variant: str, kind: int) -> dict:
     return data
 
 
-@dataclass(frozen=True)
-class LibraryEntry:
+class LibraryEntry(Record, kw_only=False):
     ident: str  # macro/property prefix
     library: Library
 

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import click
 
 from .. import __version__
 from .common import (  # noqa: F401 - the commands' modules import them from here
+    COMMANDS,
     EXIT_ERRORS,
     EXIT_OK,
     EXIT_USAGE,
@@ -18,6 +18,8 @@ from .common import (  # noqa: F401 - the commands' modules import them from her
     _err,
     _expand,
     _print_diagnostics,
+    looks_like_path,
+    missing_extra,
     usage_errors,
 )
 
@@ -59,16 +61,6 @@ class Command(click.Command):
                 formatter.write_dl(rows)
         self.format_options(ctx, formatter)
         self.format_epilog(ctx, formatter)
-
-
-# Each command and the module of modc.cli that registers it, in the order `modc --help` lists them
-# (not alphabetically). A command's module is imported when the command runs: `modc lint` builds
-# no other command's options (benchmarks/bench_startup.py).
-COMMANDS = {
-    "check": "analysis", "dh2mod": "analysis", "dh": "analysis", "compile": "compile", "design": "design_cmd",
-    "lsp": "info", "schema": "info", "codes": "info", "backends": "info", "lint": "lint", "fmt": "lint",
-    "sim": "motion", "render": "motion", "play": "motion", "plan": "motion", "view": "view",
-}
 
 
 def load_commands() -> None:
@@ -135,36 +127,6 @@ library_option = click.option(
 
 # --- the command line as a whole: routing, help, missing extras -------------------------------------
 
-# Modules of the `full` extra, by the pip package that provides them.
-HEAVY = {
-    "pinocchio": "pin",
-    "coal": "pin",
-    "pybullet": "pybullet",
-    "pybullet_data": "pybullet",
-    "ompl": "ompl",
-    "PIL": "pillow",
-    "mujoco": "mujoco",
-    "viser": "viser",
-    "cma": "cma",
-    "dask": "dask",
-    "distributed": "distributed",
-    "toppra": "toppra",
-}
-SOURCE_SUFFIXES = (".mod", ".yaml", ".yml")
-
-
-def missing_extra(e: ModuleNotFoundError, command: str) -> str | None:
-    """One line for a command that needs a module of the `full` extra; None for any other module
-    (a real bug, which keeps its traceback)."""
-    root = (e.name or "").split(".")[0]
-    if root not in HEAVY:
-        return None
-    package = f"{root} (pip package {HEAVY[root]})" if HEAVY[root] != root.lower() else root
-    # modc is not on PyPI: the extra is installed from the checkout (or the wheel) modc came from
-    return (f"modc {command}: needs {package}, which the light install leaves out: "
-            "pip install 'CHECKOUT[full]' (or the wheel, 'modc-VERSION-py3-none-any.whl[full]')")
-
-
 def route(args: list[str], commands: list[str]) -> list[str] | str:
     """The arguments for the click group, or an error line. A first word that is no command is a
     file to compile (`modc FILE -o OUT`) when it looks like one (it exists, or has a source suffix
@@ -172,8 +134,7 @@ def route(args: list[str], commands: list[str]) -> list[str] | str:
     if not args or args[0].startswith("-") or args[0] in commands:
         return args
     word = args[0]
-    looks_like_path = Path(word).exists() or word.lower().endswith(SOURCE_SUFFIXES) or any(c in word for c in "/\\.*?")
-    if looks_like_path:
+    if looks_like_path(word):
         return ["compile", *args]
     close = difflib.get_close_matches(word, commands, n=1, cutoff=0.6)
     suggestion = f"did you mean '{close[0]}'?" if close else "see modc --help"

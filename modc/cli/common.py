@@ -10,6 +10,22 @@ from pathlib import Path
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
 
+# Each command and the module of modc.cli that registers it, in the order `modc --help` lists them
+# (not alphabetically). A command's module is imported when the command runs: `modc lint` builds
+# no other command's options (benchmarks/bench_startup.py).
+COMMANDS = {
+    "check": "analysis", "dh2mod": "analysis", "dh": "analysis", "compile": "compile", "design": "design_cmd",
+    "lsp": "info", "schema": "info", "codes": "info", "backends": "info", "lint": "lint", "fmt": "lint",
+    "sim": "motion", "render": "motion", "play": "motion", "plan": "motion", "view": "view",
+}
+SOURCE_SUFFIXES = (".mod", ".yaml", ".yml")
+
+
+def looks_like_path(word: str) -> bool:
+    """A first word that is no command is a file to compile (`modc FILE -o OUT`) when it looks like
+    one: it exists, or has a source suffix or a path separator."""
+    return Path(word).exists() or word.lower().endswith(SOURCE_SUFFIXES) or any(c in word for c in "/\\.*?")
+
 
 class Verbosity:
     quiet = False
@@ -73,3 +89,58 @@ def usage_errors(prog: str, usage: tuple[type[Exception], ...] = (), writing: st
             raise
         _err(f"modc {prog}: cannot write {writing}: {e.strerror or e}")
         raise SystemExit(EXIT_USAGE) from None
+
+
+# Modules of the `full` extra, by the pip package that provides them.
+HEAVY = {
+    "pinocchio": "pin",
+    "coal": "pin",
+    "pybullet": "pybullet",
+    "pybullet_data": "pybullet",
+    "ompl": "ompl",
+    "PIL": "pillow",
+    "mujoco": "mujoco",
+    "viser": "viser",
+    "cma": "cma",
+    "dask": "dask",
+    "distributed": "distributed",
+    "toppra": "toppra",
+}
+
+
+def missing_extra(e: ModuleNotFoundError, command: str) -> str | None:
+    """One line for a command that needs a module of the `full` extra; None for any other module
+    (a real bug, which keeps its traceback)."""
+    root = (e.name or "").split(".")[0]
+    if root not in HEAVY:
+        return None
+    package = f"{root} (pip package {HEAVY[root]})" if HEAVY[root] != root.lower() else root
+    # modc is not on PyPI: the extra is installed from the checkout (or the wheel) modc came from
+    return (f"modc {command}: needs {package}, which the light install leaves out: "
+            "pip install 'CHECKOUT[full]' (or the wheel, 'modc-VERSION-py3-none-any.whl[full]')")
+
+
+def run_like_click(run, options: dict, command: str) -> None:
+    """run(**options) for a command line read without click, ending as the click group ends a
+    command: Ctrl-C prints "Aborted!" (exit 1), a closed pipe on stdout exits 1 quietly, a module
+    of the `full` extra that is missing is one line (exit 2)."""
+    import errno
+
+    try:
+        run(**options)
+    except (EOFError, KeyboardInterrupt):
+        _err("Aborted!")
+        raise SystemExit(1) from None
+    except ModuleNotFoundError as e:
+        line = missing_extra(e, command)
+        if line is None:
+            raise
+        _err(line)
+        raise SystemExit(EXIT_USAGE) from None
+    except OSError as e:
+        if e.errno != errno.EPIPE:
+            raise
+        import os
+
+        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - nothing more reaches the closed pipe
+        raise SystemExit(1) from None

@@ -242,10 +242,9 @@ def _needs_full() -> None:
 def _checked(file: str, library: str | None):
     """FILE checked, its diagnostics printed; exit here when it has errors or a statement the
     search would ignore (refused: ignoring it would mislead)."""
-    from dataclasses import replace
-
     from ..compiler import InputError, check_file
     from ..diagnostics import Severity, codes
+    from ..records import replace
 
     try:
         checked = check_file(file, library)

@@ -6,10 +6,8 @@ modc.cli.lint, which reads it as before.
 """
 from __future__ import annotations
 
-import sys
-
 from .. import __version__
-from .common import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, Verbosity, _err, _expand, _print_diagnostics
+from .common import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, Verbosity, _err, _expand, _print_diagnostics, run_like_click
 
 FORMATS = ("text", "json", "github", "sarif")
 # option -> (its name in run(), the values it takes or None for any, or "flag")
@@ -79,19 +77,5 @@ def run(files, format: str = "text", library: str | None = None, quiet: bool = F
 
 
 def run_plain(options: dict) -> None:
-    """run(), ending as click ends a command: Ctrl-C prints "Aborted!" (exit 1), a closed pipe
-    on stdout exits 1 quietly."""
-    import errno
-
-    try:
-        run(**options)
-    except (EOFError, KeyboardInterrupt):
-        _err("Aborted!")
-        raise SystemExit(1) from None
-    except OSError as e:
-        if e.errno != errno.EPIPE:
-            raise
-        import os
-
-        sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - nothing more reaches the closed pipe
-        raise SystemExit(1) from None
+    """run(), ending as click ends a command (common.run_like_click)."""
+    run_like_click(run, options, "lint")

@@ -12,17 +12,16 @@ between the axes about it. Where DH leaves a choice, the usual conventions apply
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..kinematics import Chain
+from ..records import Record
 
 EPS = 1e-9
 
 
-@dataclass(frozen=True)
-class Row:
+class Row(Record, kw_only=False):
     a: float
     alpha: float
     d: float

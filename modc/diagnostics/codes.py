@@ -6,10 +6,10 @@ raised anywhere with ``CODE.at(span, **fields)``.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import Enum
 from typing import TYPE_CHECKING
 
+from ..records import Record
 from .span import Span
 
 if TYPE_CHECKING:
@@ -22,8 +22,7 @@ class Severity(str, Enum):
     NOTE = "note"
 
 
-@dataclass(frozen=True)
-class Code:
+class Code(Record, kw_only=False):
     name: str
     severity: Severity
     summary: str  # one line for docs and `modc codes`

@@ -1,14 +1,12 @@
 """The one Diagnostic type: fed to the terminal, `lint --format json`, reports and the LSP."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-
+from ..records import Record, as_fields
 from .codes import Severity
 from .span import Span
 
 
-@dataclass(frozen=True)
-class Diagnostic:
+class Diagnostic(Record, kw_only=False):
     code: str
     severity: Severity
     span: Span
@@ -20,7 +18,7 @@ class Diagnostic:
         return self.severity is Severity.ERROR
 
     def to_json(self) -> dict:
-        s = asdict(self.span)
+        s = as_fields(self.span)
         return {
             "code": self.code,
             "severity": self.severity.value,

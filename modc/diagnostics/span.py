@@ -1,11 +1,10 @@
 """Source positions. Every AST node and model element carries one."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from ..records import Record
 
 
-@dataclass(frozen=True, slots=True)
-class Span:
+class Span(Record, kw_only=False):
     """A region of one source file; lines and columns are 1-based, end is exclusive."""
 
     file: str

@@ -6,18 +6,16 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
 
 from .. import cache
 from ..model import ResolvedRobot
-from ..records import as_plain
+from ..records import Record, as_plain
 
 SAMPLES, REFINE, SEED = 512, 4, 0  # worst_case()'s search: samples of the joint box, refined, seed
 ALGORITHM = "2"  # bump when worst_case() could give another result for the same input
 
 
-@dataclass(frozen=True)
-class JointWorst:
+class JointWorst(Record, kw_only=False):
     name: str
     variant: str
     tau: float  # max |g_i(q)|, N·m

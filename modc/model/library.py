@@ -4,14 +4,13 @@ All lengths in metres, masses in kilograms, torques in N·m; fields ending in _d
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from .. import names
+from .. import names, records
 from ..records import Record
 from . import quantities as Q
 from .library_file import LIBRARY_KEYS, MAX_LIBRARY_BYTES, LibraryError, read_library, where  # noqa: F401 (re-exported)
@@ -299,7 +298,7 @@ def load(ref: str = "mark2", relative_to: Path | None = None) -> Library:
         return _load_path(str(path.resolve()), path.stat().st_mtime)
     except LibraryError as e:  # point at the file as the user named it, not at its resolved path
         if e.span is not None:
-            e.span = dataclasses.replace(e.span, file=str(path))
+            e.span = records.replace(e.span, file=str(path))
         raise
 
 

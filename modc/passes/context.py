@@ -2,15 +2,14 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 from ..diagnostics import REGISTRY, Diagnostic
 from ..model import Robot
+from ..records import Record, field
 
 
-@dataclass
-class Context:
+class Context(Record, kw_only=False, frozen=False):
     diagnostics: list[Diagnostic] = field(default_factory=list)
     library_override: str | None = None  # `--library` on the command line
     # Analyses that need the dynamics model run in compile and check, not in lint (kept fast).

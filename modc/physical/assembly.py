@@ -6,12 +6,11 @@ bolted to unit i's output). base_link carries unit 1's input side.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from ..kinematics import A_J, A_t1, A_t2, transform
 from ..model import ResolvedRobot, Transform
+from ..records import Record, field
 from .inertia import Inertial, combine_groups, local_inertial, sphere
 from .parts import Part, unit_mass, unit_parts
 
@@ -23,29 +22,25 @@ FRAME_RADIUS = 1e-3
 BASE_INERTIA_LINK = "base_link_inertia"  # see kdl_root
 
 
-@dataclass(frozen=True)
-class Visual:
+class Visual(Record, kw_only=False):
     part: Part
     T_link_part: np.ndarray
 
 
-@dataclass
-class Link:
+class Link(Record, kw_only=False, frozen=False):
     name: str
     visuals: list[Visual] = field(default_factory=list)
     inertial: Inertial | None = None
 
 
-@dataclass(frozen=True)
-class Limits:
+class Limits(Record, kw_only=False):
     lower: float
     upper: float
     effort: float
     velocity: float
 
 
-@dataclass(frozen=True)
-class Joint:
+class Joint(Record, kw_only=False):
     name: str
     kind: str  # "revolute" | "fixed"
     parent: str
@@ -55,8 +50,7 @@ class Joint:
     variant: str = ""
 
 
-@dataclass
-class Description:
+class Description(Record, kw_only=False, frozen=False):
     name: str
     links: list[Link]
     joints: list[Joint]
@@ -96,8 +90,7 @@ class Description:
         return sum(link.inertial.mass for link in self.links if link.inertial is not None and link.name != "tool0")
 
 
-@dataclass(frozen=True)
-class _Unit:
+class _Unit(Record, kw_only=False):
     """What one modular unit contributes, independent of where it sits in the arm."""
 
     output: tuple[tuple[Part, Inertial], ...]  # carried by the unit's own link, in its joint frame

@@ -7,11 +7,11 @@ only: an arm whose pairs the bounds settle (the farm arm's) needs no coal at all
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..records import Record
 from .multibody import enclosing_sphere
 
 if TYPE_CHECKING:
@@ -22,8 +22,7 @@ CHUNK = 4096  # samples per broad-phase batch (bounds memory for large sample co
 SPHERE_MARGIN = 1e-3  # m: bounding spheres closer than this count as touching (the filter errs towards testing meshes)
 
 
-@dataclass(frozen=True)
-class Joints:
+class Joints(Record, kw_only=False):
     """An arm's joints for numpy forward kinematics (every one revolute): per joint j (0: the
     universe) its parent, its frame at q = 0 in the parent's frame (R, t), its axis and q index."""
 

@@ -5,7 +5,8 @@ Pure numpy: the compiler imports it without PyBullet."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+from ..records import Record
 
 FOV = 35.0  # degrees, vertical
 FILL = 0.9  # the scene's box fits inside this share of the frame
@@ -15,8 +16,7 @@ def vec3(v) -> tuple[float, float, float]:
     return float(v[0]), float(v[1]), float(v[2])
 
 
-@dataclass
-class Camera:
+class Camera(Record, kw_only=False, frozen=False):
     eye: tuple[float, float, float]
     target: tuple[float, float, float]
     up: tuple[float, float, float]

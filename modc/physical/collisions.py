@@ -47,7 +47,6 @@ the filter's margin keeps near-contacts out of the broad phase's hands).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -55,6 +54,7 @@ from typing import Any
 import numpy as np
 
 from ..model.robot import default_position
+from ..records import Record, field
 from .assembly import Description
 from .broadphase import (
     ALWAYS_PERCENT,
@@ -79,15 +79,13 @@ REASONS = ("Adjacent", "Default", "Always", "Never")
 UNCHECKED_REASONS = ("Adjacent", "Default", "Always")
 
 
-@dataclass(frozen=True)
-class Pair:
+class Pair(Record, kw_only=False):
     link1: str
     link2: str
     reason: str  # one of REASONS
 
 
-@dataclass(frozen=True)
-class CollisionMatrix:
+class CollisionMatrix(Record, kw_only=False):
     links: tuple[str, ...]  # every URDF link, in URDF order
     geometry_links: tuple[str, ...]  # links with collision geometry, in URDF order
     disabled: tuple[Pair, ...]  # in URDF link order (link1 before link2)
@@ -115,8 +113,7 @@ class CollisionMatrix:
         return None
 
 
-@dataclass
-class Mesh:
+class Mesh(Record, kw_only=False, frozen=False):
     """One collision mesh: the joint carrying it, its placement in that joint's frame (R, t), the
     points whose hull holds it (its vertices, in its own frame) and its coal geometry, made on
     first use (a matrix whose pairs the bounding boxes settle needs no coal at all)."""
@@ -125,15 +122,14 @@ class Mesh:
     R: np.ndarray
     t: np.ndarray
     points: np.ndarray
-    make_shape: Callable[[], Any] = field(repr=False, compare=False)
+    make_shape: Callable[[], Any] = field(hidden=True, compare=False)
 
     @property
     def shape(self) -> Any:
         return self.make_shape()
 
 
-@dataclass
-class Geometry:
+class Geometry(Record, kw_only=False, frozen=False):
     """An arm's collision model: its link graph, its joints (numpy forward kinematics; None: other
     joint types, pinocchio's) and its collision meshes placed on the joints. compute() needs no
     more and imports no pinocchio; model and geom_model (pinocchio's Model and GeometryModel of
@@ -144,8 +140,8 @@ class Geometry:
     objects: dict[str, list[int]]  # link -> indices into meshes (and geom_model.geometryObjects)
     joints: Joints | None
     meshes: list[Mesh]  # in geom_model's order
-    pin_models: Callable[[], tuple[Any, Any]] = field(repr=False, compare=False)
-    _pin: tuple[Any, Any] | None = field(default=None, repr=False, compare=False)
+    pin_models: Callable[[], tuple[Any, Any]] = field(hidden=True, compare=False)
+    _pin: tuple[Any, Any] | None = field(default=None, hidden=True, compare=False)
 
     @property
     def geometry_links(self) -> tuple[str, ...]:

@@ -1,16 +1,15 @@
 """Rigid-body inertials of URDF links, combined from parts by the parallel-axis theorem."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
+from ..records import Record
 from .parts import Part
 
 
-@dataclass(frozen=True)
-class Inertial:
+class Inertial(Record, kw_only=False):
     mass: float
     com: np.ndarray  # (3,), link frame
     inertia: np.ndarray  # (3, 3) about com, link frame axes

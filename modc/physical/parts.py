@@ -10,11 +10,11 @@ Part frames:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..model.library import Library
+from ..records import Record
 
 Z_TO_Y = ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0))  # Rx(90°): a z-axis cylinder lying along y
 IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
@@ -31,8 +31,7 @@ MATERIALS = {
 
 
 
-@dataclass(frozen=True)
-class Primitive:
+class Primitive(Record, kw_only=False):
     shape: str  # "cylinder" (r, h) | "tube" (r_in, r_out, h) | "box" (x, y, z); cylinders along local z
     dims: tuple[float, ...]
     center: tuple[float, float, float]
@@ -65,8 +64,7 @@ class Primitive:
         return R @ np.diag(d) @ R.T
 
 
-@dataclass(frozen=True)
-class Part:
+class Part(Record, kw_only=False):
     mesh: str  # mesh file stem, shared by every unit using the same part
     frame: str  # "unit", "twist1" or "joint"
     mass: float
