@@ -109,8 +109,6 @@ def _check_writable(out: PathLike) -> None:
     """OUT's folder may be created and written (the tree is written beside OUT, then renamed):
     tried with an empty folder made and removed in the nearest folder that exists, so a search of
     minutes is not lost to a read-only disk, an immutable folder or a file on the way."""
-    import tempfile
-
     from . import names
     from .diagnostics import Span, codes
     from .diagnostics.errors import InputError
@@ -123,7 +121,11 @@ def _check_writable(out: PathLike) -> None:
         why = f"'{names.shown(parent.name, 60)}' on its way is not a directory"
         raise InputError(codes.OUTPUT_UNWRITABLE.at(Span.point(where), path=where, why=why))
     try:
-        os.rmdir(tempfile.mkdtemp(prefix=".modc-probe-", dir=parent))
+        probe = parent / f".modc-probe-{os.getpid()}-{id(parent):x}"  # (tempfile's import costs start-up)
+        os.mkdir(probe, 0o700)
+        os.rmdir(probe)
+    except FileExistsError:  # (another modc's probe, this instant): the folder is writable
+        pass
     except OSError as e:
         raise InputError(codes.OUTPUT_UNWRITABLE.at(Span.point(where), path=where,
                                                     why=e.strerror or type(e).__name__)) from None
