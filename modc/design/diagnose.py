@@ -66,6 +66,27 @@ def _probe(problem: ResolvedProblem, spec: Spec, t: int, seed: int, until: float
     return res
 
 
+def _alone(problem: ResolvedProblem, spec: Spec, i: int, seed: int, deadline: float | None, closest: float,
+           entry: dict) -> dict | None:
+    """Target i searched alone (PROBE_SECONDS at most): the probe's result, or None once entry
+    says it is reached alone, or reached only with the joints beyond their limits."""
+    until = time.time() + PROBE_SECONDS if deadline is None else min(deadline, time.time() + PROBE_SECONDS)
+    p = _probe(problem, spec, i, seed, until, free=False)
+    if p["clear"]:
+        entry["reached_alone"] = True
+        return None
+    c = min(closest, p["closest"])
+    if not p["hit"] and p["screened"]:
+        loose = _probe(problem, spec, i, seed, until + PROBE_SECONDS / 2, free=True)
+        if loose["hit"]:
+            entry.update(ruled_out_by="joint limits", closest_m=_finite(c),
+                         detail="reached only with the joints beyond their limits"
+                         + (f" (within the limits no design gets closer than {_length(c)})"
+                            if math.isfinite(c) else ""))
+            return None
+    return p
+
+
 def diagnose(problem: ResolvedProblem, spec: Spec, names, blocked, hit, clear, closest, seed: int,
              deadline: float | None, stopped: bool) -> dict[str, dict]:
     out: dict[str, dict] = {}
@@ -96,20 +117,10 @@ def diagnose(problem: ResolvedProblem, spec: Spec, names, blocked, hit, clear, c
                                 "searched alone")
             continue
         if not h:
-            until = time.time() + PROBE_SECONDS if deadline is None else min(deadline, time.time() + PROBE_SECONDS)
-            p = _probe(problem, spec, i, seed, until, free=False)
-            if p["clear"]:
-                entry["reached_alone"] = True
+            p = _alone(problem, spec, i, seed, deadline, c, entry)
+            if p is None:  # said: reached alone, or only beyond the joint limits
                 continue
             h, c = p["hit"], min(c, p["closest"])
-            if not h and p["screened"]:
-                loose = _probe(problem, spec, i, seed, until + PROBE_SECONDS / 2, free=True)
-                if loose["hit"]:
-                    entry.update(ruled_out_by="joint limits", closest_m=_finite(c),
-                                 detail="reached only with the joints beyond their limits"
-                                 + (f" (within the limits no design gets closer than {_length(c)})"
-                                    if math.isfinite(c) else ""))
-                    continue
         if h:
             entry.update(ruled_out_by="obstacles", detail="reached only in collision with the cell")
             continue

@@ -81,22 +81,23 @@ def reference_file(o: Outcome) -> str | None:
     return robot_file_text(robot, comments)
 
 
+def _entry(o: Outcome, rank: int, d: Design, said: str) -> dict:
+    return {
+        "rank": rank, "file": file_name(o.problem.name, rank), "design": o.problem.name, "chain": d.chain(),
+        "modules": d.modules, "mass_kg": round(d.mass, 6), "torque_margin": round(d.margin, 6),
+        "targets": d.verified.targets, **task_figures(o, rank, d),
+        "worst_error_share": round(worst_share(d.verified.targets, o.problem.cell), 6),
+        "why": said,  # in words: what decided this rank against the next (the last: the one before)
+        # every ranked objective's value (SI: kg, s, J; shares 0 to 1), in ranking order
+        "objectives": {k: round(float(REGISTRY[k].value(d) or 0.0), 9) for k in o.problem.rank},
+        "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
+                         for a in d.alternatives],
+    }
+
+
 def ranking(outcomes: list[Outcome]) -> dict:
-    designs = []
-    for o in outcomes:
-        reasons = why(o.designs, o.problem.rank)
-        for rank, (d, said) in enumerate(zip(o.designs, reasons, strict=True), start=1):
-            designs.append({
-                "rank": rank, "file": file_name(o.problem.name, rank), "design": o.problem.name, "chain": d.chain(),
-                "modules": d.modules, "mass_kg": round(d.mass, 6), "torque_margin": round(d.margin, 6),
-                "targets": d.verified.targets, **task_figures(o, rank, d),
-                "worst_error_share": round(worst_share(d.verified.targets, o.problem.cell), 6),
-                "why": said,  # in words: what decided this rank against the next (the last: the one before)
-                # every ranked objective's value (SI: kg, s, J; shares 0 to 1), in ranking order
-                "objectives": {k: round(float(REGISTRY[k].value(d) or 0.0), 9) for k in o.problem.rank},
-                "alternatives": [{"chain": a.chain(), "mass_kg": round(a.mass, 6), "torque_margin": round(a.margin, 6)}
-                                 for a in d.alternatives],
-            })
+    designs = [_entry(o, rank, d, said) for o in outcomes
+               for rank, (d, said) in enumerate(zip(o.designs, why(o.designs, o.problem.rank), strict=True), start=1)]
     prefix = len(outcomes) > 1
 
     def shapes(o: Outcome, labels: list[str]) -> list[str]:
