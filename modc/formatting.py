@@ -8,6 +8,7 @@
     fixed         a number exact to `digits` decimals, trailing zeros dropped: .mod source that
                   reads back to the value (model/write.py: degrees to 1e-9, millimetres to 1e-6)
     json_number   a number in the trajectory JSON: rounded to 1e-12, Python's shortest repr
+    counted       a count and its noun for a message: "1 joint", "3 joints", "1,024 settings"
 """
 from __future__ import annotations
 
@@ -47,3 +48,8 @@ def angle_text(rad: float) -> str:
 
 
 __all__ = ["angle", "angle_text", "degrees", "fixed", "json_number", "num", "vec"]
+
+
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """n with its noun, singular when n is 1 (plural: the noun's plural when not noun + 's')."""
+    return f"{n:,} {noun if n == 1 else plural or noun + 's'}"

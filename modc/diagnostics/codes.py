@@ -132,9 +132,9 @@ PARAMETER_NOT_APPLICABLE = _register("parameter-not-applicable", E, "`port` or `
 LINK_LENGTH_RANGE = _register("link-length-range", E, "a link length outside what the library can print",
     "link length {value} is outside {low}..{high}", "choose a length between {low} and {high}")
 TOO_MANY_UNITS = _register("too-many-units", E, "more units in a chain than the library can assemble",
-    "the chain has {n} units; the library allows at most {max}", "modules are limited by ε per variant: {limits}")
+    "the chain has {n}; the library allows at most {max}", "modules are limited by ε per variant: {limits}")
 TOO_FEW_UNITS = _register("too-few-units", E, "fewer units than the library's minimum",
-    "the chain has {n} units; at least {min} are needed", "add units to the chain")
+    "the chain has {n}; at least {min} are needed", "add units to the chain")
 
 # --- assembly rules (paper section 3) ----------------------------------------------------------
 FIRST_VARIANT = _register("first-variant", E, "link 1 must be of the base variant (paper rule 1: H)",
@@ -248,7 +248,7 @@ INVALID_NAME = _register("invalid-name", E, "a name that is not an identifier, o
 DUPLICATE_NAME = _register("duplicate-name", E, "two poses, targets or obstacles with one name",
     "'{name}' is already defined in {block}", "names of poses, targets and obstacles must be unique")
 POSE_ARITY = _register("pose-arity", E, "a pose with the wrong number of joint values",
-    "pose '{name}' has {got} values; robot '{robot}' has {dof} joints", "give one angle per joint, base first")
+    "pose '{name}' has {got}; robot '{robot}' has {dof}", "give one angle per joint, base first")
 POSE_OUT_OF_LIMITS = _register("pose-out-of-limits", E, "a pose outside the joint limits",
     "pose '{name}': joint_{joint} = {value} is outside its limits {low}..{high}", "change the pose or the joint limit")
 UNKNOWN_JOINT = _register("unknown-joint", E, "a joint name that does not exist",
