@@ -8,6 +8,7 @@
     fixed         a number exact to `digits` decimals, trailing zeros dropped: .mod source that
                   reads back to the value (model/write.py: degrees to 1e-9, millimetres to 1e-6)
     json_number   a number in the trajectory JSON: rounded to 1e-12, Python's shortest repr
+    counted       a count and its noun for a message: "1 joint", "3 joints", "1,024 settings"
 """
 from __future__ import annotations
 
@@ -46,9 +47,9 @@ def angle_text(rad: float) -> str:
     return f"{math.degrees(rad):.1f}°"
 
 
-def counted(n: int, thing: str, many: str | None = None) -> str:
-    """'1 design', '2 designs', '5,120 shapes': a count with its noun in the right number."""
-    return f"{n:,} {thing if n == 1 else many or thing + 's'}"
+__all__ = ["angle", "angle_text", "degrees", "fixed", "json_number", "num", "vec"]
 
 
-__all__ = ["angle", "angle_text", "counted", "degrees", "fixed", "json_number", "num", "vec"]
+def counted(n: int, noun: str, plural: str | None = None) -> str:
+    """n with its noun, singular when n is 1 (plural: the noun's plural when not noun + 's')."""
+    return f"{n:,} {noun if n == 1 else plural or noun + 's'}"

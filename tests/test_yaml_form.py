@@ -74,3 +74,19 @@ def test_yaml_errors_point_into_the_yaml():
     assert ("yaml-schema", 4) in got
     c = check_text("robots:\n  - name: a\n    chain: [H1, {unit: L4, port: 45}]\n", "a.yaml")
     assert [(d.code, d.span.line, d.span.col) for d in c.diagnostics] == [("missing-unit", 3, 34)]
+
+
+@pytest.mark.parametrize("text, line, key", [
+    # the flow form of the QA report: both values of `units` at one place, the second one flagged
+    ('designs: [{name: d, targets: {a: "(0.3, 0.1, 0.25) m"}, units: "2", units: "3"}]\n', 1, "units"),
+    ("robots:\n  - name: r\n    chain: [H1, L1]\nrobots: []\n", 4, "robots"),
+    ("robots:\n  - name: r\n    chain: [H1, L1]\n    poses:\n      up: \"(0, 0) deg\"\n"
+     "      up: \"(0, 10) deg\"\n", 6, "up"),
+])
+def test_a_key_given_twice_is_refused_at_the_second(text, line, key):
+    """PyYAML keeps the last of two equal keys silently; a repeated .mod statement is refused."""
+    c = check_text(text, "dup.yaml")
+    assert [d.code for d in c.diagnostics] == ["yaml-syntax"], c.diagnostics
+    d = c.diagnostics[0]
+    assert d.span.line == line and f"key '{key}' is given twice" in d.message
+    assert text.split("\n")[line - 1][d.span.col - 1:].startswith(key)

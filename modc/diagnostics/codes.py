@@ -98,7 +98,7 @@ UNKNOWN_PARAMETER = _register("unknown-parameter", E, "a parameter that does not
 DUPLICATE_PARAMETER = _register("duplicate-parameter", E, "the same parameter twice on one unit",
     "parameter '{name}' is given twice", "keep one of them")
 DUPLICATE_STATEMENT = _register("duplicate-statement", E, "a statement that may appear once, given twice",
-    "'{what}' is given twice in robot '{robot}'", "keep one of them")
+    "'{what}' is given twice in {block}", "keep one of them")
 MISSING_CHAIN = _register("missing-chain", E, "a robot block without a chain or DH table",
     "robot '{robot}' has no chain", "add e.g.: chain H1 - H4(pivot=-90deg) - L4, or a dh {{ row … }} table")
 CHAIN_AND_DH = _register("chain-and-dh", E, "a robot with both a chain and a DH table",
@@ -131,9 +131,9 @@ PARAMETER_NOT_APPLICABLE = _register("parameter-not-applicable", E, "`port` or `
 LINK_LENGTH_RANGE = _register("link-length-range", E, "a link length outside what the library can print",
     "link length {value} is outside {low}..{high}", "choose a length between {low} and {high}")
 TOO_MANY_UNITS = _register("too-many-units", E, "more units in a chain than the library can assemble",
-    "the chain has {n} units; the library allows at most {max}", "modules are limited by ε per variant: {limits}")
+    "the chain has {n}; the library allows at most {max}", "modules are limited by ε per variant: {limits}")
 TOO_FEW_UNITS = _register("too-few-units", E, "fewer units than the library's minimum",
-    "the chain has {n} units; at least {min} are needed", "add units to the chain")
+    "the chain has {n}; at least {min} are needed", "add units to the chain")
 
 # --- assembly rules (paper section 3) ----------------------------------------------------------
 FIRST_VARIANT = _register("first-variant", E, "link 1 must be of the base variant (paper rule 1: H)",
@@ -245,9 +245,9 @@ INVALID_NAME = _register("invalid-name", E, "a name that is not an identifier, o
     "{what} name '{name}' is not allowed: {problem}",
     "names are {rule}: they become XML, file and ROS names")
 DUPLICATE_NAME = _register("duplicate-name", E, "two poses, targets or obstacles with one name",
-    "'{name}' is already defined in robot '{robot}'", "names of poses, targets and obstacles must be unique")
+    "'{name}' is already defined in {block}", "names of poses, targets and obstacles must be unique")
 POSE_ARITY = _register("pose-arity", E, "a pose with the wrong number of joint values",
-    "pose '{name}' has {got} values; robot '{robot}' has {dof} joints", "give one angle per joint, base first")
+    "pose '{name}' has {got}; robot '{robot}' has {dof}", "give one angle per joint, base first")
 POSE_OUT_OF_LIMITS = _register("pose-out-of-limits", E, "a pose outside the joint limits",
     "pose '{name}': joint_{joint} = {value} is outside its limits {low}..{high}", "change the pose or the joint limit")
 UNKNOWN_JOINT = _register("unknown-joint", E, "a joint name that does not exist",
@@ -287,6 +287,9 @@ DESIGN_BOUND = _register("design-bound", E, "a search bound of a design block th
     "{what}", "{hint}")
 UNKNOWN_OBJECTIVE = _register("unknown-objective", E, "`rank` naming an objective modc does not know",
     "unknown objective '{name}'", "objectives are {known}, written in order of importance")
+DUPLICATE_OBJECTIVE = _register("duplicate-objective", E, "`rank` naming one objective twice",
+    "objective '{name}' is ranked twice in {block}",
+    "name each objective once, in order of importance (the first place counts)")
 DESIGN_UNSUPPORTED = _register("design-unsupported", W,
     "a design-block statement the language has but `modc design` does not search yet (it refuses the block)",
     "{what} is parsed but not searched yet by modc design",

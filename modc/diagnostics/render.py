@@ -20,6 +20,18 @@ def display_width(text: str) -> int:
     return sum(0 if unicodedata.combining(c) else 2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
 
 
+# Characters never echoed as they are: controls (ESC and BEL retitle or recolour a terminal),
+# format characters (bidi overrides reorder what is shown), surrogates, private use, unassigned
+# and U+2028/U+2029; the same set names refuse (modc.names).
+_UNSHOWN = {"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"}
+
+
+def shown_char(c: str) -> str:
+    """One source character as an excerpt shows it: itself, or its escape as a message quotes it
+    (repr: '\\x1b', '\\u202e'); the caret spans the whole escape."""
+    return repr(c)[1:-1] if unicodedata.category(c) in _UNSHOWN else c
+
+
 def excerpt(source: str, d: Diagnostic) -> list[str]:
     """The offending source line and a caret line under the span (clipped to that line)."""
     lines = source.split("\n")  # as the parser counts lines: \f, \v or U+2028 do not end one
@@ -33,10 +45,11 @@ def excerpt(source: str, d: Diagnostic) -> list[str]:
         col = d.span.col
     end = d.span.end_col if d.span.end_line == d.span.line else len(text) + 1
     end = min(end, len(text) + 1)
-    lead = display_width(text[: col - 1])
-    width = max(1, display_width(text[col - 1 : end - 1]))
+    pieces = [shown_char(c) for c in text]
+    lead = display_width("".join(pieces[: col - 1]))
+    width = max(1, display_width("".join(pieces[col - 1 : end - 1])))
     gutter = f"{d.span.line:>4} | "
-    return [gutter + text, " " * (len(gutter) - 2) + "| " + " " * lead + "^" * width]
+    return [gutter + "".join(pieces), " " * (len(gutter) - 2) + "| " + " " * lead + "^" * width]
 
 
 def format_text(d: Diagnostic, sources: Mapping[str, str] | None = None) -> str:

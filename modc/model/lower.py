@@ -173,7 +173,7 @@ class _Lowerer:
             kind = st.keyword
         if kind in ONCE:
             if kind in seen:
-                self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, robot=block))
+                self.error(codes.DUPLICATE_STATEMENT.at(st.span, what=kind, block=block))
                 return
             seen[kind] = st
         if kind is not None:
@@ -270,8 +270,8 @@ class _Lowerer:
         seen: dict[str, Any] = {}
         acc = self._acc(source_dir)
         for st in r.body:
-            self.cell_statement(st, rname, fields, seen, acc)
-        self._tasks(acc, rname)
+            self.cell_statement(st, f"robot '{rname}'", fields, seen, acc)
+        self._tasks(acc, f"robot '{rname}'")
         for st in acc["base_within"]:
             self.error(codes.BASE_WITHIN_ROBOT.at(st.span, robot=rname))
         if "chain" in seen and "dh" in seen:
@@ -288,6 +288,7 @@ class _Lowerer:
         from .problem_bounds import lower_bounds
 
         named = self.name(d.name, "design")
+        block = f"design '{_say(d.name)}'"  # as duplicate messages name the block
         fields: dict = {}
         seen: dict[str, object] = {}
         acc = self._acc(source_dir)
@@ -299,13 +300,13 @@ class _Lowerer:
             elif isinstance(st, ast.Compare):
                 compare.append(st)
             else:
-                self.cell_statement(st, _say(d.name), fields, seen, acc)
+                self.cell_statement(st, block, fields, seen, acc)
         if not acc["targets"] and not any(isinstance(st, ast.Target | ast.Region) for st in d.body):
             self.error(codes.DESIGN_NO_TARGETS.at(d.name.span, name=_say(d.name)))
-        bounds = lower_bounds(self, search, _say(d.name))
-        self._tasks(acc, _say(d.name))
+        bounds = lower_bounds(self, search, block)
+        self._tasks(acc, block)
         if len(acc["base_within"]) > 1:
-            self.error(codes.DUPLICATE_STATEMENT.at(acc["base_within"][1].span, what="base within", robot=_say(d.name)))
+            self.error(codes.DUPLICATE_STATEMENT.at(acc["base_within"][1].span, what="base within", block=block))
         elif acc["base_within"]:
             from .lower_task import base_grid
 
@@ -313,7 +314,7 @@ class _Lowerer:
         if not (named and acc["named"]):
             return None
         cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)
-        reference = self._reference(compare, cell, _say(d.name))
+        reference = self._reference(compare, cell, block)
         if reference is False:
             return None
         bounds["reference"] = reference
@@ -323,7 +324,7 @@ class _Lowerer:
         """`compare with chain …`: the cell with that chain (its checks are the robot chain's,
         once the library is known: modc.passes.check_problems); False when a unit name is invalid."""
         for st in compare[1:]:
-            self.error(codes.DUPLICATE_STATEMENT.at(st.span, what="compare with", robot=block))
+            self.error(codes.DUPLICATE_STATEMENT.at(st.span, what="compare with", block=block))
         if not compare:
             return None
         units = [self.unit(u) for u in compare[0].chain.units]

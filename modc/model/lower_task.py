@@ -179,13 +179,13 @@ def tasks(low, statements: list, targets, regions, block: str,
     seen = {t.name for t in targets}
     for r in regions:
         if r.name in seen:
-            low.error(codes.DUPLICATE_NAME.at(r.span, name=r.name, robot=block))
+            low.error(codes.DUPLICATE_NAME.at(r.span, name=r.name, block=block))
         seen.add(r.name)
     out_tasks: list[Task] = []
     out_paths: list[StraightPath] = []
     for st in statements:
         if st.name.text in seen:
-            low.error(codes.DUPLICATE_NAME.at(st.span, name=st.name.text, robot=block))
+            low.error(codes.DUPLICATE_NAME.at(st.span, name=st.name.text, block=block))
             continue
         seen.add(st.name.text)
         if isinstance(st, ast.Task):

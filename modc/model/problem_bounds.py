@@ -72,7 +72,7 @@ def lower_bounds(low, statements: list, block: str) -> dict:
     for st in statements:
         if type(st) in seen:
             what = type(st).__name__.lower()
-            low.error(codes.DUPLICATE_STATEMENT.at(st.span, what=what, robot=block))
+            low.error(codes.DUPLICATE_STATEMENT.at(st.span, what=what, block=block))
             continue
         seen.add(type(st))
         match st:
@@ -89,7 +89,9 @@ def lower_bounds(low, statements: list, block: str) -> dict:
                     if k.text not in REGISTRY:
                         known = ", ".join(REGISTRY)
                         low.error(codes.UNKNOWN_OBJECTIVE.at(k.span, name=k.text, known=known))
-                    elif k.text not in keys:
+                    elif k.text in keys:  # an order is ambiguous with one objective in two places
+                        low.error(codes.DUPLICATE_OBJECTIVE.at(k.span, name=k.text, block=block))
+                    else:
                         keys.append(k.text)
                 # objectives not named keep their default order after the named ones
                 out["rank"] = tuple(keys) + tuple(k for k, o in REGISTRY.items() if o.default and k not in keys)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import difflib
 
 from ..diagnostics import codes
+from ..formatting import counted
 from ..model import Design, ResolvedRobot
 from .context import Context
 
@@ -46,7 +47,8 @@ def run(design: Design, ctx: Context) -> Design:
         n, rules = len(r.units), lib.rules
         if n > rules.max_dof:
             limits = ", ".join(f"{v}: {lib.variants[v].actuator.epsilon}" for v in lib.variants)
-            ctx.report(codes.TOO_MANY_UNITS.at(r.units[rules.max_dof].span, n=n, max=rules.max_dof, limits=limits), r)
+            ctx.report(codes.TOO_MANY_UNITS.at(r.units[rules.max_dof].span, n=counted(n, "unit"), max=rules.max_dof,
+                                               limits=limits), r)
         elif 0 < n < rules.min_dof:
-            ctx.report(codes.TOO_FEW_UNITS.at(r.name_span, n=n, min=rules.min_dof), r)
+            ctx.report(codes.TOO_FEW_UNITS.at(r.name_span, n=counted(n, "unit"), min=rules.min_dof), r)
     return design

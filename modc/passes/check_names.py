@@ -17,6 +17,6 @@ def run(design: Design, ctx: Context) -> Design:
         items: list[Pose | Target | Obstacle] = [*r.poses, *r.targets, *r.obstacles]
         for item in sorted(items, key=lambda x: (x.span.line, x.span.col)):
             if item.name in names:
-                ctx.report(codes.DUPLICATE_NAME.at(item.span, name=item.name, robot=r.name))
+                ctx.report(codes.DUPLICATE_NAME.at(item.span, name=item.name, block=f"robot '{r.name}'"))
             names.add(item.name)
     return design

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ..diagnostics import codes
-from ..formatting import angle
+from ..formatting import angle, counted
 from ..model import Design, ResolvedRobot
 from .context import Context
 
@@ -30,7 +30,8 @@ def run(design: Design, ctx: Context) -> Design:
                 ctx.report(codes.LIMIT_EXCEEDS_HARDWARE.at(lim.span, **bounds), r)
         for pose in r.poses:
             if len(pose.q) != r.dof:
-                ctx.report(codes.POSE_ARITY.at(pose.span, name=pose.name, got=len(pose.q), robot=r.name, dof=r.dof), r)
+                ctx.report(codes.POSE_ARITY.at(pose.span, name=pose.name, got=counted(len(pose.q), "value"),
+                                                   robot=r.name, dof=counted(r.dof, "joint")), r)
                 continue
             for i, q in enumerate(pose.q, start=1):
                 lo, hi = r.joint_range(i)

@@ -21,7 +21,7 @@ def _check(p: Problem, library, ctx: Context) -> None:
     declared = [(t.name, t.span) for t in p.cell.targets] + [(o.name, o.span) for o in p.cell.obstacles]
     for name, span in sorted(declared, key=lambda x: (x[1].line, x[1].col)):
         if name in names:
-            ctx.report(codes.DUPLICATE_NAME.at(span, name=name, robot=p.name))
+            ctx.report(codes.DUPLICATE_NAME.at(span, name=name, block=f"design '{p.name}'"))
         names.add(name)
     for o in p.cell.obstacles:
         if any(v <= 0 for v in o.size):

@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 from ..diagnostics import codes
+from ..formatting import counted
 from ..model import Design, ResolvedRobot
 from .context import Context
 
@@ -21,7 +22,8 @@ def run(design: Design, ctx: Context) -> Design:
         max_dof = lib.rules.max_dof
         if len(r.dh) > max_dof:  # converting (and rounding) thousands of rows would only bury this
             limits = ", ".join(f"{v}: {lib.variants[v].actuator.epsilon}" for v in lib.variants)
-            ctx.report(codes.TOO_MANY_UNITS.at(r.dh[max_dof].span, n=len(r.dh), max=max_dof, limits=limits), r)
+            ctx.report(codes.TOO_MANY_UNITS.at(r.dh[max_dof].span, n=counted(len(r.dh), "unit"), max=max_dof,
+                                               limits=limits), r)
             robots.append(r)
             continue
 

@@ -13,14 +13,16 @@ def _span(file: str, node) -> Span:
 
 
 class _Unsupported(Exception):
-    def __init__(self, node, detail: str):
+    def __init__(self, node, detail: str, code=codes.YAML_SCHEMA):
         super().__init__(detail)
-        self.node, self.detail = node, detail
+        self.node, self.detail, self.code = node, detail, code
 
 
 def _plain(node, path: tuple, spans: dict, file: str, seen: set | None = None):
     """YAML node -> Python data, recording each value's span by its path. Anchors/aliases are
-    refused (a recursive alias never ends, nested ones grow exponentially), as are non-scalar keys."""
+    refused (a recursive alias never ends, nested ones grow exponentially), as are non-scalar keys
+    and a key given twice in one mapping (YAML forbids it; PyYAML would keep the last silently, as
+    a repeated .mod statement is refused)."""
     import yaml
 
     seen = set() if seen is None else seen
@@ -35,6 +37,12 @@ def _plain(node, path: tuple, spans: dict, file: str, seen: set | None = None):
             if not isinstance(k, yaml.ScalarNode):
                 raise _Unsupported(k, "mapping keys must be plain names")
             key = k.value
+            if key in out:
+                from ..names import shown
+
+                first = spans[path + (key, "__key__")].line
+                raise _Unsupported(k, f"key '{shown(key)}' is given twice in one mapping (first on line {first})",
+                                   codes.YAML_SYNTAX)
             spans[path + (key, "__key__")] = _span(file, k)
             out[key] = _plain(v, path + (key,), spans, file, seen)
         return out
@@ -396,7 +404,7 @@ def parse_yaml(text: str, file: str) -> tuple[ast.File, list[Diagnostic]]:
     try:
         data = _plain(node, (), spans, file)
     except _Unsupported as e:
-        diags.append(codes.YAML_SCHEMA.at(_span(file, e.node), detail=e.detail))
+        diags.append(e.code.at(_span(file, e.node), detail=e.detail))
         return ast.File(file, ()), diags
     try:
         doc = Document.model_validate(data)
