@@ -8,7 +8,7 @@ import ast
 from conftest import ROOT
 
 WRITERS = {
-    "modc/design/write.py": ("ranking", "task_figures", "base_figures"),
+    "modc/design/write.py": ("ranking", "_entry", "task_figures", "base_figures"),
     "modc/design/reference.py": ("to_json", "reference"),
     "modc/plan/task.py": ("to_json",),
 }
