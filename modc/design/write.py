@@ -54,7 +54,7 @@ def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
     robot = d.verified.robot.model_copy(update={"name": name})
     # (region points are screened with poses of their own, which the robot file does not keep)
     targets = ", ".join(f"{pose_name(t)} reaches {t}" for t in d.verified.targets if robot.pose(pose_name(t)))
-    comments = [f"Design {rank} of `modc design` for '{outcome.problem.name}': {d.modules} modules, "
+    comments = [f"Design {rank} of `modc design` for '{outcome.problem.name}': {counted(d.modules, 'module')}, "
                 f"{d.mass:.3f} kg, torque margin {d.margin * 100:.0f} %.", f"Poses: {targets}."]
     if outcome.problem.base_grid is not None:  # the cell was given in the frame of the base's box
         comments.append("The base pose was searched (`base within`): the cell below is in base_link, "
@@ -77,7 +77,7 @@ def reference_file(o: Outcome) -> str | None:
     robot = robot.model_copy(update={"name": ref_name(o.problem.name)[:-len(".mod")]})
     verdict = "it passes every check the designs passed" if r.feasible else "it fails: " + "; ".join(r.fails)
     comments = [f"The reference arm of `modc design` for '{o.problem.name}' (`compare with chain {r.chain}`): "
-                f"{r.modules} modules, {r.mass:.3f} kg; {verdict}."]
+                f"{counted(r.modules, 'module')}, {r.mass:.3f} kg; {verdict}."]
     return robot_file_text(robot, comments)
 
 
@@ -156,5 +156,5 @@ def summary_line(o: Outcome) -> str:
     timed = f", cycle time {best.cycle_time:.3f} s, {best.energy:.2f} J" if best.plans else ""
     return (f"{o.problem.name}: {counted(len(o.designs), 'design')} from {o.evaluated:,} evaluated in "
             f"{o.seconds:.1f} s; "
-            f"best {best.chain()} ({best.modules} modules, {best.mass:.3f} kg, "
+            f"best {best.chain()} ({counted(best.modules, 'module')}, {best.mass:.3f} kg, "
             f"margin {math.floor(best.margin * 100)} %{timed})")
