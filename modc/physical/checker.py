@@ -104,20 +104,7 @@ class CollisionChecker:
             go = pin.GeometryObject(f"obstacle:{o.name}", 0, 0, M, g)
             obstacle_ids[o.name] = gm.addGeometryObject(go)
             self.owner.append(o.name)
-
-        objects = geo.objects
-        disabled = self.matrix.unchecked()  # the one rule: the SRDF's, modc sim's
-        glinks = geo.geometry_links
-        self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]
-                           if frozenset((a, b)) not in disabled]
-        moving = [name for name in glinks if name != "base_link"]
-        pairs: list[tuple[int, int]] = []
-        for a, b in self.self_pairs:
-            pairs += [(i, j) for i in objects[a] for j in objects[b]]
-        for link in moving:
-            for name in sorted(obstacle_ids, key=lambda n: list(self.obstacles).index(n)):
-                pairs += [(i, obstacle_ids[name]) for i in objects[link]]
-        static = [(i, obstacle_ids[name]) for name in obstacle_ids for i in objects.get("base_link", [])]
+        pairs, static = self._pairs(geo, obstacle_ids)
 
         self.gm = gm
         self.pairs = pairs
@@ -140,6 +127,25 @@ class CollisionChecker:
             req.num_max_contacts = 100000
         self.radii = self.reach_radii()
         self.checks = 0  # validity checks done (a deterministic measure of work)
+
+    def _pairs(self, geo, obstacle_ids: dict[str, int]) -> tuple[list[tuple[int, int]], list[tuple[int, int]]]:
+        """The geometry pairs to test while the arm moves (links the matrix checks, each moving
+        link with each obstacle) and the static ones (base_link with each obstacle); sets
+        self_pairs, the link pairs the matrix checks."""
+        objects = geo.objects
+        disabled = self.matrix.unchecked()  # the one rule: the SRDF's, modc sim's
+        glinks = geo.geometry_links
+        self.self_pairs = [(a, b) for i, a in enumerate(glinks) for b in glinks[i + 1:]
+                           if frozenset((a, b)) not in disabled]
+        moving = [name for name in glinks if name != "base_link"]
+        pairs: list[tuple[int, int]] = []
+        for a, b in self.self_pairs:
+            pairs += [(i, j) for i in objects[a] for j in objects[b]]
+        for link in moving:
+            for name in sorted(obstacle_ids, key=lambda n: list(self.obstacles).index(n)):
+                pairs += [(i, obstacle_ids[name]) for i in objects[link]]
+        static = [(i, obstacle_ids[name]) for name in obstacle_ids for i in objects.get("base_link", [])]
+        return pairs, static
 
     # -- configuration --------------------------------------------------------------------------
     def set_margin(self, margin: float) -> None:

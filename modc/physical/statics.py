@@ -110,10 +110,6 @@ class Statics:
         lower = -np.einsum("nid,nkd->nik", z, _cross(z, r) @ self._g_cross)  # z_i.((z_k x r_k) x g)
         return tau, self._k_carries_i * upper + self._i_carries_k * lower
 
-    def gravity_jacobians(self, Q) -> np.ndarray:
-        """(N, n, n) dg/dq of the poses Q."""
-        return self.gravity_with_jacobians(Q)[1]
-
     def torques(self, q) -> np.ndarray:
         return self.gravities(q)[0]
 
