@@ -7,16 +7,13 @@ time grid); between points the motion is linear in joint space, as `play` interp
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from .model import Dynamics
 from .torque import JointWorst
 
 
-@dataclass(frozen=True)
-class JointPeak(JointWorst):
+class JointPeak(JointWorst, kw_only=False):
     t: float = 0.0  # s: when the peak happens
 
     def to_json(self) -> dict:
