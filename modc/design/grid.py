@@ -225,12 +225,13 @@ def _mass_groups(problem: ResolvedProblem, shapes: list[space.Shape], splits) ->
 
 
 def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int | None, top: int, seed: int,
-           executor: Executor | None, deadline: float | None, enough: int | None = None):
+           executor: Executor | None, deadline: float | None, enough: int | None = None,
+           progress: Callable[..., None] | None = None):
     """The static search over the base poses (subs: the cell at each pose, nearest first):
     designs ranked by the problem's static objectives, at most `top`, each at its pose. By number
     of units, lightest shapes first, stopping as run._search does once `enough` designs rank
-    ahead of every shape not searched."""
-    from .run import Outcome, _edge, _mass, _stopping
+    ahead of every shape not searched. progress(run.Status) after each group of shapes."""
+    from .run import Outcome, Status, _edge, _mass, _stopping
 
     out = Outcome(problem, [])
     specs = [Spec.of(s) for s in subs]
@@ -242,6 +243,19 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
     closest = np.full(len(names), np.inf)
     results: list[ShapeResult] = []
     want = enough or top
+    every = [s.label() for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
+             if space.variant_splits(problem, n) for s in space.shapes(problem, n)]
+
+    def report(force: bool = False, final: bool = False) -> None:
+        if progress is not None:
+            best = distinct(tally.accepted, problem.rank)[0].chain() if tally.accepted else ""
+            st = Status(len(results), len(every), out.evaluated, out.screened, best, 0.0 if final else None)
+            if force:
+                progress(st, True)
+            else:
+                progress(st)
+
+    report(force=True)
     for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
         splits = space.variant_splits(problem, n)
         if not splits:
@@ -260,6 +274,7 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
             out.stopped = _stopping(deadline) or (None if all(r.finished for r in res) else "time budget")
             nxt = _edge(problem, groups[g + 1][0]) if g + 1 < len(groups) and not out.stopped else float("inf")
             tally.settle(n, nxt)
+            report()
             if out.stopped or (early and tally.done(n, nxt, want)):
                 break
         if out.stopped:
@@ -269,9 +284,12 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
             if tally.distinct_count() >= want:
                 break
     tally.settle(hi, float("inf"))
-    out.unfinished = [r.shape.label() for r in results if not r.finished]
+    done = {r.shape.label() for r in results if r.finished}
+    out.unfinished = [x for x in every if x not in done] if out.stopped else \
+        [r.shape.label() for r in results if not r.finished]
     out.coarse = [r.shape.label() for r in results if r.finished and not r.complete]
     out.complete = not out.unfinished and not out.coarse
     out.closest = {t: (0.0 if any(r.hit[k] for r in results) else float(closest[k])) for k, t in enumerate(names)}
     out.designs = distinct(tally.accepted, problem.rank)[:top]
+    report(force=True, final=True)
     return out

@@ -2,32 +2,25 @@
 
 The design's obstacles, targets and regions are given in the cell frame of the box. For each base
 pose of the grid the cell is written in that base's frame (base_link, the frame every robot file
-gives its environment in) with `base at` the pose, and the static search runs on it unchanged;
-the designs of all poses are merged into one ranking where a design is a (base pose, chain)
-pair, one entry per chain: its best pose (ties: the pose searched first). Each design's robot
-states its `base at …` and holds the same cell around it, so it compiles, plans and views in the
-same world as every other design.
+gives its environment in) with `base at` the pose; each design's robot states its `base at …` and
+holds the same cell around it, so it compiles, plans and views in the same world as every other.
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
 bounds is skipped (sound: no chain could reach it from there), so is one where base_link sinks
-into the cell whatever the first unit (sound: the exact check would reject every design). The
-answer is the best over the grid under the ranking's static objectives, not the first fit:
-with fewest modules ranked first, one number of units at a time is searched over every kept pose
-(closest cell first), each pose only for shapes that could rank before the `top`-th design found
-so far (search()). ranking.json "bases" says how many poses were searched and skipped. The
-ranking keeps one entry per chain (its best pose), so it may hold fewer than `top` designs.
+into the cell whatever the first unit (sound: the exact check would reject every design).
+The poses kept are searched together (modc.design.grid): a shape's candidates are (twist
+setting, pose) pairs, ranked within the shape as one pose's settings are, then nearest pose
+first, and the shape gives one design over the grid, at its setting's best pose. The answer is
+the best design over the grid under the ranking's static objectives, not the first fit.
+ranking.json "bases" says how many poses were searched and skipped.
 
-Only the designs the merged ranking keeps get their H/L swaps checked (their alternatives, at
-their own pose, by the same Verifier.swaps a pose's own search runs): alternatives never change a
-design's rank, so checking them for designs a later pose beats only cost exact checks.
+Only the designs kept get their H/L swaps checked (their alternatives, at their own pose, by the
+same Verifier.swaps a pose's own search runs).
 
-Where the time goes (benchmarks/bench_task_base.py): the static search at every pose in reach,
-mostly the IK of the settings the bounds keep. With the default ranking (modules, mass, margin)
-designs of equal modules and mass are told apart by torque margin, which only the exact check
-measures, so each pose in reach is searched for every shape as light as the designs found (the
-ceiling prunes nothing where those shapes weigh the same). A sound margin bound skipping a
-(shape, pose) would have to hold over every setting the bounds keep there: one shape's settings
-span 0.91-0.97 of margin, the poses' designs 0.948-0.960, so it would skip nothing.
+Where the time goes (benchmarks/bench_task_base.py): the IK of the settings the bounds keep at
+every pose in reach. A shape that works somewhere closes, at every pose, once its kept settings
+are all dead on (dominance over the grid: usually after two nonzero twists); a shape that works
+nowhere is screened at every pose in reach, each setting the family and per-setting bounds leave.
 """
 from __future__ import annotations
 

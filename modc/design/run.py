@@ -213,7 +213,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
                        diagnosing=diagnosing)
 
     def many(p: ResolvedProblem, cells: list[ResolvedProblem], units: int | None, k: int) -> Outcome:
-        return grid.search(p, cells, units, k, seed, executor, deadline, enough=enough[0])
+        return grid.search(p, cells, units, k, seed, executor, deadline, enough=enough[0], progress=progress)
 
     rejected: dict[str, str] = {}  # chain -> why its tasks could not be planned (planned once only)
     while True:
