@@ -82,3 +82,13 @@ def test_two_poses_that_tie_give_the_first_in_the_grids_order_on_every_engine():
         share.append(next(round(f.worst, 2) for f in search.search_shape(Spec.of(sub), c.shape, 3).found
                           if (f.pivots, f.ports) == (c.pivots, c.ports)))
     assert share[0] == share[1]
+
+
+def test_a_spent_budget_stops_the_grid_search_with_what_it_left():
+    import time
+
+    from modc.design import run
+
+    o = run.design(_problem(MIRRORED), top=1, deadline=time.time() - 1)
+    assert o.stopped == "time budget" and not o.complete and o.unfinished
+    assert not o.designs

@@ -135,8 +135,12 @@ class _Shape:
 
 
 def _next(s: _Shape) -> int:
-    """The last level of shape s's next round: one level at a time, levels 0 and 1 together
-    (a setting and a few dozen)."""
+    """The last level of shape s's next round: levels 0 and 1 together (a setting and a few
+    dozen), then one level at a time; past level 2 with nothing found anywhere, every level left
+    (the dominance bound needs KEEP settings found: one more level would rarely close the shape,
+    and one round is a batch per pose rather than several)."""
+    if s.level >= 2 and not s.found:
+        return max(len(lv.counts) for lv in s.live.values()) - 1
     return max(s.level + 1, 1)
 
 
