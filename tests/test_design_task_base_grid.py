@@ -92,3 +92,22 @@ def test_a_spent_budget_stops_the_grid_search_with_what_it_left():
     o = run.design(_problem(MIRRORED), top=1, deadline=time.time() - 1)
     assert o.stopped == "time budget" and not o.complete and o.unfinished
     assert not o.designs
+
+
+def test_a_target_walled_off_at_every_pose_needs_no_ik(monkeypatch):
+    """A target deep inside an obstacle (bounds.blocked) rules a pose out before any IK, as it
+    rules out one pose's search."""
+    from modc.design import grid, run
+
+    p = _problem(SHIFTED.replace("    units 2\n", "    box block size (0.1, 0.1, 0.1) m at (0.3, 0, 0.35) m\n    units 2\n"))
+    calls = []
+    real = grid.search_chunk
+
+    def counted(*a):
+        calls.append(a)
+        return real(*a)
+
+    monkeypatch.setattr(grid, "search_chunk", counted)
+    o = run.design(p, top=1)
+    assert not o.designs and o.bases_searched == 3 and not calls
+    assert "block" in o.why_none()

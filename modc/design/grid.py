@@ -37,6 +37,7 @@ import numpy as np
 from ..kinematics import transform
 from ..model import ResolvedProblem
 from . import dominance, prefix, space
+from .bounds import blocked as bounds_blocked
 from .evaluate import Spec
 from .rank import distinct
 from .screen import reach_bound
@@ -169,9 +170,22 @@ def _run(specs: list[Spec], work: list[tuple[int, tuple]], seed: int, deadline: 
     return [(i, p) for i, f in futures for p in f.result()]
 
 
+def walled(spec: Spec, longest: float) -> bool:
+    """Is some target at this pose out of every arm's service because of an obstacle
+    (bounds.blocked, as run._search tests one pose)?"""
+    lib = spec.problem.cell.library
+    tg = spec.targets
+    starts = np.array([(u.x01, 0.0, u.z01) for u in lib.units.values()], float)
+    out, _ = bounds_blocked(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(spec.problem.cell.tool.xyz)),
+                            float(spec.radii.min()), longest, starts)
+    return bool(out.any())
+
+
 def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadline: float | None,
-                  executor: Executor | None, stopping: Callable[[], str | None]) -> list[ShapeResult]:
-    """The shapes searched over every pose, a level at a time (see the module's docstring)."""
+                  executor: Executor | None, stopping: Callable[[], str | None],
+                  skip: frozenset[int] = frozenset()) -> list[ShapeResult]:
+    """The shapes searched over every pose but those in skip, a level at a time (see the
+    module's docstring)."""
     lib = specs[0].problem.cell.library
     open_: list[_Shape] = []
     for shape in shapes:
@@ -180,7 +194,7 @@ def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadl
         live, excluded, options = {}, 0, None
         for i, spec in enumerate(specs):
             tg = spec.targets
-            if np.any(np.linalg.norm(tg.xyz, axis=1) - r - tg.tol_p > 0):  # beyond reach from here
+            if i in skip or np.any(np.linalg.norm(tg.xyz, axis=1) - r - tg.tol_p > 0):  # walled off, beyond reach
                 excluded += full_axes(spec, shape).count
                 continue
             options = options or _options(spec, shape)
@@ -235,7 +249,7 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
     designs ranked by the problem's static objectives, at most `top`, each at its pose. By number
     of units, lightest shapes first, stopping as run._search does once `enough` designs rank
     ahead of every shape not searched. progress(run.Status) after each group of shapes."""
-    from .run import Outcome, Status, _edge, _mass, _stopping
+    from .run import Outcome, Status, _edge, _mass, _stopping, longest_reach
 
     out = Outcome(problem, [])
     specs = [Spec.of(s) for s in subs]
@@ -247,6 +261,7 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
     closest = np.full(len(names), np.inf)
     results: list[ShapeResult] = []
     want = enough or top
+    skip = frozenset(i for i, spec in enumerate(specs) if walled(spec, longest_reach(problem, hi)))
     every = [s.label() for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
              if space.variant_splits(problem, n) for s in space.shapes(problem, n)]
 
@@ -266,7 +281,7 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
             continue
         groups = _mass_groups(problem, space.shapes(problem, n), splits)
         for g, (_, shapes) in enumerate(groups):
-            res = search_shapes(specs, shapes, seed, deadline, executor, lambda: _stopping(deadline))
+            res = search_shapes(specs, shapes, seed, deadline, executor, lambda: _stopping(deadline), skip)
             for r in res:
                 results.append(r)
                 out.shapes += 1
