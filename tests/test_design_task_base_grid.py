@@ -99,7 +99,8 @@ def test_a_target_walled_off_at_every_pose_needs_no_ik(monkeypatch):
     rules out one pose's search."""
     from modc.design import grid, run
 
-    p = _problem(SHIFTED.replace("    units 2\n", "    box block size (0.1, 0.1, 0.1) m at (0.3, 0, 0.35) m\n    units 2\n"))
+    block = "    box block size (0.1, 0.1, 0.1) m at (0.3, 0, 0.35) m\n"
+    p = _problem(SHIFTED.replace("    units 2\n", block + "    units 2\n"))
     calls = []
     real = grid.search_chunk
 
