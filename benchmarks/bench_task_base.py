@@ -10,25 +10,31 @@ this process pinned to one core (BLAS pools at one thread; one pose: the median 
 and their ratio (goal: at most 5).
 bench_base() is the function bench_design.py calls.
 
-Figures (CPU s, one core of a 2-core machine shared with other jobs, load average 1.7-2.8; an
-empty MODC_CACHE_DIR per run; before and after alternating, this script for both):
+Figures (CPU s, one core of a 2-core machine shared with other jobs; an empty MODC_CACHE_DIR
+per run; before (12e0a43, per-pose search) and after (modc/design/grid.py) alternating):
 
-    2026-11-27       --top  1 pose (median)  25 poses     ratio    best (25 poses, both)
-    before 8e67231     1    0.6 / 0.6        19.4 / 16.5  31 / 27  H2(pivot=30deg) - L2(pivot=-15deg)
-    after              1    0.8 / 0.6        19.6 / 16.4  25 / 30    - L4(pivot=15deg) at (-0.05, 0.1, 0) m
-    before 8e67231     3    35.8 (one run)   19.7         0.55     (the same three designs)
-    after              3    30.9 (one run)   15.6         0.50
+    27 Nov 2026, load 2.3-4.5       --top  1 pose            25 poses        ratio
+    before 12e0a43 (07:51-07:54)      1    0.31-0.42 (median  7.2-11.6 (8.0-   20.5 / 23.7
+                                           of six, two runs)  8.1 median)
+    after          (same window)      1    0.30-0.45          5.3-7.8 (5.4-   14.9 / 17.5
+                                                              5.9 median)
+    before 12e0a43 (07:49-07:51)      3    11.0               9.0             0.82
+    after          (07:47-07:49)      3    13.0               4.3             0.33
 
-After: 25 poses = 15 in reach searched for 2 units (0.9 s) and for 3 units (15.0 s: 8 poses with
-settings in reach, 0.5-3.2 s each, the base as written among the cheapest; 7 at 0.02-0.05 s),
-plus 0.3 s of base_link contact checks. The change (fewer exact checks, a faster static torque
-screen) is about 1 s, inside the run-to-run noise.
+    best (25 poses, --top 1): before H2(pivot=30deg) - L2(pivot=-15deg) - L4(pivot=15deg) at
+    (-0.05, 0.1, 0) m (margin 0.95965); after H2 - L2(pivot=-45deg) - L4(pivot=15deg) at
+    (0, 0.05, 0) m (margin 0.95954): one design per shape over the grid, its simplest setting
+    at its nearest pose, where before every pose gave its own (see modc/design/grid.py).
 
-Goal (<= 5) not met: every pose in reach needs its whole search, because designs of equal
-modules and mass (every 3-unit shape of this library weighs 1.82 kg in one split) are told apart
-by torque margin across poses (modc/design/placement.py says why no sound bound skips them).
-With --top 3 the grid is cheaper than one pose: 25 poses give three 1.82 kg designs, one pose
-has to search on to heavier shapes for its third.
+Goal (<= 5) not met. The grid search closes a shape that works somewhere at every pose once six
+of its settings are dead on (usually after two nonzero twists), but half the 3-unit shapes of
+this cell (unit 3 of type 1 or 2) work nowhere and are screened at every one of the 15 poses in
+reach, each setting the family and per-setting bounds leave (about 45,000 IK screens, most of
+the time); their mass equals the designs', so the ranking (margin next) needs them searched.
+What is left: the IK of those settings (about 200 batched calls of a few hundred settings each:
+screening a level of a shape at every pose in one batch would need per-candidate targets in
+modc.design.evaluate.screen_batch), the family bounds per (shape, pose) (about 15 %), and the
+base_link contact test per pose (about 0.3 s).
 """
 from __future__ import annotations
 

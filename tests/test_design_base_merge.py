@@ -1,6 +1,9 @@
-"""`base within`: the merged ranking over the grid is the best of every base pose searched alone
-(a brute force written here), to the chain, the pose and the numbers; the H/L alternatives of the
-designs kept are those their pose's own search checks."""
+"""`base within`: the grid search (modc.design.grid) against a brute force written here from
+every base pose searched alone. A shape's candidates are (setting, pose) pairs: its kept list is
+the KEEP best settings, each at its best pose (least search.order_key, then the nearest pose),
+the merge of every pose's own kept list; its design per H/L split is the first of them (up to
+TRIES) that passes the exact check at its pose; the designs are ranked. The H/L alternatives of
+the designs kept are those their pose's own search checks."""
 from __future__ import annotations
 
 import pytest
@@ -40,18 +43,46 @@ def _row(d) -> tuple:
             round(d.margin, 9), tuple((a.chain(), round(a.mass, 9), round(a.margin, 9)) for a in d.alternatives))
 
 
-def _brute_force(p, top: int) -> list:
-    """Every kept pose searched alone (its base as written there), nearest first, then merged:
-    the designs ordered by the ranking (stable: of equal designs the pose searched first), one
-    entry per chain, the first `top`."""
+def _cells(p):
     from modc.design import placement, run
-    from modc.design.rank import order
 
     kept, _, _ = placement.poses(p, run.longest_reach(p, p.max_units))
+    return [p.model_copy(update={"cell": placement.cell_at(p.cell, pose), "base_grid": None}) for pose in kept]
+
+
+def _merged(p, subs, shape) -> list:
+    """The shape searched alone at every pose, the kept lists merged: (Found, pose index)."""
+    from modc.design import search
+    from modc.design.evaluate import Spec
+
+    entries = []
+    for i, sub in enumerate(subs):
+        entries += [(search.order_key(f), i, f) for f in search.search_shape(Spec.of(sub), shape, 0).found]
+    best: dict = {}
+    for k, i, f in sorted(entries, key=lambda e: e[:2]):
+        best.setdefault((f.pivots, f.ports), (k, i, f))
+    return [(f, i) for _, i, f in sorted(best.values(), key=lambda e: e[:2])[:search.KEEP]]
+
+
+def _brute_force(p, top: int) -> list:
+    from modc.design import space
+    from modc.design.evaluate import Candidate, verify
+    from modc.design.rank import Design, order
+    from modc.design.verify_order import TRIES
+
+    subs = _cells(p)
     every = []
-    for pose in kept:
-        sub = p.model_copy(update={"cell": placement.cell_at(p.cell, pose), "base_grid": None})
-        every += run.design(sub, top=top).designs
+    for n in range(p.min_units, p.max_units + 1):
+        for shape in space.shapes(p, n):
+            merged = _merged(p, subs, shape)
+            for variants in space.variant_splits(p, n):
+                if not all(space.allowed(p, v, k) for v, k in zip(variants, shape.kinds, strict=True)):
+                    continue
+                for f, i in merged[:TRIES]:
+                    v = verify(subs[i], Candidate(shape, variants, f.pivots, f.ports, f.solutions))
+                    if not isinstance(v, str):
+                        every.append(Design(Candidate(shape, variants, f.pivots, f.ports, f.solutions), v))
+                        break
     seen, out = set(), []
     for d in order(every, p.rank):
         if d.chain() not in seen:
@@ -66,8 +97,26 @@ def _same_as_brute_force(text: str, top: int) -> list:
     p = _problem(text)
     got = run.design(p, top=top)
     want = _brute_force(p, top)
-    assert [_row(d) for d in got.designs] == [_row(d) for d in want]
+    assert [_row(d)[:5] for d in got.designs] == [_row(d)[:5] for d in want]
     return got.designs
+
+
+def test_each_shape_keeps_the_best_settings_of_every_pose_searched_alone():
+    from modc.design import grid, space
+    from modc.design.evaluate import Spec
+
+    for text in (ONE, THREE):
+        p = _problem(text)
+        subs = _cells(p)
+        shapes = space.shapes(p, p.max_units)
+        results = grid.search_shapes([Spec.of(s) for s in subs], shapes, 0, None, None, lambda: None)
+        some = False
+        for shape, r in zip(shapes, results, strict=True):
+            want = [(f.pivots, f.ports, i, round(f.worst, 2)) for f, i in _merged(p, subs, shape)]
+            assert [(f.pivots, f.ports, f.pose, round(f.worst, 2)) for f in r.found] == want, shape.label()
+            assert r.complete and r.finished
+            some |= bool(want)
+        assert some
 
 
 def test_the_grid_ranks_as_every_pose_searched_alone_and_merged():

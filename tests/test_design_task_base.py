@@ -91,29 +91,26 @@ def test_the_best_pose_wins_not_the_first_that_fits():
     assert o.designs[0].verified.robot.base.xyz == pytest.approx((0.2, 0.0, 0.0))
 
 
-def test_each_pose_searches_only_what_could_beat_the_designs_found(monkeypatch):
-    """Fewest modules first over every pose; a pose searched after a design is found gets that
-    design's modules and mass as its ceiling, a greater number of units is not searched once the
-    top designs are found, and the answer is the best of every pose alone."""
-    from modc.design import placement, run
+def test_every_pose_is_searched_at_once_fewest_units_first(monkeypatch):
+    """Fewest modules first, a shape's settings at every pose at once (modc.design.grid); a
+    greater number of units is not searched once the top designs are found, and the answer is as
+    good on modules and mass as the best of every pose alone."""
+    from modc.design import grid, placement, run
 
     three = FARTHER.replace("box size (0.1, 0, 0) m at (0.25, 0, 0) m", "box size (0.2, 0, 0) m at (0.2, 0, 0) m")
     calls = []
-    real = run._search
+    real = grid.search_shapes
 
-    def counted(p, *a, **kw):
-        calls.append((p.cell.base.xyz[0], p.min_units, p.max_units, kw.get("ceiling")))
-        return real(p, *a, **kw)
+    def counted(specs, shapes, *a):
+        calls.append((len(specs), {s.n for s in shapes}))
+        return real(specs, shapes, *a)
 
-    monkeypatch.setattr(run, "_search", counted)
+    monkeypatch.setattr(grid, "search_shapes", counted)
     o = run.design(problem(three), top=1)
-    monkeypatch.setattr(run, "_search", real)
+    monkeypatch.setattr(grid, "search_shapes", real)
     assert len(o.designs) == 1 and o.bases_searched == 3
+    assert calls and all(c == (3, {2}) for c in calls)  # the three poses at once, 2 units only
     best = o.designs[0]
-    assert [c[:3] for c in calls] == [(pytest.approx(x), 2, 2) for x in (0.3, 0.2, 0.1)]  # 2 units, nearest first
-    assert calls[0][3] is None and calls[1][3] is None  # nothing found yet at x = 0.3
-    ceiling = calls[2][3]  # the design found at x = 0.2
-    assert ceiling is not None and ceiling[0] == 2 and ceiling[2]  # margin ranks after mass: ties compete
     each = []
     for x in (0.3, 0.2, 0.1):  # every pose alone, with the base as written there (more units cannot beat 2)
         p = problem(three)
@@ -121,7 +118,6 @@ def test_each_pose_searches_only_what_could_beat_the_designs_found(monkeypatch):
         each += run.design(p.model_copy(update={"cell": placement.cell_at(p.cell, pose), "base_grid": None}),
                            top=1, max_units=2).designs
     assert (best.modules, round(best.mass, 9)) == min((d.modules, round(d.mass, 9)) for d in each)
-    assert best.modules == 2 and ceiling[1] >= best.mass - 1e-9
 
 
 def test_a_base_pose_inside_an_obstacle_is_skipped():

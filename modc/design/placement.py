@@ -2,43 +2,35 @@
 
 The design's obstacles, targets and regions are given in the cell frame of the box. For each base
 pose of the grid the cell is written in that base's frame (base_link, the frame every robot file
-gives its environment in) with `base at` the pose, and the static search runs on it unchanged;
-the designs of all poses are merged into one ranking where a design is a (base pose, chain)
-pair, one entry per chain: its best pose (ties: the pose searched first). Each design's robot
-states its `base at …` and holds the same cell around it, so it compiles, plans and views in the
-same world as every other design.
+gives its environment in) with `base at` the pose; each design's robot states its `base at …` and
+holds the same cell around it, so it compiles, plans and views in the same world as every other.
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
 bounds is skipped (sound: no chain could reach it from there), so is one where base_link sinks
-into the cell whatever the first unit (sound: the exact check would reject every design). The
-answer is the best over the grid under the ranking's static objectives, not the first fit:
-with fewest modules ranked first, one number of units at a time is searched over every kept pose
-(closest cell first), each pose only for shapes that could rank before the `top`-th design found
-so far (search()). ranking.json "bases" says how many poses were searched and skipped. The
-ranking keeps one entry per chain (its best pose), so it may hold fewer than `top` designs.
+into the cell whatever the first unit (sound: the exact check would reject every design).
+The poses kept are searched together (modc.design.grid): a shape's candidates are (twist
+setting, pose) pairs, ranked within the shape as one pose's settings are, then nearest pose
+first, and the shape gives one design over the grid, at its setting's best pose. The answer is
+the best design over the grid under the ranking's static objectives, not the first fit.
+ranking.json "bases" says how many poses were searched and skipped.
 
-Only the designs the merged ranking keeps get their H/L swaps checked (their alternatives, at
-their own pose, by the same Verifier.swaps a pose's own search runs): alternatives never change a
-design's rank, so checking them for designs a later pose beats only cost exact checks.
+Only the designs kept get their H/L swaps checked (their alternatives, at their own pose, by the
+same Verifier.swaps a pose's own search runs).
 
-Where the time goes (benchmarks/bench_task_base.py): the static search at every pose in reach,
-mostly the IK of the settings the bounds keep. With the default ranking (modules, mass, margin)
-designs of equal modules and mass are told apart by torque margin, which only the exact check
-measures, so each pose in reach is searched for every shape as light as the designs found (the
-ceiling prunes nothing where those shapes weigh the same). A sound margin bound skipping a
-(shape, pose) would have to hold over every setting the bounds keep there: one shape's settings
-span 0.91-0.97 of margin, the poses' designs 0.948-0.960, so it would skip nothing.
+Where the time goes (benchmarks/bench_task_base.py): the IK of the settings the bounds keep at
+every pose in reach. A shape that works somewhere closes, at every pose, once its kept settings
+are all dead on (dominance over the grid: usually after two nonzero twists); a shape that works
+nowhere is screened at every pose in reach, each setting the family and per-setting bounds leave.
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
 from ..model import ResolvedProblem, Robot, Transform, resolved
-from .rank import Design, order
+from .rank import Design
 
 if TYPE_CHECKING:
     from .run import Outcome
@@ -153,84 +145,37 @@ def poses(problem: ResolvedProblem, longest: float) -> tuple[list[Transform], in
     return [k[2] for k in kept], len(grid.poses()) - len(kept) - touching, touching
 
 
-def _levels(problem: ResolvedProblem, max_units: int | None) -> list[tuple[int, int]]:
-    """Ranges of units searched one after the other over every pose: one number of units at a
-    time when the ranking puts fewest modules first, else the whole range at once."""
-    lib = problem.cell.library
-    lo, hi = max(problem.min_units, lib.rules.min_dof), min(max_units or problem.max_units, lib.rules.max_dof)
-    if problem.rank[:2] == ("modules", "mass"):
-        return [(n, n) for n in range(lo, hi + 1)]
-    return [(lo, hi)]
-
-
 def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: float,
-           one: Callable[..., Outcome], ties: bool = True) -> Outcome:
-    """The merged outcome of one(sub_problem, max_units, top, ceiling, diagnosing) over the kept
-    base poses: the best (pose, chain) designs of the grid under the ranking's static objectives.
-
-    Fewest modules first, a number of units at a time over every pose (nearest first), and at
-    each pose only the shapes that could rank before the `top`-th design found so far (the
-    ceiling: fewer modules, or as many and lighter; with `ties`, as light too, when a later
-    objective may still tell them apart); a number of units is searched only while fewer than
-    `top` designs are found. So a pose is skipped only where no chain could beat what is found."""
+           one: Callable[..., Outcome], many: Callable[..., Outcome]) -> Outcome:
+    """The best (pose, chain) designs of the grid under the ranking's static objectives:
+    many(problem, cells, max_units, top) searches every kept pose at once (modc.design.grid: a
+    shape's settings at every pose, one design per shape at its best pose); one(sub_problem,
+    max_units, top) at the nearest pose says why when no design is found."""
     from .run import Outcome
 
     kept, pruned, touching = poses(problem, longest)
-    outs: list[Outcome] = []
-    at: dict[int, ResolvedProblem] = {}  # id(design) -> its pose's problem (outs keeps every design alive)
-    searched: set[int] = set()
-    designs: list[Design] = []
-    levels = _levels(problem, max_units)
-    by_level = problem.rank[:2] == ("modules", "mass")
-    stopped = None
-    for lo, hi in levels:
-        for i, pose in enumerate(kept):
-            ceiling = None
-            if by_level and len(designs) >= top:
-                d = designs[top - 1]
-                ceiling = (d.modules, d.mass, ties)
-                if d.modules < lo:
-                    break  # every chain of this number of units has more modules than the top designs
-            sub = problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None,
-                                             "min_units": lo, "max_units": hi})
-            o = one(sub, hi, top, ceiling, False, swaps=False)
-            outs.append(o)
-            at.update((id(d), sub) for d in o.designs)
-            searched.add(i)
-            designs = _best_per_chain(designs + list(o.designs), problem.rank)
-            stopped = stopped or o.stopped
-            if stopped:
-                break
-        if stopped or (by_level and len(designs) >= top):
-            break
-    diagnosis = None
-    if not designs and kept and not stopped:  # why none: the nearest pose's search, told per target
-        diagnosis = one(problem.model_copy(update={"cell": cell_at(problem.cell, kept[0]), "base_grid": None}),
-                        max_units, top)
-    out = Outcome(problem, [_swaps(at[id(d)], top, d) for d in designs[:top]])
-    out.bases_searched, out.bases_pruned, out.bases_total = len(searched), pruned, len(kept) + pruned + touching
+    subs = [problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None}) for pose in kept]
+    out = many(problem, subs, max_units, top) if subs else Outcome(problem, [])
+    out.designs = [_swaps(_at(subs, d), top, d) for d in out.designs]
+    out.bases_searched, out.bases_pruned, out.bases_total = len(kept), pruned, len(kept) + pruned + touching
     out.bases_touching = touching
+    out.bases_kept = kept
     names = [t.name for t in problem.cell.targets]
-    out.closest = {t: min((o.closest.get(t, math.inf) for o in outs), default=math.inf) for t in names}
-    if not outs:  # every pose ruled out by reach: how far the nearest pose leaves the cell
+    if not subs:  # every pose ruled out by reach: how far the nearest pose leaves the cell
         grid = problem.base_grid
         assert grid is not None
         short = min(gap(problem.cell, p, longest) for p in grid.poses())
         out.closest = dict.fromkeys(names, max(short, 0.0))
-    for o in outs:
-        out.evaluated += o.evaluated
-        out.shapes += o.shapes
-        out.screened += o.screened
-        out.excluded += o.excluded
-        out.dominated += o.dominated
-        out.rejections += o.rejections
-        out.complete &= o.complete
-        out.stopped = out.stopped or o.stopped
-        out.unfinished += [s for s in o.unfinished if s not in out.unfinished]
-        out.coarse += [s for s in o.coarse if s not in out.coarse]
-    if diagnosis is not None:
-        out.targets = diagnosis.targets
+    elif not out.designs and not out.stopped:  # why none: the nearest pose's search, told per target
+        out.targets = one(subs[0], max_units, top).targets
     return out
+
+
+def _at(subs: list[ResolvedProblem], d: Design) -> ResolvedProblem:
+    """The pose's problem a design was checked in (its robot's base, read back from its text)."""
+    b = d.verified.robot.base
+    return min(subs, key=lambda s: float(np.abs(np.subtract(s.cell.base.xyz, b.xyz)).sum()
+                                         + np.abs(np.subtract(s.cell.base.rpy, b.rpy)).sum()))
 
 
 def _swaps(sub: ResolvedProblem, top: int, d: Design) -> Design:
@@ -240,13 +185,3 @@ def _swaps(sub: ResolvedProblem, top: int, d: Design) -> Design:
     from .verify_order import Verifier
 
     return Verifier(sub, top, None, _mass).swaps(d)
-
-
-def _best_per_chain(designs: list[Design], objectives: tuple[str, ...]) -> list[Design]:
-    seen: set[str] = set()
-    out = []
-    for d in order(designs, objectives):  # stable: of equal designs, the pose searched first
-        if d.chain() not in seen:
-            seen.add(d.chain())
-            out.append(d)
-    return out

@@ -68,6 +68,7 @@ class Outcome:
     bases_pruned: int = 0  # base poses ruled out by the reach bound
     bases_total: int = 0  # base poses of the grid
     bases_touching: int = 0  # base poses where base_link sinks into the cell
+    bases_kept: list | None = None  # the base poses searched, nearest first (None: the base as written)
 
     def why_none(self) -> str:
         return why_none(self)
@@ -164,20 +165,7 @@ def _edge(problem: ResolvedProblem, mass: float) -> float:
     return mass - 1e-9 if "margin" in problem.rank else mass + 1e-9
 
 
-Ceiling = tuple[int, float, bool]  # (modules, kg, ties): only shapes that could rank before this
-
-
-def _below(ceiling: Ceiling | None, n: int, mass: float) -> bool:
-    """Could a chain of n units and at least `mass` rank before the ceiling (fewest modules, then
-    least mass; with ties, an equal key too, when a later objective may still tell them apart)?"""
-    if ceiling is None:
-        return True
-    cn, cm, ties = ceiling
-    return n < cn or (n == cn and (mass < cm - 1e-9 or (ties and mass <= cm + 1e-9)))
-
-
-def _tiers(problem: ResolvedProblem, spec: Spec, hi: int, closest: dict[str, float],
-           ceiling: Ceiling | None = None) -> list:
+def _tiers(problem: ResolvedProblem, spec: Spec, hi: int, closest: dict[str, float]) -> list:
     lib = problem.cell.library
     tiers = []
     for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
@@ -193,9 +181,7 @@ def _tiers(problem: ResolvedProblem, spec: Spec, hi: int, closest: dict[str, flo
                 closest[t.name] = min(closest[t.name], max(g + t.position_tolerance, 0.0))
             if max(gaps, default=-1.0) > 0:  # a target beyond any pose of this shape: no IK needed
                 continue
-            m = _min_mass(problem, s, splits)
-            if _below(ceiling, n, m):
-                shapes.append((m, s.label(), s))
+            shapes.append((_min_mass(problem, s, splits), s.label(), s))
         shapes.sort(key=lambda e: e[:2])
         tiers.append((n, splits, shapes))
     return tiers
@@ -213,7 +199,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     its best designs, more of them when a task objective ranks (tasks.candidates); each is then
     planned and timed (tasks.plan_all) and the survivors ranked by every objective. With
     `base within`, the static search runs per base pose (modc.design.placement)."""
-    from . import placement, reference, tasks
+    from . import grid, placement, reference, tasks
 
     t0 = time.perf_counter()
     if max_units is not None:  # --max-units: the design's bound for everything below, the diagnosis too
@@ -228,24 +214,23 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
 
     enough = [top]  # designs after which a round may stop (more when the first candidates all fail planning)
 
-    def one(p: ResolvedProblem, units: int | None, k: int, ceiling: Ceiling | None = None,
-            diagnosing: bool = True, swaps: bool = True) -> Outcome:
+    def one(p: ResolvedProblem, units: int | None, k: int, diagnosing: bool = True) -> Outcome:
         # the extra candidates to time come from the shapes searched until `top` designs are found
         # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
         # settings, 369 s on a 4-goal visit cell)
-        return _search(p, units, k, seed, executor, progress, deadline, enough=enough[0], ceiling=ceiling,
-                       diagnosing=diagnosing, swaps=swaps)
+        return _search(p, units, k, seed, executor, progress, deadline, enough=enough[0],
+                       diagnosing=diagnosing)
+
+    def many(p: ResolvedProblem, cells: list[ResolvedProblem], units: int | None, k: int) -> Outcome:
+        return grid.search(p, cells, units, k, seed, executor, deadline, enough=enough[0], progress=progress)
 
     rejected: dict[str, tuple[str, str | None]] = {}  # chain -> why (and which task) it could not be planned: once only
     while True:
         if problem.base_grid is None:
             out = one(screen, max_units, n)
         else:
-            lib = problem.cell.library
-            hi = min(max_units or problem.max_units, lib.rules.max_dof)
-            # designs of equal modules and mass may still differ on a later objective (margin, a task's)
-            ties = any(o not in ("modules", "mass") for o in problem.rank)
-            out = placement.search(screen, max_units, n, longest_reach(problem, hi), one, ties)
+            hi = min(max_units or problem.max_units, problem.cell.library.rules.max_dof)
+            out = placement.search(screen, max_units, n, longest_reach(problem, hi), one, many)
         out.problem = problem
         tasks.restore(out, points)
         if not tasked:
@@ -260,10 +245,7 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         if out.designs or out.stopped or exhausted or n >= MAX_CANDIDATES:
             break
         n = enough[0] = min(n * 4, MAX_CANDIDATES)
-    grid = None if problem.base_grid is None else \
-        placement.poses(problem, longest_reach(problem, min(max_units or problem.max_units,
-                                                            problem.cell.library.rules.max_dof)))[0]
-    out.reference = reference.evaluate(problem, seed, deadline, grid)
+    out.reference = reference.evaluate(problem, seed, deadline, out.bases_kept)
     out.seconds = time.perf_counter() - t0
     return out
 
@@ -323,7 +305,7 @@ def longest_reach(problem: ResolvedProblem, hi: int) -> float:
 
 def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int, executor: Executor | None,
             progress: Callable[..., None] | None, deadline: float | None, enough: int | None = None,
-            ceiling: Ceiling | None = None, diagnosing: bool = True, swaps: bool = True) -> Outcome:
+            diagnosing: bool = True) -> Outcome:
     """The static search: designs ranked by the problem's (static) objectives.
 
     With the default objectives (fewest modules first), chains are searched by number of units,
@@ -331,10 +313,9 @@ def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int
     as `enough` (default `top`) kinematically distinct designs are checked that no unsearched
     shape could beat; up to `top` are kept.
     ROUND does not depend on the number of workers, so neither does where the search stops.
-    deadline (time.time()) and search.STOP end it early with what was found. ceiling: only shapes
-    that could rank before it are searched (base placement: what other poses found); diagnosing:
-    say per target why there is no design (probes of seconds each); swaps: check each design's
-    other H/L splits as its alternatives (base placement does it for the merged designs only)."""
+    deadline (time.time()) and search.STOP end it early with what was found. diagnosing: say per
+    target why there is no design (probes of seconds each). Each design comes with its other H/L
+    splits that pass the exact check as its alternatives."""
     t0 = time.perf_counter()
     spec = Spec.of(problem)
     lib = problem.cell.library
@@ -349,7 +330,7 @@ def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int
     starts = np.array([(u.x01, 0.0, u.z01) for u in lib.units.values()], float)
     blocked, walls = bounds_blocked(spec.obstacles, tg.xyz, tg.tol_p, float(np.linalg.norm(problem.cell.tool.xyz)),
                                     float(spec.radii.min()), longest, starts)
-    tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest, ceiling)
+    tiers = [] if blocked.any() else _tiers(problem, spec, hi, closest)
     total_shapes = sum(len(s) for _, _, s in tiers)
     total_settings = sum(estimate(spec, s) for _, _, shapes in tiers for _, _, s in shapes)
     early = problem.rank[:2] == ("modules", "mass")
@@ -461,7 +442,7 @@ def _search(problem: ResolvedProblem, max_units: int | None, top: int, seed: int
     out.coarse = [r.shape.label() for r in searched if r.finished and not r.complete]
     out.complete = not out.unfinished and not out.coarse
     out.closest = {t: (0.0 if hit[t] else float(c)) for t, c in closest.items()}
-    out.designs = [tally.swaps(d) if swaps else d for d in distinct(tally.accepted, problem.rank)[:top]]
+    out.designs = [tally.swaps(d) for d in distinct(tally.accepted, problem.rank)[:top]]
     if not out.designs and diagnosing:
         out.targets = diagnose(problem, spec, names, walls, hit, clear, closest, seed, deadline, bool(out.stopped))
     out.seconds = time.perf_counter() - t0

@@ -49,7 +49,7 @@ class Verifier:
 
         lib = self.problem.cell.library
         cand = Candidate(res.shape, variants, f.pivots, f.ports, f.solutions)
-        robot = robot_for(self.problem, cand, {}, self.problem.name)
+        robot = robot_for(self.at(f), cand, {}, self.problem.name)
         # the compiler's own static model (pinocchio's g(q) to rounding), batched over the poses
         tau = np.abs(Statics(resolved(robot, lib)).gravities([sols[0] for sols in f.solutions]))
         peak = np.array([lib.variants[v].actuator.torque_peak for v in variants])
@@ -57,6 +57,10 @@ class Verifier:
             return True
         self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: over peak torque at a target pose")
         return False
+
+    def at(self, f) -> ResolvedProblem:
+        """The problem a kept setting is checked in (base placement: its base pose's cell)."""
+        return self.problem
 
     def _primary_keys(self) -> list[tuple]:
         best: dict[tuple, tuple] = {}
@@ -95,7 +99,7 @@ class Verifier:
             for f in found[:TRIES]:
                 cand = Candidate(shape, variants, f.pivots, f.ports, f.solutions)
                 self.checks += 1
-                v = verify(self.problem, cand)
+                v = verify(self.at(f), cand)
                 if isinstance(v, str):
                     self.out.rejections.append(f"{'-'.join(u.name for u in cand.units())}: {v}")
                     continue
