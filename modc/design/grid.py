@@ -228,7 +228,7 @@ def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadl
 
 def _mass_groups(problem: ResolvedProblem, shapes: list[space.Shape], splits) -> list[tuple[float, list]]:
     """Shapes of equal least mass together, lightest first."""
-    from .run import _min_mass
+    from .sweep import _min_mass
 
     ranked = sorted(((_min_mass(problem, s, splits), s.label(), s) for s in shapes), key=lambda e: e[:2])
     groups: list[tuple[float, list]] = []
@@ -249,7 +249,8 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
     designs ranked by the problem's static objectives, at most `top`, each at its pose. By number
     of units, lightest shapes first, stopping as run._search does once `enough` designs rank
     ahead of every shape not searched. progress(run.Status) after each group of shapes."""
-    from .run import Outcome, Status, _edge, _mass, _stopping, longest_reach
+    from .outcome import Outcome, Status
+    from .sweep import _edge, _mass, _stopping, longest_reach
 
     out = Outcome(problem, [])
     specs = [Spec.of(s) for s in subs]

@@ -33,7 +33,7 @@ from ..model import ResolvedProblem, Robot, Transform, resolved
 from .rank import Design
 
 if TYPE_CHECKING:
-    from .run import Outcome
+    from .outcome import Outcome
 
 
 def _frame(pose: Transform) -> tuple[np.ndarray, np.ndarray]:
@@ -151,7 +151,7 @@ def search(problem: ResolvedProblem, max_units: int | None, top: int, longest: f
     many(problem, cells, max_units, top) searches every kept pose at once (modc.design.grid: a
     shape's settings at every pose, one design per shape at its best pose); one(sub_problem,
     max_units, top) at the nearest pose says why when no design is found."""
-    from .run import Outcome
+    from .outcome import Outcome
 
     kept, pruned, touching = poses(problem, longest)
     subs = [problem.model_copy(update={"cell": cell_at(problem.cell, pose), "base_grid": None}) for pose in kept]
@@ -181,7 +181,7 @@ def _at(subs: list[ResolvedProblem], d: Design) -> ResolvedProblem:
 def _swaps(sub: ResolvedProblem, top: int, d: Design) -> Design:
     """d with its other H/L splits checked at its pose (as the pose's own search would have):
     only for the designs the merged ranking keeps."""
-    from .run import _mass
+    from .sweep import _mass
     from .verify_order import Verifier
 
     return Verifier(sub, top, None, _mass).swaps(d)

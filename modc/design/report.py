@@ -10,8 +10,8 @@ from html import escape
 
 from ..formatting import counted
 from ..objectives import REGISTRY
+from .outcome import Outcome
 from .rank import TASK, pareto, shown, static, versus, why, worst_share
-from .run import Outcome
 from .write import file_name
 
 W, H, PAD = 520, 320, 52

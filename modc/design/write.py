@@ -10,8 +10,8 @@ import math
 from ..formatting import counted
 from ..objectives import REGISTRY
 from .evaluate import pose_name
+from .outcome import Outcome
 from .rank import Design, why, worst_share
-from .run import Outcome
 
 
 def file_name(problem: str, rank: int) -> str:
