@@ -181,26 +181,42 @@ def walled(spec: Spec, longest: float) -> bool:
     return bool(out.any())
 
 
+def _opened(specs: list[Spec], shape: space.Shape, skip: frozenset[int]) -> _Shape:
+    """A shape's live families at every pose but those skipped (walled off) or beyond its reach."""
+    lib = specs[0].problem.cell.library
+    lengths = [x or lib.units[k].x23 for k, x in zip(shape.kinds, shape.links, strict=True)]
+    r = reach_bound([lib.units[k] for k in shape.kinds], lengths, specs[0].problem.cell.tool.xyz)
+    live, excluded, options = {}, 0, None
+    for i, spec in enumerate(specs):
+        tg = spec.targets
+        if i in skip or np.any(np.linalg.norm(tg.xyz, axis=1) - r - tg.tol_p > 0):  # walled off, beyond reach
+            excluded += full_axes(spec, shape).count
+            continue
+        options = options or _options(spec, shape)
+        lv, out = _live(spec, shape, options)
+        live[i], excluded = lv, excluded + out
+    return _Shape(shape, live, excluded)
+
+
+def _level_done(s: _Shape, c: int) -> None:
+    """Levels up to c searched at every pose: the shape closes when cut short, when dominance
+    bounds the rest, or when no level is left."""
+    s.level = c
+    if not s.finished:
+        s.closed = True
+    elif dominance.dominates(kept(s.found), KEEP):
+        s.dominated = sum(sum(lv.counts[c + 1:]) for i, lv in s.live.items() if i not in s.coarse)
+        s.closed = True
+    elif all(c + 1 >= len(lv.counts) or i in s.coarse for i, lv in s.live.items()):
+        s.closed = True
+
+
 def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadline: float | None,
                   executor: Executor | None, stopping: Callable[[], str | None],
                   skip: frozenset[int] = frozenset()) -> list[ShapeResult]:
     """The shapes searched over every pose but those in skip, a level at a time (see the
     module's docstring)."""
-    lib = specs[0].problem.cell.library
-    open_: list[_Shape] = []
-    for shape in shapes:
-        lengths = [x or lib.units[k].x23 for k, x in zip(shape.kinds, shape.links, strict=True)]
-        r = reach_bound([lib.units[k] for k in shape.kinds], lengths, specs[0].problem.cell.tool.xyz)
-        live, excluded, options = {}, 0, None
-        for i, spec in enumerate(specs):
-            tg = spec.targets
-            if i in skip or np.any(np.linalg.norm(tg.xyz, axis=1) - r - tg.tol_p > 0):  # walled off, beyond reach
-                excluded += full_axes(spec, shape).count
-                continue
-            options = options or _options(spec, shape)
-            lv, out = _live(spec, shape, options)
-            live[i], excluded = lv, excluded + out
-        open_.append(_Shape(shape, live, excluded))
+    open_ = [_opened(specs, shape, skip) for shape in shapes]
     todo = [s for s in open_ if s.live]
     while todo and not stopping():
         upto = {id(s): _next(s) for s in todo}
@@ -211,14 +227,7 @@ def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadl
             s.found += [Placed(f.pivots, f.ports, f.solutions, f.worst, i) for f in p.found]
             s.finished &= p.upto >= p.hi
         for s in todo:
-            s.level = c = upto[id(s)]
-            if not s.finished:
-                s.closed = True
-            elif dominance.dominates(kept(s.found), KEEP):
-                s.dominated = sum(sum(lv.counts[c + 1:]) for i, lv in s.live.items() if i not in s.coarse)
-                s.closed = True
-            elif all(c + 1 >= len(lv.counts) or i in s.coarse for i, lv in s.live.items()):
-                s.closed = True
+            _level_done(s, upto[id(s)])
         todo = [s for s in todo if not s.closed]
     for s in todo:  # stopped: what was screened
         s.finished = False
@@ -247,69 +256,99 @@ def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int
            progress: Callable[..., None] | None = None):
     """The static search over the base poses (subs: the cell at each pose, nearest first):
     designs ranked by the problem's static objectives, at most `top`, each at its pose. By number
-    of units, lightest shapes first, stopping as run._search does once `enough` designs rank
-    ahead of every shape not searched. progress(run.Status) after each group of shapes."""
-    from .outcome import Outcome, Status
-    from .sweep import _edge, _mass, _stopping, longest_reach
-
-    out = Outcome(problem, [])
-    specs = [Spec.of(s) for s in subs]
-    tally = _Tally(subs, top, out, _mass)
-    lib = problem.cell.library
-    hi = min(max_units or problem.max_units, lib.rules.max_dof)
-    early = problem.rank[:2] == ("modules", "mass")
-    names = [t.name for t in problem.cell.targets]
-    closest = np.full(len(names), np.inf)
-    results: list[ShapeResult] = []
-    want = enough or top
-    skip = frozenset(i for i, spec in enumerate(specs) if walled(spec, longest_reach(problem, hi)))
-    every = [s.label() for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1)
-             if space.variant_splits(problem, n) for s in space.shapes(problem, n)]
-
-    def report(force: bool = False, final: bool = False) -> None:
-        if progress is not None:
-            best = distinct(tally.accepted, problem.rank)[0].chain() if tally.accepted else ""
-            st = Status(len(results), len(every), out.evaluated, out.screened, best, 0.0 if final else None)
-            if force:
-                progress(st, True)
-            else:
-                progress(st)
-
-    report(force=True)
-    for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
+    of units, lightest shapes first, stopping as the one-pose search (modc.design.sweep) does
+    once `enough` designs rank ahead of every shape not searched. progress(Status) after each
+    group of shapes."""
+    g = _Grid(problem, subs, max_units, top, seed, executor, deadline, progress)
+    g.report(force=True)
+    for n in range(max(problem.min_units, problem.cell.library.rules.min_dof), g.hi + 1):
         splits = space.variant_splits(problem, n)
-        if not splits:
-            continue
-        groups = _mass_groups(problem, space.shapes(problem, n), splits)
+        if splits and g.tier(n, splits, enough or top):
+            break
+    return g.finish()
+
+
+class _Grid:
+    """One grid search's state: the poses' Specs, the exact checks in ranking order, the shapes
+    searched, what came closest to each target."""
+
+    def __init__(self, problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int | None, top: int,
+                 seed: int, executor: Executor | None, deadline: float | None,
+                 progress: Callable[..., None] | None):
+        from .outcome import Outcome
+        from .sweep import _mass, longest_reach
+
+        self.problem, self.top, self.seed, self.executor = problem, top, seed, executor
+        self.deadline, self.progress = deadline, progress
+        self.out = Outcome(problem, [])
+        self.specs = [Spec.of(s) for s in subs]
+        self.tally = _Tally(subs, top, self.out, _mass)
+        lib = problem.cell.library
+        self.hi = min(max_units or problem.max_units, lib.rules.max_dof)
+        self.early = problem.rank[:2] == ("modules", "mass")
+        self.names = [t.name for t in problem.cell.targets]
+        self.closest = np.full(len(self.names), np.inf)
+        self.results: list[ShapeResult] = []
+        self.skip = frozenset(i for i, spec in enumerate(self.specs)
+                              if walled(spec, longest_reach(problem, self.hi)))
+        self.every = [s.label() for n in range(max(problem.min_units, lib.rules.min_dof), self.hi + 1)
+                      if space.variant_splits(problem, n) for s in space.shapes(problem, n)]
+
+    def report(self, force: bool = False, final: bool = False) -> None:
+        from .outcome import Status
+
+        if self.progress is None:
+            return
+        tally, out = self.tally, self.out
+        best = distinct(tally.accepted, self.problem.rank)[0].chain() if tally.accepted else ""
+        eta = (None if out.stopped else 0.0) if final else None
+        st = Status(len(self.results), len(self.every), out.evaluated, out.screened, best, eta)
+        if force:
+            self.progress(st, True)
+        else:
+            self.progress(st)
+
+    def tier(self, n: int, splits, want: int) -> bool:
+        """The shapes of n units, a group of equal least mass at a time: True when the search
+        ends here (stopped, or `want` designs rank before every unsearched shape)."""
+        from .sweep import _edge, _stopping
+
+        out, tally = self.out, self.tally
+        groups = _mass_groups(self.problem, space.shapes(self.problem, n), splits)
         for g, (_, shapes) in enumerate(groups):
-            res = search_shapes(specs, shapes, seed, deadline, executor, lambda: _stopping(deadline), skip)
+            res = search_shapes(self.specs, shapes, self.seed, self.deadline, self.executor,
+                                lambda: _stopping(self.deadline), self.skip)
             for r in res:
-                results.append(r)
+                self.results.append(r)
                 out.shapes += 1
                 out.evaluated += r.evaluated
                 out.excluded += r.excluded
                 out.dominated += r.dominated
-                closest = np.minimum(closest, r.closest)
+                self.closest = np.minimum(self.closest, r.closest)
                 tally.add(n, splits, r)
-            out.stopped = _stopping(deadline) or (None if all(r.finished for r in res) else "time budget")
-            nxt = _edge(problem, groups[g + 1][0]) if g + 1 < len(groups) and not out.stopped else float("inf")
+            out.stopped = _stopping(self.deadline) or (None if all(r.finished for r in res) else "time budget")
+            nxt = _edge(self.problem, groups[g + 1][0]) if g + 1 < len(groups) and not out.stopped else float("inf")
             tally.settle(n, nxt)
-            report()
-            if out.stopped or (early and tally.done(n, nxt, want)):
+            self.report()
+            if out.stopped:
+                return True
+            if self.early and tally.done(n, nxt, want):
                 break
-        if out.stopped:
-            break
-        if early:
-            tally.settle(n, float("inf"))
-            if tally.distinct_count() >= want:
-                break
-    tally.settle(hi, float("inf"))
-    done = {r.shape.label() for r in results if r.finished}
-    out.unfinished = [x for x in every if x not in done] if out.stopped else \
-        [r.shape.label() for r in results if not r.finished]
-    out.coarse = [r.shape.label() for r in results if r.finished and not r.complete]
-    out.complete = not out.unfinished and not out.coarse
-    out.closest = {t: (0.0 if any(r.hit[k] for r in results) else float(closest[k])) for k, t in enumerate(names)}
-    out.designs = distinct(tally.accepted, problem.rank)[:top]
-    report(force=True, final=True)
-    return out
+        if not self.early:
+            return False
+        tally.settle(n, float("inf"))
+        return tally.distinct_count() >= want
+
+    def finish(self):
+        out, results = self.out, self.results
+        self.tally.settle(self.hi, float("inf"))
+        done = {r.shape.label() for r in results if r.finished}
+        out.unfinished = [x for x in self.every if x not in done] if out.stopped else \
+            [r.shape.label() for r in results if not r.finished]
+        out.coarse = [r.shape.label() for r in results if r.finished and not r.complete]
+        out.complete = not out.unfinished and not out.coarse
+        out.closest = {t: (0.0 if any(r.hit[k] for r in results) else float(self.closest[k]))
+                       for k, t in enumerate(self.names)}
+        out.designs = distinct(self.tally.accepted, self.problem.rank)[:self.top]
+        self.report(force=True, final=True)
+        return out
