@@ -4,7 +4,7 @@ usage errors (the `modc lint` fast path, modc.cli.lint_run, runs on these alone)
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -144,3 +144,32 @@ def run_like_click(run, options: dict, command: str) -> None:
 
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - nothing more reaches the closed pipe
         raise SystemExit(1) from None
+
+
+def read_plain(args: list[str], table: dict, positional: Callable[[dict, str], bool]) -> dict | None:
+    """A plain command line read without click (lint_run, compile_run): every word an option of
+    table (option -> (its name in the command's run(), the values it takes or None for any, or
+    the flag's value when a bool)) given at most once, or a positional word positional() takes;
+    None for anything else (click reads it then)."""
+    options: dict = {}
+    words = iter(args)
+    for word in words:
+        if not word.startswith("-"):
+            if not positional(options, word):
+                return None
+            continue
+        name, _, inline = word.partition("=") if word.startswith("--") else (word, "", "")
+        spec = table.get(name)
+        if spec is None or spec[0] in options:
+            return None
+        key, values = spec
+        if isinstance(values, bool):
+            if "=" in word:
+                return None
+            options[key] = values
+            continue
+        value = inline if "=" in word else next(words, None)
+        if value is None or value.startswith("-") or (values is not None and value not in values):
+            return None
+        options[key] = value
+    return options

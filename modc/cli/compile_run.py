@@ -6,7 +6,7 @@ which reads it as before and then runs run() here.
 """
 from __future__ import annotations
 
-from .common import EXIT_ERRORS, EXIT_USAGE, Verbosity, _err, _print_diagnostics, usage_errors
+from .common import EXIT_ERRORS, EXIT_USAGE, Verbosity, _err, _print_diagnostics, read_plain, usage_errors
 
 TORQUE = ("error", "warning", "off")
 # option -> (its name in run(), the values it takes or None for any, or the flag's value)
@@ -24,29 +24,14 @@ def plain_args(args: list[str]) -> dict | None:
     """run()'s arguments when args (after `compile`) are a plain compile command line: one file,
     -o OUT, and options spelled as in `modc compile --help`, each at most once, none of the
     numbers (click checks their ranges); else None."""
-    options: dict = {}
-    words = iter(args)
-    for word in words:
-        if not word.startswith("-"):
-            if "file" in options:
-                return None
-            options["file"] = word
-            continue
-        name, _, inline = word.partition("=") if word.startswith("--") else (word, "", "")
-        spec = _OPTIONS.get(name)
-        if spec is None or spec[0] in options:
-            return None
-        key, values = spec
-        if isinstance(values, bool):
-            if "=" in word:
-                return None
-            options[key] = values
-            continue
-        value = inline if "=" in word else next(words, None)
-        if value is None or value.startswith("-") or (values is not None and value not in values):
-            return None
-        options[key] = value
-    return options if "file" in options and "out" in options else None
+    def one_file(options: dict, word: str) -> bool:
+        if "file" in options:
+            return False
+        options["file"] = word
+        return True
+
+    options = read_plain(args, _OPTIONS, one_file)
+    return options if options is not None and "file" in options and "out" in options else None
 
 
 def run(file: str, out: str, library: str | None = None, only: str | None = None, force: bool = False,

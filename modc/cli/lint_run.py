@@ -7,38 +7,33 @@ modc.cli.lint, which reads it as before.
 from __future__ import annotations
 
 from .. import __version__
-from .common import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, Verbosity, _err, _expand, _print_diagnostics, run_like_click
+from .common import (
+    EXIT_ERRORS,
+    EXIT_OK,
+    EXIT_USAGE,
+    Verbosity,
+    _err,
+    _expand,
+    _print_diagnostics,
+    read_plain,
+    run_like_click,
+)
 
 FORMATS = ("text", "json", "github", "sarif")
-# option -> (its name in run(), the values it takes or None for any, or "flag")
+# option -> (its name in run(), the values it takes or None for any, or the flag's value): common.read_plain
 _OPTIONS = {"-f": ("format", FORMATS), "--format": ("format", FORMATS), "--library": ("library", None),
-            "--sarif-root": ("sarif_root", None), "-q": ("quiet", "flag"), "--quiet": ("quiet", "flag")}
+            "--sarif-root": ("sarif_root", None), "-q": ("quiet", True), "--quiet": ("quiet", True)}
 
 
 def plain_args(args: list[str]) -> dict | None:
     """run()'s arguments when args are a plain lint command line (every word an option spelled
     as in `modc lint --help` or a file, each option at most once, at least one file); else None."""
-    options: dict = {"files": []}
-    words = iter(args)
-    for word in words:
-        if not word.startswith("-"):
-            options["files"].append(word)
-            continue
-        name, _, inline = word.partition("=") if word.startswith("--") else (word, "", "")
-        spec = _OPTIONS.get(name)
-        if spec is None or spec[0] in options:
-            return None
-        key, values = spec
-        if values == "flag":
-            if inline or "=" in word:
-                return None
-            options[key] = True
-            continue
-        value = inline if "=" in word else next(words, None)
-        if value is None or value.startswith("-") or (values is not None and value not in values):
-            return None
-        options[key] = value
-    return options if options["files"] else None
+    def files(options: dict, word: str) -> bool:
+        options.setdefault("files", []).append(word)
+        return True
+
+    options = read_plain(args, _OPTIONS, files)
+    return options if options is not None and options.get("files") else None
 
 
 def run(files, format: str = "text", library: str | None = None, quiet: bool = False,
