@@ -173,3 +173,24 @@ def read_plain(args: list[str], table: dict, positional: Callable[[dict, str], b
             return None
         options[key] = value
     return options
+
+
+@contextmanager
+def ticking(every: float, tick: Callable[[], None], name: str):
+    """tick() every `every` seconds on a daemon thread while the block runs (the plain progress
+    lines of `modc plan` and `modc design` in a CI log)."""
+    import threading
+
+    stop = threading.Event()
+
+    def loop() -> None:
+        while not stop.wait(every):
+            tick()
+
+    thread = threading.Thread(target=loop, name=name, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join(timeout=max(1.0, every))

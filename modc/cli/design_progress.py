@@ -31,9 +31,10 @@ def _plain(name: str):
     planning or a large block of settings can take longer - so a CI log never goes quiet."""
     import threading
 
+    from .common import ticking
+
     lock = threading.Lock()
     last: dict[str, Any] = {"at": -1e9, "text": "", "since": time.monotonic()}
-    done = threading.Event()
 
     def say(text: str) -> None:
         print(f"modc design: {text}", file=sys.stderr, flush=True)
@@ -48,19 +49,13 @@ def _plain(name: str):
                 say(text)
 
     def heartbeat() -> None:
-        while not done.wait(min(1.0, PLAIN_EVERY / 4)):
-            with lock:
-                now = time.monotonic()
-                if last["text"] and now - last["at"] >= PLAIN_EVERY:
-                    say(f"{last['text']} (still at it, {_duration(now - last['since'])})")
+        with lock:
+            now = time.monotonic()
+            if last["text"] and now - last["at"] >= PLAIN_EVERY:
+                say(f"{last['text']} (still at it, {_duration(now - last['since'])})")
 
-    beat = threading.Thread(target=heartbeat, name="modc-design-progress", daemon=True)
-    beat.start()
-    try:
+    with ticking(min(1.0, PLAIN_EVERY / 4), heartbeat, "modc-design-progress"):
         yield plain
-    finally:
-        done.set()
-        beat.join()
 
 
 @contextmanager

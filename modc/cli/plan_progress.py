@@ -52,21 +52,14 @@ def progress(mode: str, task: str) -> Iterator[Status | None]:
         return
     status = Status(task)
     if mode == "plain":
-        stop = threading.Event()
+        from .common import ticking
 
-        def tick() -> None:
-            while True:
-                print(f"modc plan: {status.line()}", file=sys.stderr, flush=True)
-                if stop.wait(PLAIN_EVERY):
-                    return
+        def say() -> None:
+            print(f"modc plan: {status.line()}", file=sys.stderr, flush=True)
 
-        ticker = threading.Thread(target=tick, name="modc-plan-progress", daemon=True)
-        ticker.start()
-        try:
+        say()
+        with ticking(PLAIN_EVERY, say, "modc-plan-progress"):
             yield status
-        finally:
-            stop.set()
-            ticker.join(timeout=1.0)
         if status.kind == "done":
             print(f"modc plan: {status.line()}", file=sys.stderr, flush=True)
         return
