@@ -419,7 +419,7 @@ def test_ten_thousand_unit_chain_is_rejected_quickly():
     render_text(c.diagnostics, c.sources)
     cpu = time.process_time() - t0
     assert [(d.code, d.span.line) for d in c.diagnostics] == [("too-many-units", 2)]
-    assert "10000 units" in c.diagnostics[0].message
+    assert "10,000 units" in c.diagnostics[0].message
     assert cpu < CPU_LIMIT_S, f"{cpu:.2f} s of CPU time"
 
 
