@@ -101,6 +101,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
         tool = spec.problem.cell.tool
         g = geometry(types, pivots, ports, links, tool.xyz, tool.rpy)
     n, C = shape.n, len(pivots)
+    g.joints  # noqa: B018  (once: every take below carries them to the IK calls of every target and seed)
     tg = spec.targets
     T = len(tg.names)
     lo, hi = np.full(n, spec.lower), np.full(n, spec.upper)

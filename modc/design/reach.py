@@ -170,6 +170,26 @@ def _sq(v: np.ndarray) -> np.ndarray:
     return np.einsum("ib,ib->b", v, v)
 
 
+_JIT: list[bool] = []
+
+
+def jit() -> bool:
+    """Whether position-only runs take the compiled path (modc.design.reach_jit: numba installed
+    and MODC_NO_JIT unset); asked once per process, numba's import being heavy."""
+    import os
+
+    if os.environ.get("MODC_NO_JIT"):
+        return False
+    if not _JIT:
+        try:
+            import numba  # noqa: F401
+        except ImportError:
+            _JIT.append(False)
+        else:
+            _JIT.append(True)
+    return _JIT[0]
+
+
 def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
     """Runs from every seed q0 (S, n), or per candidate (C, S, n), towards every target, for
     every candidate of g. Returns q (C, T, S, n), position error (C, T, S) m, orientation error
@@ -186,6 +206,14 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
     ep_all, er_all = np.empty(B), np.zeros(B)
+    if not bool(np.asarray(tg.oriented).any()) and jit():
+        from . import reach_jit
+
+        # the same runs compiled (bit for bit: reach_jit's docstring); 6-D targets stay here
+        q_all, ep_all = reach_jit.solve_position(g.joints, c_idx, t_idx, tg.xyz, np.asarray(tg.tol_p, float)[t_idx]
+                                                 * STALL_FACTOR, q_all, lo, hi, iterations, STALL_EVERY,
+                                                 STALL_GAIN, LAMBDA0)
+        return q_all.T.reshape(C, T, S, n), ep_all.reshape(C, T, S), er_all.reshape(C, T, S)
     w = ROTATION_WEIGHT
     live = np.arange(B)
     q = q_all.copy()
