@@ -34,10 +34,7 @@ def spec():
 
 
 def _solve(monkeypatch, jit: bool, *args, **kw):
-    if jit:
-        monkeypatch.delenv("MODC_NO_JIT", raising=False)
-    else:
-        monkeypatch.setenv("MODC_NO_JIT", "1")
+    monkeypatch.setenv("MODC_JIT", "1" if jit else "0")
     assert reach.jit() is jit
     return reach.solve(*args, **kw)
 
@@ -83,3 +80,16 @@ def test_few_iterations_and_one_run_equal_too(monkeypatch, spec):
         a = _solve(monkeypatch, False, g, spec.targets.take(slice(0, 1)), np.zeros((1, 3)), lo, hi, it)
         b = _solve(monkeypatch, True, g, spec.targets.take(slice(0, 1)), np.zeros((1, 3)), lo, hi, it)
         assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+
+
+def test_a_process_loads_the_compiled_path_only_after_enough_runs(monkeypatch):
+    monkeypatch.delenv("MODC_JIT", raising=False)
+    monkeypatch.setattr(reach, "_NUMPY_RUNS", [0])
+    assert not reach.jit(reach.JIT_AFTER - 1)
+    assert not reach.jit(1)
+    assert reach.jit(1)
+    monkeypatch.setenv("MODC_JIT", "0")
+    assert not reach.jit(1)
+    monkeypatch.setattr(reach, "_JIT", [False])  # numba missing: the numpy path, whatever is asked
+    monkeypatch.setenv("MODC_JIT", "1")
+    assert not reach.jit(1)

@@ -171,14 +171,23 @@ def _sq(v: np.ndarray) -> np.ndarray:
 
 
 _JIT: list[bool] = []
+JIT_AFTER = 50_000  # runs solved with numpy before a process loads the compiled path (see jit())
+_NUMPY_RUNS = [0]
 
 
-def jit() -> bool:
-    """Whether position-only runs take the compiled path (modc.design.reach_jit: numba installed
-    and MODC_NO_JIT unset); asked once per process, numba's import being heavy."""
+def jit(runs: int = 0) -> bool:
+    """Whether `runs` position-only runs take the compiled path (modc.design.reach_jit, numba).
+    Both paths return the same bits, so when to switch is a matter of cost only: importing numba
+    and loading the cached kernel take ~0.9 s CPU per process, so a process switches once it has
+    solved JIT_AFTER runs with numpy (~0.5 s) - a short search never pays for it. MODC_JIT=0
+    never switches, MODC_JIT=1 at once; without numba installed the numpy path always runs."""
     import os
 
-    if os.environ.get("MODC_NO_JIT"):
+    mode = os.environ.get("MODC_JIT", "")
+    if mode == "0":
+        return False
+    if mode != "1" and _NUMPY_RUNS[0] < JIT_AFTER:
+        _NUMPY_RUNS[0] += runs
         return False
     if not _JIT:
         try:
@@ -206,7 +215,7 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
     ep_all, er_all = np.empty(B), np.zeros(B)
-    if not bool(np.asarray(tg.oriented).any()) and jit():
+    if not bool(np.asarray(tg.oriented).any()) and jit(B):
         from . import reach_jit
 
         # the same runs compiled (bit for bit: reach_jit's docstring); 6-D targets stay here
