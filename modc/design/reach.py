@@ -199,18 +199,19 @@ def jit(runs: int = 0) -> bool:
     return _JIT[0]
 
 
-def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
+def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS,
+          rows: np.ndarray | None = None):
     """Runs from every seed q0 (S, n), or per candidate (C, S, n), towards every target, for
-    every candidate of g. Returns q (C, T, S, n), position error (C, T, S) m, orientation error
-    (C, T, S) rad.
+    every candidate of g (or its candidates `rows`, without copying g's arrays for them). Returns
+    q (C, T, S, n), position error (C, T, S) m, orientation error (C, T, S) rad.
 
     The runs are one flat batch; a run leaves it when it is within 1e-7 m (and 1e-6 rad) of its target or
     stalls (its damping saturates), so late iterations cost only what is still moving. Targets
     without an orientation take a position-only path: no tool rotation, three residual rows."""
-    C, n, T, S = g.pre.shape[0], g.dof, len(tg.names), q0.shape[-2]
+    C, n, T, S = g.pre.shape[0] if rows is None else len(rows), g.dof, len(tg.names), q0.shape[-2]
     lo, hi = np.asarray(lower, float)[:, None], np.asarray(upper, float)[:, None]
     B = C * T * S
-    c_idx = np.repeat(np.arange(C), T * S)
+    c_idx = np.repeat(np.arange(C) if rows is None else np.asarray(rows), T * S)
     t_idx = np.tile(np.repeat(np.arange(T), S), C)
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
