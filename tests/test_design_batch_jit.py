@@ -93,3 +93,22 @@ def test_a_process_loads_the_compiled_path_only_after_enough_runs(monkeypatch):
     monkeypatch.setattr(reach, "_JIT", [False])  # numba missing: the numpy path, whatever is asked
     monkeypatch.setenv("MODC_JIT", "1")
     assert not reach.jit(1)
+
+
+def test_a_design_run_ranks_the_same_with_either_path(monkeypatch):
+    """End to end on a small cell: the designs, their joint vectors (the candidates' solutions, to
+    the bit) and the search's counts."""
+    from conftest import SMALL_CELL
+
+    from modc.design import run
+
+    c = check_text(SMALL_CELL, "small.mod")
+    assert c.ok, c.diagnostics
+    out = {}
+    for mode in ("0", "1"):
+        monkeypatch.setenv("MODC_JIT", mode)
+        o = run.design(c.design.problems[0], top=3, seed=0)
+        out[mode] = ([(d.chain(), d.mass, d.margin, d.candidate.solutions) for d in o.designs], o.evaluated,
+                     o.excluded, o.complete)
+    assert out["0"][0]
+    assert out["0"] == out["1"]

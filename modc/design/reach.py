@@ -191,11 +191,11 @@ def jit(runs: int = 0) -> bool:
         return False
     if not _JIT:
         try:
-            import numba  # noqa: F401
-        except ImportError:
+            from . import reach_jit  # noqa: F401  (numba; its cache needs a writable folder)
+        except Exception:  # noqa: BLE001 - numba missing or unusable here: the numpy path
             _JIT.append(False)
         else:
-            _JIT.append(True)
+            _JIT.append(reach_jit.numba is not None)
     return _JIT[0]
 
 
