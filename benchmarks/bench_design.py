@@ -2,6 +2,7 @@
 
     python benchmarks/bench_design.py                 # everything, Timor if installed
     python benchmarks/bench_design.py --quick         # smaller samples, no whole-library run
+    python benchmarks/bench_design.py --solve         # only measurements 1-2 and the JIT's cost (with --quick too)
     python benchmarks/bench_design.py --timor ROOT    # ROOT: a venv with timor-python installed (ROOT/bin/python)
     python benchmarks/bench_design.py --json [OUT]
     python benchmarks/bench_design.py --beyond 4 [5 6]   # only measurement 7, units 1-4 [1-5, 1-6]
@@ -418,12 +419,21 @@ def bench_dask(shapes: int) -> dict | None:
     from modc.design import search, space
     from modc.design.evaluate import Spec
 
-    # five-unit shapes of the three-target cell searched on their coarse grid: targets in reach, so
-    # each is real work of one size (a cell the family bounds close would time only the scheduling)
+    # five-unit shapes of the three-target cell: targets in reach, so each unit is real work (a cell
+    # the family bounds close would time only the scheduling)
     prob = _problem(CELL.replace("units 2 to 3", "units 5"))
     spec = Spec.of(prob)
-    coarse = [s for s in space.shapes(prob, 5)[::-1] if not search.plan(spec, s).complete][:shapes]
-    work = [w for s in coarse for w in search.parts_of(spec, s)]
+    # shapes whose plan leaves settings to screen (searched by level or in full: most 5-unit
+    # shapes of this cell are complete by dominance now, none on the coarse grid), `shapes` of them
+    work: list = []
+    picked = 0
+    for s in space.shapes(prob, 5)[::-1]:
+        units = [w for w in search.parts_of(spec, s) if any(b > a for a, b in w[1])]
+        if units:
+            work += units
+            picked += 1
+        if picked == shapes:
+            break
     out: dict = {"tasks": len(work)}
     for n in (1, 2):
         with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -515,40 +525,9 @@ def bench_timor(root: Path, designs: int) -> dict | None:
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--timor", default=os.environ.get("TIMOR_ROOT", "/tmp/timor-offline"),
-                    help="a venv with timor-python installed (ROOT/bin/python)")
-    ap.add_argument("--json", nargs="?", const="-", default=None)
-    ap.add_argument("--beyond", nargs="+", type=int, metavar="UNITS",
-                    help="only measurement 7: units 1 to each UNITS (4 in this process, 5-6 on --workers 2)")
-    args = ap.parse_args()
-    warnings.simplefilter("ignore")
-    if args.beyond:
-        b = bench_beyond(args.beyond)
-        print("\n".join(_beyond_lines(b)), file=sys.stderr)
-        if args.json is not None:
-            print(json.dumps(b, indent=2))
-        return
-    result: dict = {"machine": platform.processor() or platform.machine(), "python": platform.python_version()}
-    # before pinning (the worker processes would inherit one core)
-    result["library"] = bench_library(4 if args.quick else 16, whole=not args.quick)
-    result["dask"] = bench_dask(8 if args.quick else 24)
-    result["core"] = pin_one_core()
-    result["candidate"] = bench_candidates(2048 if args.quick else 8192)
-    result["reference"] = bench_reference(48 if args.quick else 192)
-    result["solve"] = bench_solve(1 if args.quick else 2)
-    result["jit_cost"] = bench_jit_cost()
-    result["complete"] = bench_complete()
-    from bench_task import bench_region, bench_visit  # the task goals and base placement, side by side
-    from bench_task_base import bench_base
-
-    result["task"] = {"visit": bench_visit(), "region": bench_region()}
-    result["base_placement"] = bench_base()
-    result["anchor"] = bench_timor(Path(args.timor), 10 if args.quick else 40)
-    c, r, s, k, lib = (result[x] for x in ("candidate", "reference", "solve", "complete", "library"))
-    a = result["anchor"]
+def _screen_lines(result: dict) -> list[str]:
+    """The lines of measurements 1-2 and the JIT's cost."""
+    c, r, s = (result[x] for x in ("candidate", "reference", "solve"))
     h = c["hard"]
     lines = [f"candidate  {c['ms_per_candidate']:.4f} ms CPU per twist setting ({c['targets']} targets, all "
              f"{c['settings']:,} settings of {c['shape']}: {c['excluded']:,} excluded by the bounds, {c['screened']:,} "
@@ -564,14 +543,65 @@ def main() -> None:
              f"({s['seconds_wall']:.1f} s wall; goal 10 s; numpy IK {s['numpy']['seconds_cpu']:.1f} s), "
              f"{s['evaluated']:,} settings over {s['shapes']} shapes, complete={s['complete']}; best {s['best']}; "
              f"--top 1: {s['top_1']['seconds_cpu']:.2f} s CPU; load average "
-             f"{', '.join(f'{x:.1f}' for x in s['load_average'])}",
-             f"complete   nothing feasible, units 1-3: {k['seconds_cpu']:.1f} s CPU, {k['evaluated']:,} settings "
-             f"({k['excluded']:,} excluded by bounds), complete={k['complete']}: {k['why_none']}"]
+             f"{', '.join(f'{x:.1f}' for x in s['load_average'])}"]
     j = result["jit_cost"]
     if j:
         lines.append(f"jit        numba import {j['cached']['import_s']:.2f} s + cached kernel "
                      f"{j['cached']['first_call_s']:.2f} s CPU per process that switches to it; first compile "
                      f"{j['cold']['first_call_s']:.1f} s CPU (once, then cached)")
+    return lines
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--timor", default=os.environ.get("TIMOR_ROOT", "/tmp/timor-offline"),
+                    help="a venv with timor-python installed (ROOT/bin/python)")
+    ap.add_argument("--json", nargs="?", const="-", default=None)
+    ap.add_argument("--solve", action="store_true", help="only measurements 1-2 and the JIT's cost")
+    ap.add_argument("--beyond", nargs="+", type=int, metavar="UNITS",
+                    help="only measurement 7: units 1 to each UNITS (4 in this process, 5-6 on --workers 2)")
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")
+    if args.beyond:
+        b = bench_beyond(args.beyond)
+        print("\n".join(_beyond_lines(b)), file=sys.stderr)
+        if args.json is not None:
+            print(json.dumps(b, indent=2))
+        return
+    result: dict = {"machine": platform.processor() or platform.machine(), "python": platform.python_version()}
+    if args.solve:
+        result["core"] = pin_one_core()
+        result["candidate"] = bench_candidates(2048 if args.quick else 8192)
+        result["reference"] = bench_reference(48 if args.quick else 192)
+        result["solve"] = bench_solve(1 if args.quick else 2)
+        result["jit_cost"] = bench_jit_cost()
+        print("\n".join(_screen_lines(result)), file=sys.stderr)
+        if args.json == "-":
+            print(json.dumps(result, indent=2))
+        elif args.json is not None:
+            Path(args.json).write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+        return
+    # before pinning (the worker processes would inherit one core)
+    result["library"] = bench_library(4 if args.quick else 16, whole=not args.quick)
+    result["dask"] = bench_dask(8 if args.quick else 24)
+    result["core"] = pin_one_core()
+    result["candidate"] = bench_candidates(2048 if args.quick else 8192)
+    result["reference"] = bench_reference(48 if args.quick else 192)
+    result["solve"] = bench_solve(1 if args.quick else 2)
+    result["jit_cost"] = bench_jit_cost()
+    result["complete"] = bench_complete()
+    from bench_task import bench_region, bench_visit  # the task goals and base placement, side by side
+    from bench_task_base import bench_base
+
+    result["task"] = {"visit": bench_visit(), "region": bench_region()}
+    result["base_placement"] = bench_base()
+    result["anchor"] = bench_timor(Path(args.timor), 10 if args.quick else 40)
+    c, k, lib = (result[x] for x in ("candidate", "complete", "library"))
+    a = result["anchor"]
+    lines = _screen_lines(result)
+    lines.append(f"complete   nothing feasible, units 1-3: {k['seconds_cpu']:.1f} s CPU, {k['evaluated']:,} settings "
+                 f"({k['excluded']:,} excluded by bounds), complete={k['complete']}: {k['why_none']}")
     for name, t in result["task"].items():
         lines.append(f"task       {name}: {t['seconds_cpu']:.1f} s CPU (goal {t['goal_cpu_s']:.0f} s; search "
                      f"{t['static_search_cpu_s']:.1f} s, planning {t['planning_cpu_s']:.1f} s); best {t['best']} "
