@@ -195,7 +195,7 @@ def jit(runs: int = 0) -> bool:
         except Exception:  # noqa: BLE001 - numba missing or unusable here: the numpy path
             _JIT.append(False)
         else:
-            _JIT.append(reach_jit.numba is not None)
+            _JIT.append(reach_jit.numba is not None and reach_jit.matches_numpy())
     return _JIT[0]
 
 

@@ -240,6 +240,24 @@ def _solve_position(joints, c_idx, t_idx, xyz, give_up, q, lo, hi, iterations, s
     return q_out, ep_out
 
 
+def matches_numpy() -> bool:
+    """Whether numpy's einsum here sums three terms as _s3 assumes (in order over a batch; (a + c)
+    + b for a batch of one, as its SIMD kernels of 2, 4 or 8 lanes do): else the kernel would not
+    return numpy's bits, and reach.jit keeps the numpy path."""
+    rng = np.random.default_rng(0)
+    for B in (1, 2, 5):
+        for _ in range(16):
+            J, e = rng.normal(size=(3, 3, B)), rng.normal(size=(3, B))
+            x = J[:, 0] * e[0], J[:, 1] * e[1], J[:, 2] * e[2]
+            want = (x[0] + x[2]) + x[1] if B == 1 else (x[0] + x[1]) + x[2]
+            sq = e[0] * e[0], e[1] * e[1], e[2] * e[2]
+            want_sq = (sq[0] + sq[2]) + sq[1] if B == 1 else (sq[0] + sq[1]) + sq[2]
+            if not (np.array_equal(np.einsum("ikb,kb->ib", J, e), want)
+                    and np.array_equal(np.einsum("ib,ib->b", e, e), want_sq)):
+                return False
+    return True
+
+
 def solve_position(joints: np.ndarray, c_idx: np.ndarray, t_idx: np.ndarray, xyz: np.ndarray, give_up: np.ndarray,
                    q: np.ndarray, lo: np.ndarray, hi: np.ndarray, iterations: int, stall_every: int,
                    stall_gain: float, lambda0: float):
