@@ -2,6 +2,7 @@
 
     python benchmarks/bench_design.py                 # everything, Timor if installed
     python benchmarks/bench_design.py --quick         # smaller samples, no whole-library run
+    python benchmarks/bench_design.py --solve         # only measurements 1-2 and the JIT's cost (with --quick too)
     python benchmarks/bench_design.py --timor ROOT    # ROOT: a venv with timor-python installed (ROOT/bin/python)
     python benchmarks/bench_design.py --json [OUT]
     python benchmarks/bench_design.py --beyond 4 [5 6]   # only measurement 7, units 1-4 [1-5, 1-6]
@@ -18,11 +19,18 @@ thread), so other load on the machine does not count; wall figures are time.perf
                settings that reached the IK: the goal's figure (<= 0.1 ms). The hardest range
                (4-4-3: most settings pass the bounds, many solve all targets) likewise, and the
                case where every candidate solves all three (the farm arm's twists, repeated).
+               The IK runs compiled (numba, modc/design/reach_jit.py, when installed); the whole
+               shape again with the numpy path (MODC_JIT=0) gives "with the numpy IK".
    reference   the same screen written plainly: one candidate at a time, numpy on small arrays
                (docs/conventions.md FK, DLS from the same 4 seeds, 40 iterations, the first target
                missed ends it), no bounds, no batching: CPU ms per candidate.
 2. solve       run.design on the three-target cell with at most 3 modules, --top 5 (the command
-               line's default, the goal's figure) and --top 1: CPU s.
+               line's default, the goal's figure) and --top 1: CPU s. --top 5 runs with the compiled
+               IK and with the numpy path (MODC_JIT=0), alternating, twice each (once with --quick):
+               the smaller CPU time of each; the process has loaded numba already (a fresh
+               `modc design` loads it once it has solved 50,000 IK runs: the "jit" line's cost).
+   jit         numba's import and the kernel's first call in a fresh process: with an empty cache
+               (the compile, once per install) and with the cache (every process that switches).
 3. complete    run.design on a cell where nothing is feasible, units 1 to 3, every unit type:
                every setting of every shape screened or excluded (CPU s, settings, excluded).
 4. library     `modc design --workers 2` on two cells nothing can serve, units 1 to 6, every unit
@@ -166,13 +174,19 @@ def bench_candidates(count: int) -> dict:
 
     spec = Spec.of(problem())
     whole = Shape((1, 4, 3), (None, None, None))
-    search.search_part(spec, whole, ((0, 256),), 0)  # warm up (imports, caches)
+    _path(True)
+    search.search_part(spec, whole, ((0, 256),), 0)  # warm up (imports, caches, numba's kernel)
     t = time.process_time()
     res = search.search_shape(spec, whole, 0)
     cpu = time.process_time() - t
     out = {"shape": whole.label(), "settings": res.evaluated, "targets": 3,
            "ms_per_candidate": 1e3 * cpu / res.evaluated, "screened": res.screened, "excluded": res.excluded,
            "ms_per_screened": 1e3 * cpu / max(res.screened, 1)}
+    _path(False)  # the numpy path on the same shape (MODC_JIT=0)
+    t = time.process_time()
+    search.search_shape(spec, whole, 0)
+    out["numpy_ms_per_screened"] = 1e3 * (time.process_time() - t) / max(res.screened, 1)
+    _path(True)
     # the hardest range met: most settings of 4-4-3 there pass the bounds and many solve all targets
     shape = Shape((4, 4, 3), (None, None, None))
     lo = search.size(spec, shape) // 3
@@ -291,9 +305,61 @@ def _design(text: str, **kw) -> dict:
             "why_none": None if o.designs else o.why_none()}
 
 
-def bench_solve() -> dict:
-    """The three-target cell with --top 5 (the command line's default: the goal's figure) and --top 1."""
-    return {**_design(CELL, top=5, seed=0), "top_1": _design(CELL, top=1, seed=0)}
+def _path(jit: bool):
+    """Run the screen's IK compiled (numba: modc.design.reach_jit) or in numpy from now on."""
+    os.environ["MODC_JIT"] = "1" if jit else "0"
+
+
+def bench_solve(reps: int) -> dict:
+    """The three-target cell with --top 5 (the command line's default: the goal's figure) and --top 1,
+    with the compiled IK and with the numpy path (MODC_JIT=0), alternating, reps times each: the
+    smallest CPU time of each (the same ranking: the two paths return the same bits)."""
+    runs: dict[str, list[dict]] = {"jit": [], "numpy": []}
+    for _ in range(reps):
+        for name in runs:
+            _path(name == "jit")
+            runs[name].append(_design(CELL, top=5, seed=0))
+    _path(True)
+    best = {k: min(v, key=lambda r: r["seconds_cpu"]) for k, v in runs.items()}
+    assert best["jit"]["best"] == best["numpy"]["best"]
+    return {**best["jit"], "numpy": best["numpy"], "all_cpu_s": {k: [r["seconds_cpu"] for r in v] for k, v in
+                                                                  runs.items()},
+            "top_1": _design(CELL, top=1, seed=0), "load_average": os.getloadavg()}
+
+
+JIT_COST = r"""
+import sys, time
+t = time.process_time()
+import numpy as np
+from modc.design import reach_jit
+t1 = time.process_time()
+C, n = 4, 3
+reach_jit.solve_position(np.tile(np.eye(4), (C, n + 1, 1, 1)), np.arange(C), np.zeros(C, int), np.ones((1, 3)),
+                         np.full(C, 0.01), np.zeros((n, C)), -np.ones(n), np.ones(n), 40, 5, 0.5, 1e-2)
+print(t1 - t, time.process_time() - t1)
+"""
+
+
+def bench_jit_cost() -> dict | None:
+    """What the compiled path costs a process: numba's import and the kernel's first call, with an
+    empty cache (the compile, once per install) and then with the cache (every process that
+    switches to it: modc.design.reach.jit)."""
+    import tempfile
+
+    from _common import child_env
+
+    try:
+        import numba  # noqa: F401
+    except ImportError:
+        return None
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in ("cold", "cached"):
+            p = subprocess.run([sys.executable, "-c", JIT_COST], capture_output=True, text=True,
+                               env=dict(child_env(), NUMBA_CACHE_DIR=tmp), check=True)
+            imp, first = (float(x) for x in p.stdout.split())
+            out[name] = {"import_s": imp, "first_call_s": first}
+    return out
 
 
 def bench_complete() -> dict:
@@ -353,12 +419,21 @@ def bench_dask(shapes: int) -> dict | None:
     from modc.design import search, space
     from modc.design.evaluate import Spec
 
-    # five-unit shapes of the three-target cell searched on their coarse grid: targets in reach, so
-    # each is real work of one size (a cell the family bounds close would time only the scheduling)
+    # five-unit shapes of the three-target cell: targets in reach, so each unit is real work (a cell
+    # the family bounds close would time only the scheduling)
     prob = _problem(CELL.replace("units 2 to 3", "units 5"))
     spec = Spec.of(prob)
-    coarse = [s for s in space.shapes(prob, 5)[::-1] if not search.plan(spec, s).complete][:shapes]
-    work = [w for s in coarse for w in search.parts_of(spec, s)]
+    # shapes whose plan leaves settings to screen (searched by level or in full: most 5-unit
+    # shapes of this cell are complete by dominance now, none on the coarse grid), `shapes` of them
+    work: list = []
+    picked = 0
+    for s in space.shapes(prob, 5)[::-1]:
+        units = [w for w in search.parts_of(spec, s) if any(b > a for a, b in w[1])]
+        if units:
+            work += units
+            picked += 1
+        if picked == shapes:
+            break
     out: dict = {"tasks": len(work)}
     for n in (1, 2):
         with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -450,12 +525,40 @@ def bench_timor(root: Path, designs: int) -> dict | None:
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
+def _screen_lines(result: dict) -> list[str]:
+    """The lines of measurements 1-2 and the JIT's cost."""
+    c, r, s = (result[x] for x in ("candidate", "reference", "solve"))
+    h = c["hard"]
+    lines = [f"candidate  {c['ms_per_candidate']:.4f} ms CPU per twist setting ({c['targets']} targets, all "
+             f"{c['settings']:,} settings of {c['shape']}: {c['excluded']:,} excluded by the bounds, {c['screened']:,} "
+             f"screened = {c['ms_per_screened']:.3f} ms each, {c['numpy_ms_per_screened']:.3f} ms with the numpy "
+             f"IK); hardest range ({h['settings']:,} of {h['shape']}, "
+             f"{h['screened']:,} screened): {h['ms_per_screened']:.3f} ms each; "
+             f"{c['ms_per_candidate_all_targets']:.3f} ms when every candidate solves all 3; exact check of one "
+             f"design {c.get('verify_ms', float('nan')):.0f} ms; "
+             f"load average {', '.join(f'{x:.1f}' for x in c['load_average'])}",
+             f"reference  {r['ms_per_candidate']:.2f} ms CPU per candidate, plain numpy one at a time "
+             f"({r['settings']} settings): {r['ms_per_candidate'] / c['ms_per_candidate']:.0f}x modc",
+             f"solve      3 targets, <= 3 modules, --top 5: {s['seconds_cpu']:.1f} s CPU "
+             f"({s['seconds_wall']:.1f} s wall; goal 10 s; numpy IK {s['numpy']['seconds_cpu']:.1f} s), "
+             f"{s['evaluated']:,} settings over {s['shapes']} shapes, complete={s['complete']}; best {s['best']}; "
+             f"--top 1: {s['top_1']['seconds_cpu']:.2f} s CPU; load average "
+             f"{', '.join(f'{x:.1f}' for x in s['load_average'])}"]
+    j = result["jit_cost"]
+    if j:
+        lines.append(f"jit        numba import {j['cached']['import_s']:.2f} s + cached kernel "
+                     f"{j['cached']['first_call_s']:.2f} s CPU per process that switches to it; first compile "
+                     f"{j['cold']['first_call_s']:.1f} s CPU (once, then cached)")
+    return lines
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--timor", default=os.environ.get("TIMOR_ROOT", "/tmp/timor-offline"),
                     help="a venv with timor-python installed (ROOT/bin/python)")
     ap.add_argument("--json", nargs="?", const="-", default=None)
+    ap.add_argument("--solve", action="store_true", help="only measurements 1-2 and the JIT's cost")
     ap.add_argument("--beyond", nargs="+", type=int, metavar="UNITS",
                     help="only measurement 7: units 1 to each UNITS (4 in this process, 5-6 on --workers 2)")
     args = ap.parse_args()
@@ -467,13 +570,26 @@ def main() -> None:
             print(json.dumps(b, indent=2))
         return
     result: dict = {"machine": platform.processor() or platform.machine(), "python": platform.python_version()}
+    if args.solve:
+        result["core"] = pin_one_core()
+        result["candidate"] = bench_candidates(2048 if args.quick else 8192)
+        result["reference"] = bench_reference(48 if args.quick else 192)
+        result["solve"] = bench_solve(1 if args.quick else 2)
+        result["jit_cost"] = bench_jit_cost()
+        print("\n".join(_screen_lines(result)), file=sys.stderr)
+        if args.json == "-":
+            print(json.dumps(result, indent=2))
+        elif args.json is not None:
+            Path(args.json).write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+        return
     # before pinning (the worker processes would inherit one core)
     result["library"] = bench_library(4 if args.quick else 16, whole=not args.quick)
     result["dask"] = bench_dask(8 if args.quick else 24)
     result["core"] = pin_one_core()
     result["candidate"] = bench_candidates(2048 if args.quick else 8192)
     result["reference"] = bench_reference(48 if args.quick else 192)
-    result["solve"] = bench_solve()
+    result["solve"] = bench_solve(1 if args.quick else 2)
+    result["jit_cost"] = bench_jit_cost()
     result["complete"] = bench_complete()
     from bench_task import bench_region, bench_visit  # the task goals and base placement, side by side
     from bench_task_base import bench_base
@@ -481,23 +597,11 @@ def main() -> None:
     result["task"] = {"visit": bench_visit(), "region": bench_region()}
     result["base_placement"] = bench_base()
     result["anchor"] = bench_timor(Path(args.timor), 10 if args.quick else 40)
-    c, r, s, k, lib = (result[x] for x in ("candidate", "reference", "solve", "complete", "library"))
+    c, k, lib = (result[x] for x in ("candidate", "complete", "library"))
     a = result["anchor"]
-    h = c["hard"]
-    lines = [f"candidate  {c['ms_per_candidate']:.4f} ms CPU per twist setting ({c['targets']} targets, all "
-             f"{c['settings']:,} settings of {c['shape']}: {c['excluded']:,} excluded by the bounds, {c['screened']:,} "
-             f"screened = {c['ms_per_screened']:.3f} ms each); hardest range ({h['settings']:,} of {h['shape']}, "
-             f"{h['screened']:,} screened): {h['ms_per_screened']:.3f} ms each; "
-             f"{c['ms_per_candidate_all_targets']:.3f} ms when every candidate solves all 3; exact check of one "
-             f"design {c.get('verify_ms', float('nan')):.0f} ms; "
-             f"load average {', '.join(f'{x:.1f}' for x in c['load_average'])}",
-             f"reference  {r['ms_per_candidate']:.2f} ms CPU per candidate, plain numpy one at a time "
-             f"({r['settings']} settings): {r['ms_per_candidate'] / c['ms_per_candidate']:.0f}x modc",
-             f"solve      3 targets, <= 3 modules, --top 5: {s['seconds_cpu']:.1f} s CPU "
-             f"({s['seconds_wall']:.1f} s wall; goal 10 s), {s['evaluated']:,} settings over {s['shapes']} shapes, "
-             f"complete={s['complete']}; best {s['best']}; --top 1: {s['top_1']['seconds_cpu']:.1f} s CPU",
-             f"complete   nothing feasible, units 1-3: {k['seconds_cpu']:.1f} s CPU, {k['evaluated']:,} settings "
-             f"({k['excluded']:,} excluded by bounds), complete={k['complete']}: {k['why_none']}"]
+    lines = _screen_lines(result)
+    lines.append(f"complete   nothing feasible, units 1-3: {k['seconds_cpu']:.1f} s CPU, {k['evaluated']:,} settings "
+                 f"({k['excluded']:,} excluded by bounds), complete={k['complete']}: {k['why_none']}")
     for name, t in result["task"].items():
         lines.append(f"task       {name}: {t['seconds_cpu']:.1f} s CPU (goal {t['goal_cpu_s']:.0f} s; search "
                      f"{t['static_search_cpu_s']:.1f} s, planning {t['planning_cpu_s']:.1f} s); best {t['best']} "

@@ -98,11 +98,12 @@ def residual_plain(runs, R_tool, t_tool):
     return e_p, e_r
 
 
-def solve_plain(g, tg, q0, lower, upper, iterations=None):
-    """modc.design.reach.solve before the fast path, step for step."""
+def solve_plain(g, tg, q0, lower, upper, iterations=None, rows=None):
+    """modc.design.reach.solve before the fast path, step for step (rows: g's candidates to solve)."""
     from modc.design import reach
     from modc.design.batch import Flat
 
+    g = g if rows is None else g.take(rows)
     iterations = reach.ITERATIONS if iterations is None else iterations
     C, n, T, S = g.pre.shape[0], g.dof, len(tg.names), q0.shape[-2]
     lo, hi = np.asarray(lower, float)[:, None], np.asarray(upper, float)[:, None]

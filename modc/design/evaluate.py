@@ -101,6 +101,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
         tool = spec.problem.cell.tool
         g = geometry(types, pivots, ports, links, tool.xyz, tool.rpy)
     n, C = shape.n, len(pivots)
+    g.joints  # noqa: B018  (once: the IK calls of every target and seed index them)
     tg = spec.targets
     T = len(tg.names)
     lo, hi = np.full(n, spec.lower), np.full(n, spec.upper)
@@ -134,9 +135,8 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
             # iterations more than its runs)
             group = seeds if seeds[0] < SEEDS and need.size <= FEW else seeds[:1]
             seeds = seeds[len(group):]
-            sub = g.take(need)
             start = q[need, warm, hit[need, warm].argmax(-1)][:, None] if group == [SEEDS] else q0[group]
-            qt, ept, ert = reach.solve(sub, _sub_targets(tg, t), start, lo, hi)
+            qt, ept, ert = reach.solve(g, _sub_targets(tg, t), start, lo, hi, rows=need)
             got = np.zeros(need.size, bool)
             for j, s in enumerate(group):
                 r = ept[:, 0, j] / max(tg.tol_p[t], 1e-12)
@@ -147,7 +147,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
                 if h.any() and len(spec.obstacles.shape):
                     # only the runs that reached their target are worth a collision test
                     c = np.flatnonzero(h)
-                    one = sub.take(c)
+                    one = g.take(need[c])
                     _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
                     h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
                 q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r

@@ -170,22 +170,60 @@ def _sq(v: np.ndarray) -> np.ndarray:
     return np.einsum("ib,ib->b", v, v)
 
 
-def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS):
+_JIT: list[bool] = []
+JIT_AFTER = 50_000  # runs solved with numpy before a process loads the compiled path (see jit())
+_NUMPY_RUNS = [0]
+
+
+def jit(runs: int = 0) -> bool:
+    """Whether `runs` position-only runs take the compiled path (modc.design.reach_jit, numba).
+    Both paths return the same bits, so when to switch is a matter of cost only: importing numba
+    and loading the cached kernel take ~0.9 s CPU per process, so a process switches once it has
+    solved JIT_AFTER runs with numpy (~0.5 s) - a short search never pays for it. MODC_JIT=0
+    never switches, MODC_JIT=1 at once; without numba installed the numpy path always runs."""
+    import os
+
+    mode = os.environ.get("MODC_JIT", "")
+    if mode == "0":
+        return False
+    if mode != "1" and _NUMPY_RUNS[0] < JIT_AFTER:
+        _NUMPY_RUNS[0] += runs
+        return False
+    if not _JIT:
+        try:
+            from . import reach_jit  # noqa: F401  (numba; its cache needs a writable folder)
+        except Exception:  # noqa: BLE001 - numba missing or unusable here: the numpy path
+            _JIT.append(False)
+        else:
+            _JIT.append(reach_jit.numba is not None and reach_jit.matches_numpy())
+    return _JIT[0]
+
+
+def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS,
+          rows: np.ndarray | None = None):
     """Runs from every seed q0 (S, n), or per candidate (C, S, n), towards every target, for
-    every candidate of g. Returns q (C, T, S, n), position error (C, T, S) m, orientation error
-    (C, T, S) rad.
+    every candidate of g (or its candidates `rows`, without copying g's arrays for them). Returns
+    q (C, T, S, n), position error (C, T, S) m, orientation error (C, T, S) rad.
 
     The runs are one flat batch; a run leaves it when it is within 1e-7 m (and 1e-6 rad) of its target or
     stalls (its damping saturates), so late iterations cost only what is still moving. Targets
     without an orientation take a position-only path: no tool rotation, three residual rows."""
-    C, n, T, S = g.pre.shape[0], g.dof, len(tg.names), q0.shape[-2]
+    C, n, T, S = g.pre.shape[0] if rows is None else len(rows), g.dof, len(tg.names), q0.shape[-2]
     lo, hi = np.asarray(lower, float)[:, None], np.asarray(upper, float)[:, None]
     B = C * T * S
-    c_idx = np.repeat(np.arange(C), T * S)
+    c_idx = np.repeat(np.arange(C) if rows is None else np.asarray(rows), T * S)
     t_idx = np.tile(np.repeat(np.arange(T), S), C)
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
     ep_all, er_all = np.empty(B), np.zeros(B)
+    if not bool(np.asarray(tg.oriented).any()) and jit(B):
+        from . import reach_jit
+
+        # the same runs compiled (bit for bit: reach_jit's docstring); 6-D targets stay here
+        q_all, ep_all = reach_jit.solve_position(g.joints, c_idx, t_idx, tg.xyz, np.asarray(tg.tol_p, float)[t_idx]
+                                                 * STALL_FACTOR, q_all, lo, hi, iterations, STALL_EVERY,
+                                                 STALL_GAIN, LAMBDA0)
+        return q_all.T.reshape(C, T, S, n), ep_all.reshape(C, T, S), er_all.reshape(C, T, S)
     w = ROTATION_WEIGHT
     live = np.arange(B)
     q = q_all.copy()
