@@ -123,3 +123,23 @@ def test_numpy_summing_in_another_order_keeps_the_numpy_path(monkeypatch):
     monkeypatch.setattr(reach_jit, "matches_numpy", lambda: False)
     monkeypatch.setenv("MODC_JIT", "1")
     assert not reach.jit(1)
+
+
+@pytest.mark.slow
+def test_the_compiled_kernel_is_cached_outside_the_source_tree(tmp_path):
+    """numba's default cache is a __pycache__ beside the source (the checkout, or site-packages):
+    modc's kernel goes to the user's cache (XDG_CACHE_HOME) instead, and the tree stays as it was."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    before = sorted(str(p) for p in (root / "modc").rglob("*.nb[ic]"))
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(XDG_CACHE_HOME=str(tmp_path), PYTHONPATH=str(root))
+    r = subprocess.run([sys.executable, "-c", "from modc.design import reach_jit; reach_jit._s3(1.0, 2.0, 3.0, False)"],
+                       env=env, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert list((tmp_path / "modc-numba").rglob("*.nbi"))  # compiled once, kept for the next process
+    assert sorted(str(p) for p in (root / "modc").rglob("*.nb[ic]")) == before

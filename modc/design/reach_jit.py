@@ -13,20 +13,46 @@ from __future__ import annotations
 
 import numpy as np
 
+
+def _cache_dir() -> str | None:
+    """Where numba keeps the compiled kernel: NUMBA_CACHE_DIR when the user set it, else a
+    folder of the user's cache shared by every modc cache (the kernel depends on modc's source and
+    numba alone, and compiling it takes ~10 s); None with MODC_NO_CACHE. Never numba's default,
+    a __pycache__ beside modc's own files (the source tree, or site-packages)."""
+    import os
+
+    if os.environ.get("MODC_NO_CACHE"):
+        return None
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return os.environ["NUMBA_CACHE_DIR"]
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    path = os.path.join(base, "modc-numba")
+    try:
+        os.makedirs(path, exist_ok=True)
+    except OSError:
+        return None
+    os.environ["NUMBA_CACHE_DIR"] = path  # read by numba's config when it is imported, below
+    return path
+
+
+_CACHE = _cache_dir()
+_CACHED = _CACHE is not None
 try:  # imported only by reach.solve (numba takes ~0.3 s to import)
     import numba
 except ImportError:  # pragma: no cover - the numpy path
     numba = None  # type: ignore[assignment]
+if numba is not None and _CACHE is not None and numba.config.CACHE_DIR != _CACHE:
+    numba.config.CACHE_DIR = _CACHE  # numba was imported before NUMBA_CACHE_DIR was set: its config read it then
 
 
 def _jit(f):
-    return numba.njit(cache=True, nogil=True)(f) if numba is not None else f
+    return numba.njit(cache=_CACHED, nogil=True)(f) if numba is not None else f
 
 
 def _inline(f):
     # inlined into the kernel: a call passing arrays costs their reference counting, more than the
     # work (the kernel runs 1.7x faster; its first compile takes ~10 s instead of ~7, once: cached)
-    return numba.njit(cache=True, nogil=True, inline="always")(f) if numba is not None else f
+    return numba.njit(cache=_CACHED, nogil=True, inline="always")(f) if numba is not None else f
 
 
 @_jit
