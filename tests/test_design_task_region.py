@@ -60,7 +60,7 @@ def test_region_points_start_from_the_nearest_point_already_reached(monkeypatch)
 def test_a_round_stops_at_the_shape_where_the_top_designs_are_found(monkeypatch):
     """Shapes are searched lightest first: once the top designs are checked and no shape left
     is lighter, the rest of the round is not searched (it was, to the round's end)."""
-    from modc.design import run, search
+    from modc.design import run, search, space
 
     seen: list = []
     real = search.search_part
@@ -75,12 +75,12 @@ def test_a_round_stops_at_the_shape_where_the_top_designs_are_found(monkeypatch)
     o = run.design(p, top=1)
     assert len(o.designs) == 1
     best = o.designs[0]
-    splits = run.space.variant_splits(p, 3)
+    splits = space.variant_splits(p, 3)
     masses = [run._min_mass(p, s, splits) for s in seen]
     assert masses == sorted(masses)
     # nothing heavier than the design was searched; shapes were left unsearched
     assert max(masses) <= best.mass + 1e-9
-    assert len(run.space.shapes(p, 3)) > len(seen)
+    assert len(space.shapes(p, 3)) > len(seen)
     assert o.complete and not o.unfinished
 
 
