@@ -41,8 +41,8 @@ try:  # imported only by reach.solve (numba takes ~0.3 s to import)
     import numba
 except ImportError:  # pragma: no cover - the numpy path
     numba = None  # type: ignore[assignment]
-if numba is not None and _CACHE is not None and numba.config.CACHE_DIR != _CACHE:
-    numba.config.CACHE_DIR = _CACHE  # numba was imported before NUMBA_CACHE_DIR was set: its config read it then
+if numba is not None and _CACHE is not None and numba.config.CACHE_DIR != _CACHE:  # type: ignore[attr-defined]
+    numba.config.CACHE_DIR = _CACHE  # type: ignore[attr-defined]  # numba imported before NUMBA_CACHE_DIR was set
 
 
 def _jit(f):
