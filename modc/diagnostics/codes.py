@@ -290,6 +290,9 @@ UNKNOWN_OBJECTIVE = _register("unknown-objective", E, "`rank` naming an objectiv
 DUPLICATE_OBJECTIVE = _register("duplicate-objective", E, "`rank` naming one objective twice",
     "objective '{name}' is ranked twice in {block}",
     "name each objective once, in order of importance (the first place counts)")
+OBJECTIVE_NEEDS_TASK = _register("objective-needs-task", E, "`rank` naming a task objective in a cell without a task",
+    "objective '{name}' ranks the cell's tasks, but design '{block}' has no `task` and no `path`",
+    "add `task NAME {{ visit a, b }}` or `path NAME from a to b straight`, or rank by {static}")
 DESIGN_UNSUPPORTED = _register("design-unsupported", W,
     "a design-block statement the language has but `modc design` does not search yet (it refuses the block)",
     "{what} is parsed but not searched yet by modc design",

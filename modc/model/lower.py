@@ -305,6 +305,7 @@ class _Lowerer:
             self.error(codes.DESIGN_NO_TARGETS.at(d.name.span, name=_say(d.name)))
         bounds = lower_bounds(self, search, block)
         self._tasks(acc, block)
+        self._task_objectives(bounds, acc, _say(d.name))
         if len(acc["base_within"]) > 1:
             self.error(codes.DUPLICATE_STATEMENT.at(acc["base_within"][1].span, what="base within", block=block))
         elif acc["base_within"]:
@@ -319,6 +320,18 @@ class _Lowerer:
             return None
         bounds["reference"] = reference
         return Problem(name=d.name.text, cell=cell, span=d.span, name_span=d.name.span, **bounds)
+
+    def _task_objectives(self, bounds: dict, acc: dict, name: str) -> None:
+        """An objective measured on the cell's tasks (cycle time, energy) needs one to measure."""
+        from ..objectives import REGISTRY
+
+        if acc["task_statements"]:
+            return
+        for key in bounds.get("rank", ()):
+            span = bounds["bound_spans"].get(f"rank:{key}")
+            if REGISTRY[key].needs_task and span is not None:
+                static = ", ".join(k for k, o in REGISTRY.items() if not o.task)
+                self.error(codes.OBJECTIVE_NEEDS_TASK.at(span, name=key, block=name, static=static))
 
     def _reference(self, compare: list[ast.Compare], cell: Robot, block: str) -> Robot | None | bool:
         """`compare with chain …`: the cell with that chain (its checks are the robot chain's,

@@ -93,6 +93,7 @@ def lower_bounds(low, statements: list, block: str) -> dict:
                         low.error(codes.DUPLICATE_OBJECTIVE.at(k.span, name=k.text, block=block))
                     else:
                         keys.append(k.text)
+                        out["bound_spans"][f"rank:{k.text}"] = k.span
                 # objectives not named keep their default order after the named ones
                 out["rank"] = tuple(keys) + tuple(k for k, o in REGISTRY.items() if o.default and k not in keys)
     return out

@@ -20,6 +20,7 @@ class Objective(Record, kw_only=False):
     digits: int = 0  # decimals shown in a table
     larger_first: bool = False  # a larger value ranks first (margin, coverage)
     task: bool = False  # known only once a design's tasks are planned and timed
+    needs_task: bool = False  # measured on the cell's tasks and paths: `rank` it only in a cell with one
     default: bool = False  # ranked, in registry order, after the objectives `rank` names
     planned_column: bool = False  # report.html shows it for planned designs even when not ranked
 

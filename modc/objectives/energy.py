@@ -3,4 +3,4 @@ planned, timed motion."""
 from .base import Objective
 
 OBJECTIVE = Objective("energy", "least mechanical energy over the cell's tasks first (J)", "energy",
-                      lambda d: d.energy, unit=" J", digits=2, task=True, planned_column=True)
+                      lambda d: d.energy, unit=" J", digits=2, task=True, needs_task=True, planned_column=True)
