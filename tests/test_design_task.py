@@ -255,3 +255,45 @@ def test_coverage_measurement_stops_at_the_budget():
     assert len(asked) == 7  # once before the design, five times measuring it (4 points tried), once for why
     assert o.not_planned == [d.chain()] and o.complete is False  # said: found, not planned, maybe not the best
     assert "not yet planned and timed" in o.why_none() and "touching" not in o.why_none()
+
+
+# both ends are reached by every 3-unit arm's simplest twists, folded so that no motion keeps
+# tool0 on the line between them; the arms that follow it have other twists
+SEAM = """design seam {
+    payload 50 g
+    box ground size (0.8, 0.8, 0.02) m at (0, 0, -0.02) m
+    target p at (0.18, 0.22, 0.12) m
+    target q at (0.18, -0.22, 0.12) m
+    path weld from p to q straight
+    task go { visit p, q }
+    units 3
+    modules H1, L3, L4
+    rank cycle_time
+}
+"""
+
+
+def test_a_straight_path_is_screened_along_its_way():
+    """Points inside a straight path are screened as targets (an arm on the segment reaches each),
+    with the tighter tolerance of its ends, position only; the designs' robots keep the cell's
+    own targets and the figures name the points after the path."""
+    from modc.design import tasks
+
+    p = problem(SEAM)
+    screen, names = tasks.with_points(p)
+    inside = [t for t in screen.cell.targets if t.name in names]
+    assert [names[t.name] for t in inside] == ["weld at 1/4", "weld at 2/4", "weld at 3/4"]
+    assert [round(t.xyz[1], 9) for t in inside] == [0.11, 0.0, -0.11]
+    assert all(t.rpy is None and t.pointing is None and t.position_tolerance == 0.005 for t in inside)
+
+
+@pytest.mark.slow
+def test_a_path_the_simplest_twists_cannot_follow_gets_a_design(tmp_path):
+    """It was "no design" (every shape's representative stood at both ends folded the wrong way):
+    the designs returned follow the path, planned and timed."""
+    r = _design(tmp_path, SEAM, "--top", "1")
+    assert r.returncode == 0, r.stderr
+    d = json.loads((tmp_path / "out" / "ranking.json").read_text())["designs"][0]
+    assert d["cycle_time_s"] > 0 and [t["task"] for t in d["tasks"]] == ["go", "weld"]
+    robot = check_file(tmp_path / "out" / d["file"]).design.robots[0]
+    assert [t.name for t in robot.targets] == ["p", "q"]

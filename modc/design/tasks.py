@@ -38,11 +38,11 @@ def with_points(problem, every: bool = False, only: str | None = None):
     names given to them (a point's own name, `tray[1,0,0]`, is no identifier), new name -> point
     name. only: that one point (its name, as `tray[1,0,0]`) of the regions, no other."""
     cell = problem.cell
-    if ("coverage" in problem.rank and not every and only is None) or not cell.regions:
-        return problem, {}
     taken = {t.name for t in cell.targets} | {r.name for r in cell.regions} | set(task_names(cell))
     names: dict[str, str] = {}
-    extra = []
+    extra = _path_points(cell, taken, names)
+    if ("coverage" in problem.rank and not every and only is None) or not cell.regions:
+        return _with(problem, extra), names
     for r in cell.regions:
         for ix in r.indices():
             stem = f"{r.name}_{ix[0]}_{ix[1]}_{ix[2]}"[:60]
@@ -54,7 +54,45 @@ def with_points(problem, every: bool = False, only: str | None = None):
             taken.add(name)
             names[name] = r.point_name(ix)
             extra.append(r.point(ix).model_copy(update={"name": name}))
-    return problem.model_copy(update={"cell": cell.model_copy(update={"targets": cell.targets + tuple(extra)})}), names
+    return _with(problem, extra), names
+
+
+def _with(problem, extra: list):
+    if not extra:
+        return problem
+    cell = problem.cell
+    return problem.model_copy(update={"cell": cell.model_copy(update={"targets": cell.targets + tuple(extra)})})
+
+
+PATH_POINTS = 3  # points inside a straight path screened as targets: at 1/4, 2/4 and 3/4 of the way
+
+
+def _path_points(cell, taken: set[str], names: dict[str, str]) -> list:
+    """Points inside each straight path, as position targets with the tighter tolerance of its
+    ends: an arm that keeps tool0 on the segment reaches each of them, so screening them is a
+    sound filter, and it keeps the arms that stand at both ends only folded another way (which
+    no planning can join) from taking every candidate's place. Named `seam_1_of_4`, told as
+    `seam at 1/4`."""
+    import numpy as np
+
+    out = []
+    for path in cell.paths:
+        a, b = cell.task_target(path.start), cell.task_target(path.end)
+        if a is None or b is None:
+            continue
+        tol = min(a.position_tolerance, b.position_tolerance)
+        n = PATH_POINTS + 1
+        for k in range(1, n):
+            stem = f"{path.name}_{k}_of_{n}"[:60]
+            name, j = stem, 2
+            while name in taken:
+                name, j = f"{stem}_{j}", j + 1
+            taken.add(name)
+            names[name] = f"{path.name} at {k}/{n}"
+            xyz = tuple(float(x) for x in np.asarray(a.xyz) + (np.asarray(b.xyz) - np.asarray(a.xyz)) * k / n)
+            out.append(a.model_copy(update={"name": name, "xyz": xyz, "rpy": None, "pointing": None,
+                                            "position_tolerance": tol}))
+    return out
 
 
 def restore(out, names: dict[str, str]) -> None:
