@@ -322,6 +322,17 @@ def test_cycle_time_retimed_independently(farm, serve, seam, urdf_model):
 
 
 @pytest.mark.slow
+def test_the_written_trajectory_keeps_every_speed_limit_between_samples(serve, seam, urdf_model):
+    """A trajectory file moves linearly from sample to sample (docs/conventions.md): every chord
+    is within the URDF's joint velocity, also where toppra's speed peaks between two samples."""
+    model, _ = urdf_model
+    for result in (serve, seam):
+        t, q = _samples(result)
+        chords = np.abs(np.diff(q, axis=0)) / np.diff(t)[:, None]
+        assert np.all(chords <= np.asarray(model.velocityLimit) * (1 + 1e-9))
+
+
+@pytest.mark.slow
 def test_plan_task_cli_json(tmp_path, capsys):
     from modc.cli import main
     from modc.trajectory import parse

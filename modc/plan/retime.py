@@ -89,7 +89,16 @@ class Timed:
 
     @property
     def speed_share(self) -> float:
-        return float(np.max(np.abs(self.qd) / self.limits.velocity)) if len(self.t) else 0.0
+        """max over joints of the speed over the speed limit: at the samples, and between them as
+        the written trajectory moves (linearly from sample to sample: a chord can be faster than
+        both its ends where toppra's speed peaks between two samples)."""
+        if not len(self.t):
+            return 0.0
+        sampled = float(np.max(np.abs(self.qd) / self.limits.velocity))
+        if len(self.t) < 2:
+            return sampled
+        chords = np.abs(np.diff(self.q, axis=0)) / np.diff(self.t)[:, None]
+        return max(sampled, float(np.max(chords / self.limits.velocity)))
 
 
 def _toppra_piece(path, limits: Limits, grid_points: int = GRID_POINTS):
