@@ -191,3 +191,15 @@ def test_the_reference_arm_stands_at_a_base_pose_where_it_passes():
     assert r.to_json("shifted")["base"]["xyz_m"] == pytest.approx(list(r.verified.robot.base.xyz))
     at_origin = reference.evaluate(p, seed=0)
     assert at_origin is not None and not at_origin.feasible and "'a'" in " ".join(at_origin.fails)
+
+
+def test_a_searched_base_at_the_origin_is_stated():
+    """Each robot file of a `base within` design states its `base at`, the origin included (the
+    search chose it); a robot file of a block without a base grid writes none for the origin."""
+    from modc.model.write import robot_file_text
+
+    robot = check_text("robot r {\n    chain H1 - L3\n}\n", "r.mod").design.robots[0]
+    assert "    base at (0, 0, 0) m\n" in robot_file_text(robot, state_base=True)
+    assert "base at" not in robot_file_text(robot)
+    again = check_text(robot_file_text(robot, state_base=True), "again.mod")
+    assert again.ok and again.design.robots[0].base == robot.base

@@ -59,7 +59,7 @@ def robot_file(outcome: Outcome, rank: int, d: Design) -> str:
     if outcome.problem.base_grid is not None:  # the cell was given in the frame of the base's box
         comments.append("The base pose was searched (`base within`): the cell below is in base_link, "
                         "the frame of `base at`.")
-    return robot_file_text(robot, comments)
+    return robot_file_text(robot, comments, state_base=outcome.problem.base_grid is not None)
 
 
 def reference_file(o: Outcome) -> str | None:
@@ -78,7 +78,7 @@ def reference_file(o: Outcome) -> str | None:
     verdict = "it passes every check the designs passed" if r.feasible else "it fails: " + "; ".join(r.fails)
     comments = [f"The reference arm of `modc design` for '{o.problem.name}' (`compare with chain {r.chain}`): "
                 f"{counted(r.modules, 'module')}, {r.mass:.3f} kg; {verdict}."]
-    return robot_file_text(robot, comments)
+    return robot_file_text(robot, comments, state_base=o.problem.base_grid is not None)
 
 
 def _entry(o: Outcome, rank: int, d: Design, said: str) -> dict:

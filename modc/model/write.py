@@ -90,8 +90,10 @@ def target_text(t) -> str:
     return s
 
 
-def robot_file_text(robot: Robot, comments: Sequence[str] = ()) -> str:
-    """A complete robot block: chain, library, placements, payload, limits, poses, the cell and its targets."""
+def robot_file_text(robot: Robot, comments: Sequence[str] = (), state_base: bool = False) -> str:
+    """A complete robot block: chain, library, placements, payload, limits, poses, the cell and its
+    targets. state_base: write `base at` even when the base is the origin (a searched base pose
+    says where it is)."""
     lines = robot_text(robot, comments).rstrip("\n").split("\n")[:-1]  # without the closing brace
     if robot.library_ref != "mark2" and robot.library_dir is not None:
         from pathlib import Path
@@ -100,7 +102,7 @@ def robot_file_text(robot: Robot, comments: Sequence[str] = ()) -> str:
         # quoted string, so it holds no quote or newline)
         path = (Path(robot.library_dir) / robot.library_ref).resolve()
         lines = [f'    library "{path}"' if ln.startswith("    library ") else ln for ln in lines]
-    base = _placement("base", robot.base)
+    base = _placement("base", robot.base) or ("    base at (0, 0, 0) m" if state_base else None)
     if base:
         lines.append(base)
     if robot.payload is not None:
