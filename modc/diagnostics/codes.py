@@ -274,6 +274,9 @@ REGION_GRID = _register("region-grid", E, "a region's grid that gives no points,
     "{what}", "{hint}")
 UNKNOWN_TASK_TARGET = _register("unknown-task-target", E, "a task or path naming no target or region point",
     "{kind} '{name}' names '{ref}', {why}", "{known}")
+TASK_NO_MOTION = _register("task-no-motion", W, "a task or path with nothing to move between",
+    "{kind} '{name}' has no motion: {why}",
+    "a task visits two or more places, a straight path joins two different points")
 BASE_WITHIN_ROBOT = _register("base-within-robot", E, "`base within` in a robot block",
     "`base within` belongs in design blocks: robot '{robot}' stands at one base pose",
     "write the pose as `base at (x, y, z) m [rpy (r, p, y) deg]`, or move the statement into a `design` block")

@@ -172,6 +172,17 @@ def _resolve(low, ref: ast.PointRef, kind: str, name: str, targets, regions, bad
     return None
 
 
+def _same_place(a: str, b: str, targets, regions) -> bool:
+    """Two task stops at one position (a name twice, or two targets or points that coincide)."""
+    if a == b:
+        return True
+    where = {t.name: t.xyz for t in targets}
+    for r in regions:
+        where.update({p.name: p.xyz for p in r.points()})
+    pa, pb = where.get(a), where.get(b)
+    return pa is not None and pb is not None and max(abs(x - y) for x, y in zip(pa, pb, strict=True)) < 1e-9
+
+
 def tasks(low, statements: list, targets, regions, block: str,
           bad=frozenset()) -> tuple[tuple[Task, ...], tuple[StraightPath, ...]]:
     """Tasks and paths with every reference resolved; names unique among targets, regions,
@@ -191,8 +202,11 @@ def tasks(low, statements: list, targets, regions, block: str,
         if isinstance(st, ast.Task):
             visits = [_resolve(low, ref, "task", st.name.text, targets, regions, bad) for ref in st.visits]
             if low.name(st.name, "task") and None not in visits:
-                out_tasks.append(Task(name=st.name.text, visits=tuple(p for v in visits if v for p in v),
-                                      span=st.span))
+                stops = tuple(p for v in visits if v for p in v)
+                if len(stops) < 2:
+                    low.error(codes.TASK_NO_MOTION.at(st.span, kind="task", name=st.name.text,
+                                                      why="it visits one place"))
+                out_tasks.append(Task(name=st.name.text, visits=stops, span=st.span))
         else:
             ends = [_resolve(low, ref, "path", st.name.text, targets, regions, bad) for ref in (st.start, st.end)]
             for ref, e in zip((st.start, st.end), ends, strict=True):
@@ -204,5 +218,8 @@ def tasks(low, statements: list, targets, regions, block: str,
             if low.name(st.name, "path") and all(e is not None and len(e) == 1 for e in ends):
                 a, b = ends
                 assert a is not None and b is not None
+                if _same_place(a[0], b[0], targets, regions):
+                    low.error(codes.TASK_NO_MOTION.at(st.span, kind="path", name=st.name.text,
+                                                      why=f"'{a[0]}' and '{b[0]}' are one point"))
                 out_paths.append(StraightPath(name=st.name.text, start=a[0], end=b[0], span=st.span))
     return tuple(out_tasks), tuple(out_paths)
