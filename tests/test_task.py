@@ -312,6 +312,8 @@ def test_cycle_time_retimed_independently(farm, serve, seam, urdf_model):
         assert result.t[-1] == pytest.approx(total, abs=1e-6)
         assert result.cycle_time == pytest.approx(total - result.segments[0].duration)
         assert result.energy > 0 and 0 < result.peak_share <= 1.0
+        # like cycle time and energy, the task's peak torque leaves out the approach from home
+        assert result.peak_share == max(s.peak_share for s in result.segments if s.kind != "approach")
     # each segment is no faster than its slowest joint moving at full speed the whole way
     acts = [farm.library.variants[u.variant].actuator for u in farm.units]
     vmax = np.array([a.velocity for a in acts])

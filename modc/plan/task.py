@@ -88,7 +88,9 @@ class TaskPlan:
 
     @property
     def peak_share(self) -> float:
-        return max((s.peak_share for s in self.segments), default=0.0)
+        """Over the counted segments, as cycle time and energy are (the approach from home has its
+        own figure in its segment)."""
+        return max((s.peak_share for s in self.counted), default=0.0)
 
     @property
     def trajectory(self) -> Trajectory:
