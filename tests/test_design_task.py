@@ -297,3 +297,20 @@ def test_a_path_the_simplest_twists_cannot_follow_gets_a_design(tmp_path):
     assert d["cycle_time_s"] > 0 and [t["task"] for t in d["tasks"]] == ["go", "weld"]
     robot = check_file(tmp_path / "out" / d["file"]).design.robots[0]
     assert [t.name for t in robot.targets] == ["p", "q"]
+
+
+@pytest.mark.slow
+def test_no_design_for_region_points_out_of_reach_points_at_the_region(tmp_path):
+    """Only points of one region are out of every arm's reach: the diagnostic points at that
+    region's line, names the points and says by how much."""
+    text = """design far {
+    target a at (0.3, 0, 0.2) m
+    region r box size (1.6, 0, 0) m at (0.9, 0, 0.2) m grid 3 x 1 x 1
+    task t { visit a, r }
+    units 3
+    modules H1, L3
+}
+"""
+    r = _design(tmp_path, text)
+    assert r.returncode == 1, r.stderr
+    assert "cell.mod:3:5: error[no-design]" in r.stderr and "target 'r[2,0,0]': no design gets closer than" in r.stderr

@@ -60,7 +60,7 @@ def _search_all(problems, max_units, top, seed, workers, scheduler, deadline, mo
     """Every design block searched in turn (until one stops): the outcomes, a no-design diagnostic
     per block without a design, and whether Ctrl-C stopped it."""
     from ..design import run as search
-    from ..design.diagnose import blamed_task
+    from ..design.diagnose import blamed_statement
     from ..diagnostics import codes
     from ..formatting import counted
     from .design_progress import progress as show_progress
@@ -79,7 +79,7 @@ def _search_all(problems, max_units, top, seed, workers, scheduler, deadline, mo
             if not o.designs:
                 hi = min(max_units or p.max_units, p.cell.library.rules.max_dof)
                 units = f"{p.min_units} to {hi} units" if hi > p.min_units else counted(hi, "unit")
-                blamed = blamed_task(o)  # every candidate failed planning on it: point there
+                blamed = blamed_statement(o)  # a task every candidate failed, a region no design reaches
                 failed.append(codes.NO_DESIGN.at(p.name_span if blamed is None else blamed.span, units=units,
                                                  name=p.name, closest=o.why_none()))
             outcomes.append(o)

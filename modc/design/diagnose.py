@@ -172,6 +172,18 @@ def blamed_task(o) -> Task | StraightPath | None:
     return max(written, key=lambda t: o.failed_on[t.name], default=None)
 
 
+def blamed_statement(o):
+    """The statement a no-design diagnostic points at: the task or path every candidate failed
+    planning on, else the one region whose points alone no design reaches; None: the design block."""
+    task = blamed_task(o)
+    if task is not None:
+        return task
+    missed = {n.partition("[")[0] for n, t in o.targets.items() if not t["reached_alone"]}
+    if len(missed) != 1 or not all("[" in n for n, t in o.targets.items() if not t["reached_alone"]):
+        return None
+    return next((r for r in o.problem.cell.regions if r.name in missed), None)
+
+
 def why_none(o) -> str:
     if o.stopped and o.not_planned:
         return (f"the search stopped ({o.stopped}) with {counted(len(o.not_planned), 'design')} that reach "
