@@ -20,6 +20,11 @@ per run; before (12e0a43, per-pose search) and after (modc/design/grid.py) alter
                                                               5.9 median)
     before 12e0a43 (07:49-07:51)      3    11.0               9.0             0.82
     after          (07:47-07:49)      3    13.0               4.3             0.33
+    with the compiled IK (reach_jit, numba; 08:44-08:46, load 1.8-2.1):
+                                      1    0.3                3.6-3.8         12.1 / 13.7
+                                      3    6.6                2.9             0.44
+    (screening every pose of a level in one shared IK batch was tried on top: 115 IK calls
+    instead of 327, the same time once the IK is compiled: 3.2-3.6 s, 11.7 / 14.2; left out)
 
     best (25 poses, --top 1): before H2(pivot=30deg) - L2(pivot=-15deg) - L4(pivot=15deg) at
     (-0.05, 0.1, 0) m (margin 0.95965); after H2 - L2(pivot=-45deg) - L4(pivot=15deg) at
