@@ -341,3 +341,20 @@ def test_a_huge_region_keeps_to_the_time_budget_and_names_targets_by_reason(tmp_
     assert r.returncode == 1, r.stderr
     assert ("time budget" in r.stderr or "the time ran out" in r.stderr) and "Traceback" not in r.stderr
     assert " more: " in r.stderr and len(r.stderr) < 5000  # 'tray[…]' five times, the rest counted
+
+
+def test_family_bounds_test_a_spread_subset_of_many_targets():
+    """A region of hundreds of neighbouring points: the family bounds test at most SPREAD of them,
+    spread out, every one a target (sound: a family that misses one misses them all); few targets
+    are all kept."""
+    from modc.design import prefix
+
+    xyz = np.array([[0.3 + 0.005 * i, 0.005 * j, 0.2] for i in range(20) for j in range(20)])
+    tol = np.full(len(xyz), 0.005)
+    sub, sub_tol = prefix.spread(xyz, tol)
+    assert len(sub) == prefix.SPREAD and len(sub_tol) == prefix.SPREAD
+    assert {tuple(p) for p in sub} <= {tuple(p) for p in xyz}
+    corners = {(0.3, 0.0), (0.3 + 0.095, 0.0), (0.3, 0.095), (0.3 + 0.095, 0.095)}
+    assert corners <= {(round(p[0], 9), round(p[1], 9)) for p in sub}  # the extremes are among them
+    few = xyz[:5]
+    assert prefix.spread(few, tol[:5])[0] is few

@@ -78,6 +78,8 @@ def _end(code: object) -> None:
 
     if not (code is None or isinstance(code, int)) or threading.active_count() > 1:
         return
+    if sys.getprofile() is not None or sys.gettrace() is not None:  # cProfile, coverage: they write at exit
+        return
     import atexit
     import os
 

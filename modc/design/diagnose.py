@@ -186,9 +186,9 @@ def blamed_statement(o):
 
 def why_none(o) -> str:
     if o.stopped and o.not_planned:
-        return (f"the search stopped ({o.stopped}) with {counted(len(o.not_planned), 'design')} that reach "
-                f"every target not yet planned and timed (first: {o.not_planned[0]}); give it more time "
-                "(--time-budget)")
+        return (f"the search stopped ({o.stopped}) before planning and timing the "
+                f"{counted(len(o.not_planned), 'design')} reaching every target it found (first: "
+                f"{o.not_planned[0]}); give it more time (--time-budget)")
     head = f"the search stopped ({o.stopped}) before finding one; " if o.stopped else ""
     if o.bases_searched == 0 and o.bases_touching:
         return head + (f"of the {o.bases_total} base poses, {o.bases_touching} put base_link into the cell and "
