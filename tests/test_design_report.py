@@ -11,24 +11,16 @@ import warnings
 from dataclasses import dataclass
 
 import pytest
+from conftest import SMALL_CELL
 
 from modc.compiler import check_text
 from modc.design.rank import why
 from modc.objectives import REGISTRY
 from modc.syntax.format import format_text
 
-SMALL = """\
-design small {
-    payload 100 g
-    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    units 3
-    modules H1, L3
-    rank modules, mass, margin
-    compare with chain H1 - L3 - L3(link=180mm)
-}
-"""
+# the shared small cell, ranked by every static objective and compared with the paper's chain
+SMALL = SMALL_CELL.replace("    modules H1, L3\n", "    modules H1, L3\n    rank modules, mass, margin\n"
+                           "    compare with chain H1 - L3 - L3(link=180mm)\n")
 
 
 def problem(text: str = SMALL):

@@ -8,24 +8,15 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from conftest import modc_design
+from conftest import SMALL_CELL, modc_design
 
 from modc.compiler import check_file, check_text
 
 ROOT = Path(__file__).resolve().parent.parent
 
 # two targets on either side of a post: the motion between them is planned around it
-TASKED = """design small {
-    payload 100 g
-    box post size (0.05, 0.05, 0.6) m at (0.2, 0.25, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    units 3
-    modules H1, L3
-    task serve { visit a, b }
-    rank modules, cycle_time
-}
-"""
+TASKED = SMALL_CELL.replace("    modules H1, L3\n", "    modules H1, L3\n    task serve { visit a, b }\n"
+                            "    rank modules, cycle_time\n")
 
 
 def problem(text: str = TASKED):
