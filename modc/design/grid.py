@@ -86,10 +86,9 @@ def _options(spec: Spec, shape: space.Shape) -> list[prefix.Level]:
                          space.port_free(spec.problem, shape, lib), transform(tool.xyz, tool.rpy))
 
 
-def _live(spec: Spec, shape: space.Shape, options: list[prefix.Level]) -> tuple[dominance.Levels, int]:
+def _live(spec: Spec, shape: space.Shape, fam: prefix.Families) -> tuple[dominance.Levels, int]:
     """The shape's live settings at this pose by level (its families, as search._plan finds
     them) and how many settings the families exclude."""
-    fam = prefix.refine(options, spec.targets.xyz, spec.targets.tol_p)
     full = full_axes(spec, shape)
     return dominance.levels_of(full.values, fam.alive, fam.per), full.count - fam.settings
 
@@ -186,15 +185,19 @@ def _opened(specs: list[Spec], shape: space.Shape, skip: frozenset[int]) -> _Sha
     lib = specs[0].problem.cell.library
     lengths = [x or lib.units[k].x23 for k, x in zip(shape.kinds, shape.links, strict=True)]
     r = reach_bound([lib.units[k] for k in shape.kinds], lengths, specs[0].problem.cell.tool.xyz)
-    live, excluded, options = {}, 0, None
+    live, excluded, near = {}, 0, []
     for i, spec in enumerate(specs):
         tg = spec.targets
         if i in skip or np.any(np.linalg.norm(tg.xyz, axis=1) - r - tg.tol_p > 0):  # walled off, beyond reach
             excluded += full_axes(spec, shape).count
-            continue
-        options = options or _options(spec, shape)
-        lv, out = _live(spec, shape, options)
-        live[i], excluded = lv, excluded + out
+        else:
+            near.append(i)
+    if near:  # the family bounds of every pose in reach in one pass (prefix.refine_many)
+        options = _options(specs[near[0]], shape)
+        families = prefix.refine_many(options, [(specs[i].targets.xyz, specs[i].targets.tol_p) for i in near])
+        for i, fam in zip(near, families, strict=True):
+            live[i], out = _live(specs[i], shape, fam)
+            excluded += out
     return _Shape(shape, live, excluded)
 
 

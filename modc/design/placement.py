@@ -102,10 +102,13 @@ def gap(cell: Robot, pose: Transform, longest: float) -> float:
                 for t in points(cell)), default=-1.0)
 
 
-def base_blocked(problem: ResolvedProblem, pose: Transform) -> bool:
+def base_blocked(problem: ResolvedProblem, pose: Transform, checkers: dict | None = None) -> bool:
     """Does base_link, at pose, sink into the cell whatever the first unit (every allowed variant
     and type)? The exact check rejects every design there ("base_link touches the cell"), so
-    the pose is not worth a search (sound)."""
+    the pose is not worth a search (sound). checkers: one CollisionChecker per (variant, type)
+    kept across the poses of a grid, its obstacles moved to each pose (base_link's geometry does
+    not depend on the pose; the obstacles' placements are what a checker built at the pose
+    would hold: the same decision for a fraction of the cost)."""
     from ..model import UnitSpec
     from ..physical.checker import CollisionChecker
     from . import space
@@ -114,14 +117,31 @@ def base_blocked(problem: ResolvedProblem, pose: Transform) -> bool:
     if not problem.cell.obstacles:
         return False
     cell = cell_at(resolved(problem.cell, lib), pose)
+    checkers = {} if checkers is None else checkers
     for v in lib.variants:
         for k in lib.units:
             if not space.allowed(problem, v, k):
                 continue
-            robot = cell.model_copy(update={"units": (UnitSpec(name=f"{v}{k}", variant=v, kind=k),)})
-            if not CollisionChecker(robot).static_contacts():
+            checker = checkers.get((v, k))
+            if checker is None:
+                robot = cell.model_copy(update={"units": (UnitSpec(name=f"{v}{k}", variant=v, kind=k),)})
+                checker = checkers[(v, k)] = CollisionChecker(robot)
+            else:
+                _move_obstacles(checker, cell.obstacles)
+            if not checker.static_contacts():
                 return False
     return True
+
+
+def _move_obstacles(checker, obstacles) -> None:
+    """Place a checker's obstacles (static model, the one static_contacts tests) as `obstacles`
+    (the same names and shapes, in another base frame)."""
+    from ..physical.multibody import obstacle_geometry
+
+    at = {o.name: o for o in obstacles}
+    for go in checker.gm_static.geometryObjects:
+        if go.name.startswith("obstacle:"):
+            go.placement = obstacle_geometry(at[go.name[len("obstacle:"):]])[1]
 
 
 def poses(problem: ResolvedProblem, longest: float) -> tuple[list[Transform], int, int]:
@@ -132,10 +152,11 @@ def poses(problem: ResolvedProblem, longest: float) -> tuple[list[Transform], in
     cell = problem.cell
     kept = []
     touching = 0
+    checkers: dict = {}
     for i, pose in enumerate(grid.poses()):
         if gap(cell, pose, longest) > 0:
             continue
-        if base_blocked(problem, pose):
+        if base_blocked(problem, pose, checkers):
             touching += 1
             continue
         p = np.asarray(pose.xyz, float)

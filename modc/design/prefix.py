@@ -25,6 +25,7 @@ from . import bounds
 from .batch import pre_post
 
 CAP = 200_000  # live families per level (memory: ~100 bytes each per fixed transform)
+TOGETHER = 4 * CAP  # families refined at once for several target sets (refine_many), at most
 SPREAD = 32  # targets the family bounds test at most (a region of 400 points: 12x less work)
 
 
@@ -164,3 +165,54 @@ def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP) ->
         depth += 1
     per = total // int(np.prod(sizes[:depth], dtype=object))
     return Families(depth, alive, int(per))
+
+
+def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap: int = CAP) -> list[Families]:
+    """refine(lv, xyz, tol, cap) for each (xyz, tol) of sets (a shape at several base poses), in
+    one pass: the families are tested against the targets of every set still refining at once,
+    each set with its own alive mask (a family counts at a set only while its parent is alive
+    there, as in refine), and each set stops where refine would (its own count against cap).
+    The bounds are row by row, so every set gets refine's families; past TOGETHER families at
+    once the sets left are refined one by one (memory)."""
+    if len(sets) <= 1 or any(len(x) == 0 for x, _ in sets):
+        return [refine(lv, x, t, cap) for x, t in sets]
+    picked = [spread(np.asarray(x, float), np.asarray(t, float)) for x, t in sets]
+    n = len(lv) - 1
+    U = tails(lv)
+    sizes = [len(level.t) for level in lv]
+    total = int(np.prod(sizes, dtype=object))
+    out: dict[int, Families] = {}
+    R, t = lv[0].R[:, None], lv[0].t[:, None]
+    alive = np.arange(sizes[0])
+    going = list(range(len(sets)))
+    mask = np.ones((sizes[0], len(going)), bool)  # (families, sets going): alive at that set so far
+    depth = 1
+    while True:
+        tail = U[depth - 1] if depth <= n else None
+        ok = bounds.possible(bounds.Frames(R, t), np.concatenate([picked[s][0] for s in going]),
+                             np.concatenate([picked[s][1] for s in going]), tail)
+        mask &= np.logical_and.reduceat(ok, np.cumsum([0] + [len(picked[s][0]) for s in going[:-1]]), axis=1)
+        per = total // int(np.prod(sizes[:depth], dtype=object))
+        stay = []
+        for j, s in enumerate(going):
+            k = int(mask[:, j].sum())
+            if depth == n + 1 or k == 0 or k * sizes[depth] > cap:
+                out[s] = Families(depth, alive[mask[:, j]], int(per))
+            else:
+                stay.append(j)
+        going, mask = [going[j] for j in stay], mask[:, stay]
+        keep = mask.any(1)
+        R, t, alive, mask = R[keep], t[keep], alive[keep], mask[keep]
+        if not going:
+            break
+        m = sizes[depth]
+        if len(alive) * m > TOGETHER:
+            out.update((s, refine(lv, *sets[s], cap)) for s in going)
+            break
+        nxt = lv[depth]
+        R = np.concatenate([np.repeat(R, m, 0), np.tile(nxt.R, (len(alive), 1, 1))[:, None]], 1)
+        t = np.concatenate([np.repeat(t, m, 0), np.tile(nxt.t, (len(alive), 1))[:, None]], 1)
+        alive = (alive[:, None] * m + np.arange(m)[None]).reshape(-1)
+        mask = np.repeat(mask, m, 0)
+        depth += 1
+    return [out[s] for s in range(len(sets))]

@@ -1,0 +1,100 @@
+"""Base placement's shared work over the poses of a grid: the family bounds of a shape at every
+pose in one pass (prefix.refine_many) and one base_link checker per (variant, type) moved from
+pose to pose (placement.base_blocked) decide exactly what the per-pose work decides."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from modc.compiler import check_text
+
+CELL = """design grid {
+    payload 100 g
+    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
+    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    target c at (0.10, 0.30, 0.45) m
+    units 2 to 3
+    base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 100 mm yaw 0 to 90 deg step 45 deg
+}
+"""
+
+
+def problem(text: str = CELL):
+    checked = check_text(text, "cell.mod")
+    assert checked.ok, [d.message for d in checked.diagnostics]
+    return checked.design.problems[0]
+
+
+def _specs(p):
+    from modc.design import placement
+    from modc.design.evaluate import Spec
+
+    return [Spec.of(p.model_copy(update={"cell": placement.cell_at(p.cell, pose), "base_grid": None}))
+            for pose in p.base_grid.poses()]
+
+
+def _same(a, b) -> bool:
+    return a.depth == b.depth and a.per == b.per and np.array_equal(a.alive, b.alive)
+
+
+@pytest.mark.parametrize("cap, every", [(200_000, 4), (3_000, 1)])
+def test_the_family_bounds_of_every_pose_at_once_are_each_poses_own(cap, every):
+    """Yawed and shifted poses (their targets differ in the base frame), 2- and 3-unit shapes; a
+    small cap makes poses stop refining at different depths."""
+    from modc.design import grid, prefix, space
+
+    p = problem()
+    specs = _specs(p)
+    assert len(specs) == 27
+    specs = specs[::every]
+    assert len({s.problem.cell.base.rpy for s in specs}) == 3
+    shapes = [s for n in (2, 3) for s in space.shapes(p, n)][::5 * every]
+    depths = set()
+    for shape in shapes:
+        lv = grid._options(specs[0], shape)
+        sets = [(s.targets.xyz, s.targets.tol_p) for s in specs]
+        one = [prefix.refine(lv, x, t, cap) for x, t in sets]
+        many = prefix.refine_many(lv, sets, cap)
+        assert all(_same(a, b) for a, b in zip(one, many, strict=True)), shape.label()
+        depths |= {f.depth for f in one}
+    assert len(depths) > 1 and any(f.settings for f in one)
+
+
+def test_too_many_families_at_once_fall_back_to_one_pose_at_a_time(monkeypatch):
+    from modc.design import grid, prefix, space
+
+    p = problem()
+    specs = _specs(p)[:6]
+    shape = next(s for s in space.shapes(p, 3) if s.kinds == (3, 3, 4))
+    lv = grid._options(specs[0], shape)
+    sets = [(s.targets.xyz, s.targets.tol_p) for s in specs]
+    one = [prefix.refine(lv, x, t) for x, t in sets]
+    monkeypatch.setattr(prefix, "TOGETHER", 50)
+    many = prefix.refine_many(lv, sets)
+    assert all(_same(a, b) for a, b in zip(one, many, strict=True))
+
+
+def test_one_checker_per_unit_type_moved_over_the_poses_decides_as_a_checker_per_pose(monkeypatch):
+    """The base sinks into the shelf (z 0.04 to 0.06 m) at some poses of a grid that rises to
+    0.1 m, turned and shifted: the shared checkers block exactly the poses fresh ones do."""
+    from modc.design import placement
+    from modc.physical import checker
+
+    p = problem(CELL.replace("box size (0.2, 0.2, 0) m at (0, 0, 0) m step 100 mm yaw 0 to 90 deg step 45 deg",
+                             "box size (0.2, 0.2, 0.1) m at (0.1, 0, 0.05) m step 100 mm yaw 0 to 90 deg step 90 deg"))
+    poses = p.base_grid.poses()
+    fresh = [placement.base_blocked(p, pose) for pose in poses]
+    built = []
+    real = checker.CollisionChecker
+
+    def counted(*a, **k):
+        built.append(1)
+        return real(*a, **k)
+
+    monkeypatch.setattr(checker, "CollisionChecker", counted)
+    shared: dict = {}
+    assert [placement.base_blocked(p, pose, shared) for pose in poses] == fresh
+    assert 0 < sum(fresh) < len(poses)
+    assert len(built) == len(shared) <= len(p.cell.library.variants) * len(p.cell.library.units)
