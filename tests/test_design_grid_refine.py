@@ -98,3 +98,15 @@ def test_one_checker_per_unit_type_moved_over_the_poses_decides_as_a_checker_per
     assert [placement.base_blocked(p, pose, shared) for pose in poses] == fresh
     assert 0 < sum(fresh) < len(poses)
     assert len(built) == len(shared) <= len(p.cell.library.variants) * len(p.cell.library.units)
+
+
+def test_the_bounds_norm_has_numpys_bits():
+    """bounds._norm replaces np.linalg.norm in the bounds' hot loops: the same bits (so the
+    families, and what they count, are unchanged), on contiguous and strided vectors."""
+    from modc.design import bounds
+
+    rng = np.random.default_rng(5)
+    for v in (rng.normal(size=(4000, 7, 3)), rng.normal(size=(4000, 5, 3))[:, 2], rng.uniform(-1, 1, (9, 3)) * 1e-3):
+        assert np.array_equal(bounds._norm(v), np.linalg.norm(v, axis=-1))
+    a, b = rng.normal(size=(2, 1000))
+    assert np.array_equal(bounds._floor(a, b), np.maximum.reduce([np.zeros_like(a), a, b]))
