@@ -51,11 +51,16 @@ def frames(g) -> Frames:
     return Frames(R, t)
 
 
-def _norm(v: np.ndarray) -> np.ndarray:
-    """|v| over the last axis (3): np.linalg.norm's bits (the same sum, left to right), without
-    its reduction over an axis of 3, which costs several times the arithmetic."""
+def _norm2(v: np.ndarray) -> np.ndarray:
+    """|v|^2 over the last axis (3): (v * v).sum(-1)'s bits (the same sum, left to right),
+    without a reduction over an axis of 3, which costs several times the arithmetic."""
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    return np.sqrt(x * x + y * y + z * z)
+    return x * x + y * y + z * z
+
+
+def _norm(v: np.ndarray) -> np.ndarray:
+    """|v| over the last axis (3): np.linalg.norm's bits."""
+    return np.sqrt(_norm2(v))
 
 
 def _floor(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -111,13 +116,14 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float, flo
     tl = tol[None] + 1e-9  # rounding: a target exactly at an interval's end stays possible
     ok = np.ones((C, len(xyz)), bool)
     # D_1: p_1 fixed
-    d1 = _norm(x - p1[:, None])
+    dx = x - p1[:, None]
+    d1 = _norm(dx)
     lo, hi = _reach(f, 1, tail)
     ok &= (d1 <= hi[:, None] + tl) & (d1 >= lo[:, None] - tl)
     if k < 2:
         return ok
     # height along joint 1's axis
-    h_x = np.einsum("cti,ci->ct", x - p1[:, None], z1)
+    h_x = np.einsum("cti,ci->ct", dx, z1)
     a1 = f.t[:, 1]
     if tail is None and n == 1:
         h_lo = h_hi = a1[:, 2]
@@ -140,7 +146,7 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float, flo
     centre = p1 + along[:, None] * z1
     rel = x - centre[:, None]
     h = np.einsum("cti,ci->ct", rel, z1)
-    s = np.sqrt(np.maximum((rel * rel).sum(-1) - h * h, 0.0))
+    s = np.sqrt(np.maximum(_norm2(rel) - h * h, 0.0))
     dlo2, dhi2 = np.hypot(h, s - r[:, None]), np.hypot(h, s + r[:, None])
     for j in range(2, n + 1):
         if j == 2:
