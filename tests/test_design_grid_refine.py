@@ -110,3 +110,31 @@ def test_the_bounds_norm_has_numpys_bits():
         assert np.array_equal(bounds._norm(v), np.linalg.norm(v, axis=-1))
     a, b = rng.normal(size=(2, 1000))
     assert np.array_equal(bounds._floor(a, b), np.maximum.reduce([np.zeros_like(a), a, b]))
+
+
+def test_the_bounds_by_group_of_targets_are_the_bounds_per_target_grouped():
+    """bounds.possible_all (D_1 first, the other tests on the rows left) is possible()'s answer
+    for every group of targets: families of real shapes, at the poses' targets stacked."""
+    from modc.design import bounds, grid, prefix, space
+
+    p = problem()
+    specs = _specs(p)[::6]
+    xyz = np.concatenate([s.targets.xyz for s in specs])
+    tol = np.concatenate([s.targets.tol_p for s in specs])
+    starts = np.cumsum([0] + [len(s.targets.xyz) for s in specs[:-1]])
+    rng = np.random.default_rng(2)
+    seen = set()
+    for shape in [s for n in (2, 3) for s in space.shapes(p, n)][::7]:
+        lv = grid._options(specs[0], shape)
+        U = prefix.tails(lv)
+        for k in range(1, len(lv) + 1):
+            pick = [rng.integers(len(level.t), size=500) for level in lv[:k]]
+            f = bounds.Frames(np.stack([lv[j].R[pick[j]] for j in range(k)], 1),
+                              np.stack([lv[j].t[pick[j]] for j in range(k)], 1))
+            tail = U[k - 1] if k < len(lv) else None
+            each = bounds.possible(f, xyz, tol, tail)
+            want = np.logical_and.reduceat(each, starts, axis=1)
+            assert np.array_equal(bounds.possible_all(f, xyz, tol, tail, starts), want)
+            assert np.array_equal(bounds.possible_all(f, xyz, tol, tail)[:, 0], each.all(-1))
+            seen |= {bool(want.any()), bool((~want).any())}
+    assert seen == {True, False}

@@ -23,6 +23,10 @@ setting kept from the pose where it works closes the shape at the poses where it
 Past search.COMPLETE settings listed at a pose the levels left there go on its coarse grid
 (not complete), as at one pose.
 
+A shape's family bounds at every pose in reach are refined in one pass (prefix.refine_many:
+each pose gets the families its own prefix.refine gives, so the same settings are listed and
+counted as pose by pose).
+
 Every unit of work is search.search_chunk on a pose's Spec, merged in a fixed order, so the
 ranking is the same in one process, a process pool or Dask.
 """

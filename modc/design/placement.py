@@ -7,7 +7,8 @@ holds the same cell around it, so it compiles, plans and views in the same world
 
 Cheap first: a pose from which some target lies beyond the reach bound of the longest arm in the
 bounds is skipped (sound: no chain could reach it from there), so is one where base_link sinks
-into the cell whatever the first unit (sound: the exact check would reject every design).
+into the cell whatever the first unit (sound: the exact check would reject every design; one
+base_link checker per variant and type serves every pose, its obstacles moved).
 The poses kept are searched together (modc.design.grid): a shape's candidates are (twist
 setting, pose) pairs, ranked within the shape as one pose's settings are, then nearest pose
 first, and the shape gives one design over the grid, at its setting's best pose. The answer is

@@ -153,7 +153,7 @@ def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP) ->
     depth = 1
     while True:
         tail = U[depth - 1] if depth <= n else None
-        ok = bounds.possible(bounds.Frames(R, t), xyz, tol, tail).all(-1)
+        ok = bounds.possible_all(bounds.Frames(R, t), xyz, tol, tail)[:, 0]
         R, t, alive = R[ok], t[ok], alive[ok]
         if depth == n + 1 or len(alive) == 0 or len(alive) * sizes[depth] > cap:
             break
@@ -189,9 +189,9 @@ def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap:
     depth = 1
     while True:
         tail = U[depth - 1] if depth <= n else None
-        ok = bounds.possible(bounds.Frames(R, t), np.concatenate([picked[s][0] for s in going]),
-                             np.concatenate([picked[s][1] for s in going]), tail)
-        mask &= np.logical_and.reduceat(ok, np.cumsum([0] + [len(picked[s][0]) for s in going[:-1]]), axis=1)
+        mask &= bounds.possible_all(bounds.Frames(R, t), np.concatenate([picked[s][0] for s in going]),
+                                    np.concatenate([picked[s][1] for s in going]), tail,
+                                    np.cumsum([0] + [len(picked[s][0]) for s in going[:-1]]))
         per = total // int(np.prod(sizes[:depth], dtype=object))
         stay = []
         for j, s in enumerate(going):
