@@ -7,39 +7,44 @@ The same cell (bench_design.CELL: three position targets, a shelf and a post, at
 searched with its base as written (one pose) and with `base within box size (0.2, 0.2, 0) m at
 (0, 0, 0) m step 50 mm` (5 x 5 = 25 poses): run.design (--top 1 by default, seed 0), CPU seconds of
 this process pinned to one core (BLAS pools at one thread; one pose: the median of three runs),
-and their ratio (goal: at most 5).
+and their ratio (goal: at most 5). The warm-up runs both sides once (counted in nothing: imports,
+caches, numba's kernel), so both run in the same state: the grid crosses reach.JIT_AFTER, so by
+default both sides then run the compiled IK; with MODC_JIT=0 both run numpy ("compiled IK" in the
+output says which). Before 443ef04 only the one-pose side warmed up, and by default the 25-pose
+run paid numba's import and cache load (~0.8 s) inside the measured run.
 bench_base() is the function bench_design.py calls.
 
-Figures (CPU s, one core of a 2-core machine shared with other jobs; an empty MODC_CACHE_DIR
-per run; before (12e0a43, per-pose search) and after (modc/design/grid.py) alternating):
+Figures (CPU s, --top 1, one core of a 2-core machine shared with three other jobs, load 2.5-3.5;
+an empty MODC_CACHE_DIR per run; before (12d2c95) and after (this file's commit) alternating,
+three runs each, 27 Nov 2026 10:02-10:05, the same benchmark for both):
 
-    27 Nov 2026, load 2.3-4.5       --top  1 pose            25 poses        ratio
-    before 12e0a43 (07:51-07:54)      1    0.31-0.42 (median  7.2-11.6 (8.0-   20.5 / 23.7
-                                           of six, two runs)  8.1 median)
-    after          (same window)      1    0.30-0.45          5.3-7.8 (5.4-   14.9 / 17.5
-                                                              5.9 median)
-    before 12e0a43 (07:49-07:51)      3    11.0               9.0             0.82
-    after          (07:47-07:49)      3    13.0               4.3             0.33
-    with the compiled IK (reach_jit, numba; 08:44-08:46, load 1.8-2.1):
-                                      1    0.3                3.6-3.8         12.1 / 13.7
-                                      3    6.6                2.9             0.44
-    (screening every pose of a level in one shared IK batch was tried on top: 115 IK calls
-    instead of 327, the same time once the IK is compiled: 3.2-3.6 s, 11.7 / 14.2; left out)
+                      1 pose (three runs)   25 poses (three runs)   ratio
+    default (compiled IK on both sides after the warm-up)
+      before 12d2c95  0.23 0.23 0.25        2.98 3.44 3.42          12.7 15.0 13.7
+      after           0.19 0.20 0.21        2.91 2.64 2.25          15.4 13.5 10.5
+    MODC_JIT=0 (numpy IK)
+      before 12d2c95  0.27 0.35 0.30        5.87 5.71 5.91          22.1 16.4 20.0
+      after           0.37 0.38 0.28        5.75 5.77 5.44          15.7 15.2 19.8
 
-    best (25 poses, --top 1): before H2(pivot=30deg) - L2(pivot=-15deg) - L4(pivot=15deg) at
-    (-0.05, 0.1, 0) m (margin 0.95965); after H2 - L2(pivot=-45deg) - L4(pivot=15deg) at
-    (0, 0.05, 0) m (margin 0.95954): one design per shape over the grid, its simplest setting
-    at its nearest pose, where before every pose gave its own (see modc/design/grid.py).
+    best (25 poses): H2 - L2(pivot=-45deg) - L4(pivot=15deg) at (0, 0.05, 0) m, margin 0.959537,
+    before and after (ranking.json identical but for "seconds").
 
-Goal (<= 5) not met. The grid search closes a shape that works somewhere at every pose once six
-of its settings are dead on (usually after two nonzero twists), but half the 3-unit shapes of
-this cell (unit 3 of type 1 or 2) work nowhere and are screened at every one of the 15 poses in
-reach, each setting the family and per-setting bounds leave (about 45,000 IK screens, most of
-the time); their mass equals the designs', so the ranking (margin next) needs them searched.
-What is left: the IK of those settings (about 200 batched calls of a few hundred settings each:
-screening a level of a shape at every pose in one batch would need per-candidate targets in
-modc.design.evaluate.screen_batch), the family bounds per (shape, pose) (about 15 %), and the
-base_link contact test per pose (about 0.3 s).
+What changed (none of it changes what is listed, screened or counted): a shape's family bounds
+at every pose in one pass (prefix.refine_many) testing D_1 first and the other bounds only on the
+families some pose still passes (bounds.possible_all: half the rows), the bounds' norms without
+reductions over an axis of 3; base_link's contact test with one checker per (variant, type)
+moved over the poses (8 checkers instead of 109). Measured apart (same process, best of four,
+compiled IK): the family bounds of the run's 40 shapes at 15 poses 0.92-1.08 s -> 0.58-0.73 s;
+the pose filter (placement.poses) about 0.34 -> 0.1 s.
+
+Goal (<= 5) not met. The floor is the IK: half the 3-unit shapes of this cell (unit 3 of type 1
+or 2) reach target c only in collision with the post, work at no pose, and are screened at every
+one of the 15 poses in reach, each setting the family and per-setting bounds leave (about 45,000
+settings x 4 seeds: ~0.55 s compiled, most of the 25-pose run with numpy, against 0.16-0.2 s for
+the whole one-pose run); their mass equals the designs', so the ranking (margin next) needs them
+searched. What is left besides: the screen's per-call work around the IK (collision sampling,
+forward kinematics, ~0.3 s over 170 calls) and the family bounds (~0.5 s, array work per
+(family, pose): sharing them over the poses saves only the per-call overhead).
 """
 from __future__ import annotations
 
