@@ -4,12 +4,11 @@ searched - later tiers (more units) included - and finds what the whole search f
 from __future__ import annotations
 
 import pytest
+from conftest import SMALL_CELL
 
 from modc.compiler import check_text
 from modc.design import run
 from modc.design.verify_order import Verifier
-
-from conftest import SMALL_CELL
 
 
 def _problem(text: str):
