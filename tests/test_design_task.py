@@ -305,3 +305,31 @@ def test_no_design_for_region_points_out_of_reach_points_at_the_region(tmp_path)
     r = _design(tmp_path, text)
     assert r.returncode == 1, r.stderr
     assert "cell.mod:3:5: error[no-design]" in r.stderr and "target 'r[2,0,0]': no design gets closer than" in r.stderr
+
+
+@pytest.mark.slow
+def test_a_static_search_cut_short_by_the_budget_still_hands_over_planned_designs(monkeypatch):
+    """Was: the static search spent the whole --time-budget, planned nothing and said "no design"
+    though it had found 15. It now stops PLAN_RESERVE s per candidate (at most half the budget)
+    early. Here the search takes all the time it is given (it waits for its deadline)."""
+    import time
+
+    from modc.design import run
+
+    real = run._search
+    given = []
+
+    def slow(p, units, k, seed, executor, progress, deadline, **kw):
+        given.append(deadline)
+        out = real(p, units, k, seed, executor, progress, None, **kw)
+        time.sleep(max(0.0, deadline - time.time()))
+        out.stopped, out.complete = "time budget", False
+        return out
+
+    monkeypatch.setattr(run, "_search", slow)
+    budget = 40.0
+    end = time.time() + budget
+    o = run.design(problem(), top=2, seed=0, deadline=end)
+    assert given and given[0] <= end - budget / 4  # time left for planning
+    assert o.designs and all(d.plans and d.cycle_time > 0 for d in o.designs)
+    assert o.stopped == "time budget" and not o.complete

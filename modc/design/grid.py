@@ -258,6 +258,20 @@ def _mass_groups(problem: ResolvedProblem, shapes: list[space.Shape], splits) ->
     return groups
 
 
+def _floors(problem: ResolvedProblem, hi: int) -> dict[int, float]:
+    """n -> the least mass of a shape of more than n units (Verifier.floors)."""
+    from .sweep import floors
+
+    lib = problem.cell.library
+    tiers = []
+    for n in range(max(problem.min_units, lib.rules.min_dof), hi + 1):
+        splits = space.variant_splits(problem, n)
+        if splits:
+            tiers.append((n, splits, [(m, "", None) for m, shapes in _mass_groups(problem, space.shapes(problem, n),
+                                                                                splits) for _ in shapes]))
+    return floors(tiers)
+
+
 def search(problem: ResolvedProblem, subs: list[ResolvedProblem], max_units: int | None, top: int, seed: int,
            executor: Executor | None, deadline: float | None, enough: int | None = None,
            progress: Callable[..., None] | None = None):
@@ -292,7 +306,8 @@ class _Grid:
         self.tally = _Tally(subs, top, self.out, _mass)
         lib = problem.cell.library
         self.hi = min(max_units or problem.max_units, lib.rules.max_dof)
-        self.early = problem.rank[:2] == ("modules", "mass")
+        self.tally.floors = _floors(problem, self.hi)
+        self.early = self.tally.bounded
         self.names = [t.name for t in problem.cell.targets]
         self.closest = np.full(len(self.names), np.inf)
         self.results: list[ShapeResult] = []
@@ -318,7 +333,7 @@ class _Grid:
     def tier(self, n: int, splits, want: int) -> bool:
         """The shapes of n units, a group of equal least mass at a time: True when the search
         ends here (stopped, or `want` designs rank before every unsearched shape)."""
-        from .sweep import _edge, _stopping
+        from .sweep import _stopping
 
         out, tally = self.out, self.tally
         groups = _mass_groups(self.problem, space.shapes(self.problem, n), splits)
@@ -334,7 +349,7 @@ class _Grid:
                 self.closest = np.minimum(self.closest, r.closest)
                 tally.add(n, splits, r)
             out.stopped = _stopping(self.deadline) or (None if all(r.finished for r in res) else "time budget")
-            nxt = _edge(self.problem, groups[g + 1][0]) if g + 1 < len(groups) and not out.stopped else float("inf")
+            nxt = groups[g + 1][0] if g + 1 < len(groups) and not out.stopped else float("inf")
             tally.settle(n, nxt)
             self.report()
             if out.stopped:
@@ -344,7 +359,7 @@ class _Grid:
         if not self.early:
             return False
         tally.settle(n, float("inf"))
-        return tally.distinct_count() >= want
+        return tally.done(n, float("inf"), want)
 
     def finish(self):
         out, results = self.out, self.results

@@ -13,6 +13,7 @@ from .rank import key, static
 from .sweep import _min_mass, _search, _stopping, _tiers, longest_reach
 
 MAX_CANDIDATES = 96  # static designs a task cell plans at most, when the first ones all fail planning
+PLAN_RESERVE = 4.0  # s of a task cell's time budget kept for planning each candidate (at most half of it)
 
 
 def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int = 5, seed: int = 0,
@@ -39,18 +40,22 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
 
     enough = [top]  # designs after which a round may stop (more when the first candidates all fail planning)
 
+    # a task cell's static search leaves part of the budget to plan what it found: a search cut
+    # short by the budget still hands over its best designs, planned and timed
+    by = [deadline]
+
     def one(p: ResolvedProblem, units: int | None, k: int, diagnosing: bool = True) -> Outcome:
         # the extra candidates to time come from the shapes searched until `top` designs are found
         # (a round at a time): searching on only to have more of them cost whole tiers (6.6 M
         # settings, 369 s on a 4-goal visit cell)
-        return _search(p, units, k, seed, executor, progress, deadline, enough=enough[0],
-                       diagnosing=diagnosing)
+        return _search(p, units, k, seed, executor, progress, by[0], enough=enough[0], diagnosing=diagnosing)
 
     def many(p: ResolvedProblem, cells: list[ResolvedProblem], units: int | None, k: int) -> Outcome:
-        return grid.search(p, cells, units, k, seed, executor, deadline, enough=enough[0], progress=progress)
+        return grid.search(p, cells, units, k, seed, executor, by[0], enough=enough[0], progress=progress)
 
     rejected: dict[str, tuple[str, str | None]] = {}  # chain -> why (and which task) it could not be planned: once only
     while True:
+        by[0] = _search_deadline(deadline, n) if tasked else deadline
         if problem.base_grid is None:
             out = one(screen, max_units, n)
         else:
@@ -73,6 +78,15 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     out.reference = reference.evaluate(problem, seed, deadline, out.bases_kept)
     out.seconds = time.perf_counter() - t0
     return out
+
+
+def _search_deadline(deadline: float | None, candidates: int) -> float | None:
+    """When a task cell's static search must stop (time.time()): PLAN_RESERVE s per candidate
+    before the budget's end, at most half of what is left of it."""
+    if deadline is None:
+        return None
+    left = max(deadline - time.time(), 0.0)
+    return deadline - min(PLAN_RESERVE * candidates, left / 2)
 
 
 def _planning(out: Outcome, progress: Callable[..., None] | None) -> Callable[[int, int, str], None] | None:

@@ -115,11 +115,15 @@ def _longest(problem: ResolvedProblem, n: int) -> list[space.Shape]:
     return space.shapes(problem, n)
 
 
-def _edge(problem: ResolvedProblem, mass: float) -> float:
-    """The lightest unsearched shape's mass as the search compares designs with it: equal masses
-    summed in another order differ in the last bits, so 1e-9 kg either way - ahead of a design
-    as heavy when margin may still tell them apart, level with it when nothing can."""
-    return mass - 1e-9 if "margin" in problem.rank else mass + 1e-9
+def floors(tiers: list) -> dict[int, float]:
+    """n -> the least mass of a shape of more than n units in the tiers ((n, splits, [(mass,
+    label, shape)]) each; Verifier.frontier's bound on what later tiers hold)."""
+    out: dict[int, float] = {}
+    least = float("inf")
+    for n, _, shapes in reversed(tiers):
+        out[n] = least
+        least = min([least, *(m for m, _, _ in shapes)])
+    return out
 
 
 def _tiers(problem: ResolvedProblem, spec: Spec, hi: int, closest: dict[str, float]) -> list:
@@ -199,8 +203,9 @@ class _Sweep:
         self.tiers = [] if blocked.any() else _tiers(problem, spec, self.hi, self.closest)
         self.total_shapes = sum(len(s) for _, _, s in self.tiers)
         self.total_settings = sum(estimate(spec, s) for _, _, shapes in self.tiers for _, _, s in shapes)
-        self.early = problem.rank[:2] == ("modules", "mass")
         self.tally = Verifier(problem, top, self.out, _mass)
+        self.tally.floors = floors(self.tiers)
+        self.early = self.tally.bounded
         self.done, self.settings, self.best = 0, 0.0, ""
         self.searched: list[ShapeResult] = []
 
@@ -225,7 +230,7 @@ class _Sweep:
         for k, batch in enumerate(rounds):
             halt = _Round(self, n, splits, batch).run()
             stop = _stopping(self.deadline)
-            nxt = _edge(self.problem, rounds[k + 1][0][0]) if k + 1 < len(rounds) and not stop else float("inf")
+            nxt = rounds[k + 1][0][0] if k + 1 < len(rounds) and not stop else float("inf")
             if halt is not None:  # the rest of the round unsearched: nothing heavier than it may be checked
                 nxt = halt
                 seen = {r.shape.label() for r in self.searched}
@@ -242,7 +247,7 @@ class _Sweep:
         if not self.early:
             return False
         self.tally.settle(n, float("inf"))
-        return self.tally.distinct_count() >= enough
+        return self.tally.done(n, float("inf"), enough)
 
     def absorb(self, n: int, splits, res: ShapeResult) -> None:
         out = self.out
@@ -338,7 +343,7 @@ class _Round:
         # executor: shapes complete in submission order). A round searched to its end stops the
         # search at `enough` (Sweep.tier).
         heavier = self.after.get(res.shape.label())
-        below = None if heavier is None else _edge(sw.problem, heavier)
+        below = heavier
         if sw.early and below is not None and not self.waiting and (res.found or sw.tally.accepted):
             sw.tally.settle(self.n, below)
             if sw.tally.done(self.n, below, sw.top):

@@ -12,6 +12,7 @@ from .rank import Design, identity
 from .search import ShapeResult
 
 TRIES = 3  # twist settings verified per chain before giving up on it
+SAME = 1e-6  # kg (or units): ranking values this close are level when bounding what is unsearched
 VERIFY_FACTOR = 4  # at most this many exact checks per design asked for, per number of units
 
 
@@ -22,6 +23,9 @@ class Verifier:
         self.accepted: list[Design] = []
         self.keys: list[tuple] = []
         self.checks = 0
+        # n -> the least mass of a shape of more than n units in the search (set by the search;
+        # absent: none)
+        self.floors: dict[int, float] = {}
 
     def add(self, n: int, splits, res: ShapeResult) -> None:
         from .rank import Screened, key
@@ -69,24 +73,51 @@ class Verifier:
             best[i] = min(best.get(i, k), k)
         return sorted(best.values())
 
-    def distinct_count(self) -> int:
-        return len(self._primary_keys())
+    @property
+    def bounded(self) -> bool:
+        """Can a design rank before every unsearched shape (the first objective ranked is modules
+        or mass, which the search's order bounds)? Then the search may stop early (done())."""
+        return bool(self.problem.rank) and self.problem.rank[0] in ("modules", "mass")
+
+    def frontier(self, n: int, below: float) -> tuple | None:
+        """The least ranking key (the static objectives', chain text left out) any design not yet
+        found could have: the shapes of n units from mass `below` kg on (inf: none left) and every
+        shape of more units (self.floors[n]: the least mass among them; absent: none). Modules
+        and mass bound it; any other objective (margin) is unbounded there, so no design is ahead
+        of an unsearched shape on it. None: nothing is left unsearched."""
+        inf = float("inf")
+        lows = ([(n, below)] if below != inf else []) + \
+            ([(n + 1, self.floors[n])] if self.floors.get(n, inf) != inf else [])
+        keys = [tuple(float(m) if o == "modules" else mass if o == "mass" else -inf for o in self.problem.rank)
+                for m, mass in lows]
+        return min(keys) if keys else None
+
+    def _ahead(self, k: tuple, bound: tuple | None) -> bool:
+        """Does a design of key k rank before everything left unsearched (bound: frontier())?
+        Objective by objective, values within SAME of each other are level (equal masses summed
+        in another order differ in the last bits). Level on every objective ranked: ahead when
+        margin is not ranked (nothing can tell them apart but the chain's text), else not (the
+        unsearched shape's margin may be larger)."""
+        if bound is None:
+            return True
+        for h, b in zip(k, bound, strict=False):
+            if abs(h - b) > SAME:
+                return h < b
+        return "margin" not in self.problem.rank
 
     def done(self, n: int, next_mass: float, count: int | None = None) -> bool:
-        """count (default top) distinct designs found that rank before anything of n units not
-        yet searched. Without margin in the ranking, a shape as heavy as a design found cannot
-        pass it (they tie on every objective ranked), so ties count as ahead too."""
-        ties = "margin" not in self.problem.rank
-        ahead = [k for k in self._primary_keys()
-                 if k[0] < n or (k[0] == n and (k[1] < next_mass or (ties and k[1] <= next_mass)))]
-        return len(ahead) >= (count or self.top)
+        """count (default top) distinct designs found that rank before every shape not yet
+        searched (frontier(n, next_mass))."""
+        bound = self.frontier(n, next_mass)
+        return sum(self._ahead(k, bound) for k in self._primary_keys()) >= (count or self.top)
 
     def settle(self, n: int, below: float) -> None:
-        """Check the pending chains of up to n units lighter than `below`, best first."""
-        ties = "margin" not in self.problem.rank  # as in done(): an equally heavy shape cannot pass
+        """Check the pending chains that rank before every shape not yet searched (frontier(n,
+        below)), best first."""
+        bound = self.frontier(n, below)
 
         def due(e) -> bool:
-            return e[1] < n or (e[1] == n and (e[2] < below or (ties and e[2] <= below)))
+            return self._ahead(e[0], bound)
 
         ready = sorted((e for e in self.pending if due(e)), key=lambda e: e[0])
         self.pending = [e for e in self.pending if not due(e)]
