@@ -20,6 +20,19 @@ tool position the suffix can reach are the target's distance apart:
   distance range), p_j (j > 2) within the interval of |p_j - p_2| of the circle;
 - the tool's height along joint 1's axis, z_1 . (tool - p_1) = e_z . v_1, does not depend on
   theta_1: exact range for two joints, a triangle bound after.
+
+A target's orientation (posed): the tool's rotation is R = R(K_0) Rz(theta_1) R(K_1) … Rz(theta_n)
+R(K_n), and a rotation within eps of the target's R_t turns no vector more than eps (and moves
+a point at distance r by at most the chord 2 sin(eps / 2) r). Two exact consequences:
+
+- tilt: the angle between joint 1's axis z_1 and a vector w fixed in the tool (w = R(K_n)^T e_z,
+  joint n's axis, for a full orientation; tool0's x axis for `pointing`) does not depend on
+  theta_1, and its range over the other joints is exact (angles of a vector turned about e_z
+  keep their tilt, see _tilt): the angle between z_1 and R_t w must lie within eps of it;
+- wrist: joint n's origin p_n = x - R R(K_n)^T t(K_n) follows from the tool's pose, so with a full
+  orientation it lies within tol + chord |R(K_n)^T t(K_n)| of x_t - R_t R(K_n)^T t(K_n), and the
+  chain of the first n - 1 joints (K_0 … K_(n-1)) must bring its end there (possible, per
+  setting). A 3-joint arm meets a 6-D pose only on a 3-D set: this rules out most settings.
 """
 from __future__ import annotations
 
@@ -95,9 +108,9 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float, flo
     n = k - 1 if tail is None else k  # joints whose origin p_j is fixed by f
     p1 = f.t[:, 0]  # (C, 3)
     z1 = f.R[:, 0, :, 2]
-    x = xyz[None]  # (1, T, 3)
-    tl = tol[None] + 1e-9  # rounding: a target exactly at an interval's end stays possible
-    ok = np.ones((C, len(xyz)), bool)
+    x = xyz if xyz.ndim == 3 else xyz[None]  # (C or 1, T, 3): a target per setting, or shared
+    tl = (tol if tol.ndim == 2 else tol[None]) + 1e-9  # rounding: a target exactly at an interval's end stays possible
+    ok = np.ones((C, x.shape[1]), bool)
     # D_1: p_1 fixed
     d1 = np.linalg.norm(x - p1[:, None], axis=-1)
     lo, hi = _reach(f, 1, tail)
@@ -139,6 +152,66 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float, flo
             dhi = dhi2 + uhi[:, None]
         wlo, whi = _reach(f, j, tail)
         ok &= (dlo <= whi[:, None] + tl) & (dhi >= wlo[:, None] - tl)
+    return ok
+
+
+def _tilt(f: Frames, gamma: np.ndarray, top: int) -> tuple[np.ndarray, np.ndarray]:
+    """Range (lo, hi) of the angle between e_z and R(K_1) Rz R(K_2) … R(K_top) Rz v over every
+    joint angle, for v at angle gamma (C,) from e_z. Turning v about e_z keeps its tilt gamma and
+    frees its azimuth, so against c = R(K_j)^T e_z (tilt b) the angle takes every value in
+    [|b - gamma|, pi - |pi - b - gamma|]: over a range of gamma, its distance to b, and pi less
+    the distance of pi - b to it (exact; the joint limits only shrink the set)."""
+    lo = hi = gamma
+    for j in range(top, 0, -1):
+        b = _polar(f.R[:, j, 2, :])
+        lo, hi = np.maximum.reduce([np.zeros_like(b), lo - b, b - hi]), np.pi - np.maximum.reduce(
+            [np.zeros_like(b), lo - (np.pi - b), (np.pi - b) - hi])
+    return lo, hi
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angles between unit vectors a, b (..., 3) (atan2: arccos loses 1e-8 rad near 0 and pi)."""
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), (a * b).sum(-1))
+
+
+def _polar(v: np.ndarray) -> np.ndarray:
+    """Angles between unit vectors v (..., 3) and e_z."""
+    return np.arctan2(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
+
+
+def posed(f: Frames, tg) -> np.ndarray:
+    """(C, T): False where no joint vector (limits or not) meets target t's orientation within its
+    tolerance and its position with it (tilt and wrist in the module docstring); True for the
+    targets without an orientation. tg: a reach.Targets."""
+    C, k = f.t.shape[:2]
+    n = k - 1
+    T = len(tg.xyz)
+    ok = np.ones((C, T), bool)
+    pointed = tg.pointed if len(tg.pointed) else np.zeros(T, bool)
+    full = np.flatnonzero(tg.oriented & ~pointed)
+    point = np.flatnonzero(tg.oriented & pointed)
+    z1 = f.R[:, 0, :, 2]  # (C, 3)
+    Rn = f.R[:, n]
+    slack = 1e-7  # rad and m: rounding never excludes a pose at the edge of its tolerances
+    if full.size:
+        eps = np.minimum(tg.tol_r[full], np.pi)
+        w = Rn[:, 2, :]  # R(K_n)^T e_z: joint n's axis in the tool frame
+        lo, hi = _tilt(f, _polar(f.R[:, n - 1, :, 2]), n - 2) if n > 1 else (
+            np.zeros(C), np.zeros(C))
+        a = _angle(np.einsum("tij,cj->cti", tg.R[full], w), z1[:, None])
+        ok[:, full] &= (a >= lo[:, None] - eps - slack) & (a <= hi[:, None] + eps + slack)
+        u = np.einsum("cji,cj->ci", Rn, f.t[:, n])  # joint n's origin to tool0, in the tool frame
+        wrist = tg.xyz[full][None] - np.einsum("tij,cj->cti", tg.R[full], u)  # (C, T', 3)
+        tol = tg.tol_p[full][None] + 2 * np.sin(eps / 2)[None] * np.linalg.norm(u, axis=-1)[:, None]
+        if n == 1:  # p_1 is fixed
+            ok[:, full] &= np.linalg.norm(wrist - f.t[:, 0][:, None], axis=-1) <= tol + slack
+        else:
+            ok[:, full] &= possible(Frames(f.R[:, :n], f.t[:, :n]), wrist, tol + slack)
+    if point.size:
+        eps = np.minimum(tg.tol_r[point], np.pi)
+        lo, hi = _tilt(f, _polar(Rn[:, :, 0]), n - 1)  # tool0's x axis: R(K_n) e_x
+        a = _angle(tg.axis[point][None], z1[:, None])
+        ok[:, point] &= (a >= lo[:, None] - eps - slack) & (a <= hi[:, None] + eps + slack)
     return ok
 
 

@@ -40,6 +40,7 @@ from .space import Shape, port_free, twist_values
 COMPLETE = 2_000_000  # settings of a shape searched in full up to this many
 BLOCK = 4096  # settings screened together (numpy amortisation)
 WORK = 65536  # settings per unit of work
+ORIENTED = True  # the orientation bounds (bounds.posed) screen settings before the IK (off: tests compare)
 KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
 
 STOP = threading.Event()  # set by Ctrl-C in this process: blocks end at the next boundary
@@ -284,7 +285,10 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         end = min(start + BLOCK, hi)
         piv, por = settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
-        ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
+        f = bounds.frames(g)
+        ok: np.ndarray = np.asarray(bounds.possible(f, tg.xyz, tg.tol_p).all(-1))
+        if ORIENTED and tg.oriented.any() and ok.any():
+            ok[ok] = bounds.posed(bounds.Frames(f.R[ok], f.t[ok]), tg).all(-1)
         excluded += int((~ok).sum())
         upto = end
         for tick in TICK:
