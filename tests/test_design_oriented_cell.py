@@ -55,8 +55,8 @@ def test_the_orientation_bounds_change_no_ranking(monkeypatch, rank, space):
     calls = []
     real = bounds.posed
 
-    def counted(f, tg):
-        out = real(f, tg)
+    def counted(f, tg, every=False):
+        out = real(f, tg, every)
         calls.append((out.size, int((~out).sum())))
         return out
 

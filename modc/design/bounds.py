@@ -179,40 +179,112 @@ def _polar(v: np.ndarray) -> np.ndarray:
     return np.arctan2(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
 
 
-def posed(f: Frames, tg) -> np.ndarray:
+SLACK = 1e-7  # rad and m: rounding never excludes a pose at the edge of its tolerances
+SPIN = 128  # joint 2's angles a 3-joint chain's wrist scan samples (Lipschitz margins cover the gaps)
+
+
+def _tilt_ok(f: Frames, tg, full: np.ndarray) -> np.ndarray:
+    """(C, T'): the tilt of joint n's axis to joint 1's fits the targets full's rotations."""
+    C, n = len(f.t), f.t.shape[1] - 1
+    eps = np.minimum(tg.tol_r[full], np.pi)
+    lo, hi = _tilt(f, _polar(f.R[:, n - 1, :, 2]), n - 2) if n > 1 else (np.zeros(C), np.zeros(C))
+    a = _angle(np.einsum("tij,cj->cti", tg.R[full], f.R[:, n, 2, :]), f.R[:, 0, :, 2][:, None])
+    return (a >= lo[:, None] - eps - SLACK) & (a <= hi[:, None] + eps + SLACK)
+
+
+def _pointing_ok(f: Frames, tg, point: np.ndarray) -> np.ndarray:
+    """(C, T'): the tilt of tool0's x axis (R(K_n) e_x) to joint 1's axis fits the targets' axes."""
+    n = f.t.shape[1] - 1
+    eps = np.minimum(tg.tol_r[point], np.pi)
+    lo, hi = _tilt(f, _polar(f.R[:, n, :, 0]), n - 1)
+    a = _angle(tg.axis[point][None], f.R[:, 0, :, 2][:, None])
+    return (a >= lo[:, None] - eps - SLACK) & (a <= hi[:, None] + eps + SLACK)
+
+
+def _wrist(f: Frames, tg, full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where the targets full's poses put joint n's origin (C, T', 3), within tol (C, T'); eps (T')."""
+    n = f.t.shape[1] - 1
+    eps = np.minimum(tg.tol_r[full], np.pi)
+    u = np.einsum("cji,cj->ci", f.R[:, n], f.t[:, n])  # joint n's origin to tool0, in the tool frame
+    wrist = tg.xyz[full][None] - np.einsum("tij,cj->cti", tg.R[full], u)
+    tol = tg.tol_p[full][None] + 2 * np.sin(eps / 2)[None] * np.linalg.norm(u, axis=-1)[:, None] + SLACK
+    return wrist, tol, eps
+
+
+def _wrist_ok(f: Frames, tg, full: np.ndarray) -> np.ndarray:
+    """(C, T'): joint n's origin, where the targets full's poses put it, within reach of the
+    first n - 1 joints."""
+    n = f.t.shape[1] - 1
+    wrist, tol, _ = _wrist(f, tg, full)
+    if n == 1:  # p_1 is fixed
+        return np.linalg.norm(wrist - f.t[:, 0][:, None], axis=-1) <= tol
+    return possible(Frames(f.R[:, :n], f.t[:, :n]), wrist, tol)
+
+
+def _spin(f: Frames, tg, full: np.ndarray) -> np.ndarray:
+    """(C, T'), 3 joints: some theta_2 puts p_3 at the wrist's height along z_1 and distance from
+    p_1 (within tol) and joint 3's axis at its tilt to z_1 (within eps) - the three at once. In
+    joint 1's frame a = t(K_1) + R(K_1) Rz(theta_2) t(K_2) is p_3 - p_1 and b = R(K_1) Rz(theta_2)
+    R(K_2) e_z is z_3; a_z, |a|^2 and b_z are each m + A cos(theta_2 - phi), so between the SPIN
+    samples each moves by at most A pi / SPIN from the nearest one: a sample within the bands so
+    widened stands for every angle near it. Other chains: True."""
+    if f.t.shape[1] != 4:
+        return np.ones((len(f.t), len(full)), bool)
+    wrist, tol, eps = _wrist(f, tg, full)
+    R0, p1 = f.R[:, 0], f.t[:, 0]
+    W = np.einsum("cji,ctj->cti", R0, wrist - p1[:, None])  # the wrist in joint 1's frame
+    Z = np.einsum("cji,ctj->cti", R0, np.einsum("tij,cj->cti", tg.R[full], f.R[:, 3, 2, :]))
+    gamma = _polar(Z)
+    t1, t2, c1 = f.t[:, 1], f.t[:, 2], f.R[:, 1, 2, :]  # c1 = R(K_1)^T e_z
+    th = np.arange(SPIN) * (2 * np.pi / SPIN)
+    cs, sn = np.cos(th), np.sin(th)
+
+    def wave(p: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """p . Rz(theta) v at the samples (C, SPIN), and its amplitude's reach between them (C,)."""
+        a = p[:, 0] * v[:, 0] + p[:, 1] * v[:, 1]
+        b = p[:, 1] * v[:, 0] - p[:, 0] * v[:, 1]
+        return (p[:, 2] * v[:, 2])[:, None] + a[:, None] * cs + b[:, None] * sn, np.hypot(a, b) * np.pi / SPIN
+
+    h, dh = wave(c1, t2)
+    d, dd = wave(np.einsum("cji,cj->ci", f.R[:, 1], t1), t2)
+    z, dz = wave(c1, f.R[:, 2, :, 2])
+    h = h + t1[:, 2:3]
+    d = (t1 * t1).sum(-1)[:, None] + (t2 * t2).sum(-1)[:, None] + 2 * d
+    rho = np.linalg.norm(W, axis=-1)
+
+    def within(x: np.ndarray, dx: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        return (x[:, None] >= lo[..., None] - dx[:, None, None] - SLACK) & (
+            x[:, None] <= hi[..., None] + dx[:, None, None] + SLACK)
+
+    ok = within(h, dh, W[..., 2] - tol, W[..., 2] + tol)
+    ok &= within(d, 2 * dd, np.maximum(rho - tol, 0.0) ** 2, (rho + tol) ** 2)
+    ok &= within(z, dz, np.cos(np.minimum(gamma + eps, np.pi)), np.cos(np.maximum(gamma - eps, 0.0)))
+    return ok.any(-1)
+
+
+def posed(f: Frames, tg, every: bool = False) -> np.ndarray:
     """(C, T): False where no joint vector (limits or not) meets target t's orientation within its
     tolerance and its position with it (tilt and wrist in the module docstring); True for the
-    targets without an orientation. tg: a reach.Targets."""
-    C, k = f.t.shape[:2]
-    n = k - 1
-    T = len(tg.xyz)
-    ok = np.ones((C, T), bool)
+    targets without an orientation. tg: a reach.Targets. every: (C,) whether every target may be
+    met, each test on the settings the cheaper ones left."""
+    C, T = len(f.t), len(tg.xyz)
     pointed = tg.pointed if len(tg.pointed) else np.zeros(T, bool)
     full = np.flatnonzero(tg.oriented & ~pointed)
     point = np.flatnonzero(tg.oriented & pointed)
-    z1 = f.R[:, 0, :, 2]  # (C, 3)
-    Rn = f.R[:, n]
-    slack = 1e-7  # rad and m: rounding never excludes a pose at the edge of its tolerances
-    if full.size:
-        eps = np.minimum(tg.tol_r[full], np.pi)
-        w = Rn[:, 2, :]  # R(K_n)^T e_z: joint n's axis in the tool frame
-        lo, hi = _tilt(f, _polar(f.R[:, n - 1, :, 2]), n - 2) if n > 1 else (
-            np.zeros(C), np.zeros(C))
-        a = _angle(np.einsum("tij,cj->cti", tg.R[full], w), z1[:, None])
-        ok[:, full] &= (a >= lo[:, None] - eps - slack) & (a <= hi[:, None] + eps + slack)
-        u = np.einsum("cji,cj->ci", Rn, f.t[:, n])  # joint n's origin to tool0, in the tool frame
-        wrist = tg.xyz[full][None] - np.einsum("tij,cj->cti", tg.R[full], u)  # (C, T', 3)
-        tol = tg.tol_p[full][None] + 2 * np.sin(eps / 2)[None] * np.linalg.norm(u, axis=-1)[:, None]
-        if n == 1:  # p_1 is fixed
-            ok[:, full] &= np.linalg.norm(wrist - f.t[:, 0][:, None], axis=-1) <= tol + slack
-        else:
-            ok[:, full] &= possible(Frames(f.R[:, :n], f.t[:, :n]), wrist, tol + slack)
-    if point.size:
-        eps = np.minimum(tg.tol_r[point], np.pi)
-        lo, hi = _tilt(f, _polar(Rn[:, :, 0]), n - 1)  # tool0's x axis: R(K_n) e_x
-        a = _angle(tg.axis[point][None], z1[:, None])
-        ok[:, point] &= (a >= lo[:, None] - eps - slack) & (a <= hi[:, None] + eps + slack)
-    return ok
+    tests = [(idx, test) for idx, test in ((full, _tilt_ok), (point, _pointing_ok), (full, _wrist_ok),
+                                                    (full, _spin)) if idx.size]
+    if not every:
+        ok = np.ones((C, T), bool)
+        for idx, test in tests:
+            ok[:, idx] &= test(f, tg, idx)
+        return ok
+    alive = np.arange(C)
+    for idx, test in tests:
+        if alive.size:
+            alive = alive[test(Frames(f.R[alive], f.t[alive]), tg, idx).all(-1)]
+    out = np.zeros(C, bool)
+    out[alive] = True
+    return out
 
 
 def blocked(obstacles, xyz: np.ndarray, tol: np.ndarray, tool_reach: float, radius: float, reach: float,

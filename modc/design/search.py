@@ -286,9 +286,10 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         piv, por = settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
         f = bounds.frames(g)
-        ok: np.ndarray = np.asarray(bounds.possible(f, tg.xyz, tg.tol_p).all(-1))
-        if ORIENTED and tg.oriented.any() and ok.any():
-            ok[ok] = bounds.posed(bounds.Frames(f.R[ok], f.t[ok]), tg).all(-1)
+        # the orientation bounds first where they apply: cheaper per setting, and most settings fail them
+        ok = bounds.posed(f, tg, every=True) if ORIENTED and tg.oriented.any() else np.ones(len(piv), bool)
+        if ok.any():
+            ok[ok] = bounds.possible(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p).all(-1)
         excluded += int((~ok).sum())
         upto = end
         for tick in TICK:
