@@ -259,7 +259,7 @@ def _spin(f: Frames, tg, full: np.ndarray) -> np.ndarray:
     ok = within(h, dh, W[..., 2] - tol, W[..., 2] + tol)
     ok &= within(d, 2 * dd, np.maximum(rho - tol, 0.0) ** 2, (rho + tol) ** 2)
     ok &= within(z, dz, np.cos(np.minimum(gamma + eps, np.pi)), np.cos(np.maximum(gamma - eps, 0.0)))
-    return ok.any(-1)
+    return np.asarray(ok.any(-1))
 
 
 def posed(f: Frames, tg, every: bool = False) -> np.ndarray:
