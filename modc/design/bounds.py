@@ -169,13 +169,8 @@ def _tilt(f: Frames, gamma: np.ndarray, top: int) -> tuple[np.ndarray, np.ndarra
     return lo, hi
 
 
-def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Angles between unit vectors a, b (..., 3) (atan2: arccos loses 1e-8 rad near 0 and pi)."""
-    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), (a * b).sum(-1))
-
-
 def _polar(v: np.ndarray) -> np.ndarray:
-    """Angles between unit vectors v (..., 3) and e_z."""
+    """Angles between unit vectors v (..., 3) and e_z (atan2: arccos loses 1e-8 rad near 0 and pi)."""
     return np.arctan2(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
 
 
@@ -183,13 +178,24 @@ SLACK = 1e-7  # rad and m: rounding never excludes a pose at the edge of its tol
 SPIN = 128  # joint 2's angles a 3-joint chain's wrist scan samples (Lipschitz margins cover the gaps)
 
 
+def _turned(R: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """R[t] v[c] (C, T, 3) for rotations R (T, 3, 3) and vectors v (C, 3): one matrix product."""
+    return (v @ R.reshape(-1, 3).T).reshape(len(v), len(R), 3)
+
+
+def _cos_within(c: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Whether the angles whose cosines are c lie in [lo, hi] (rad, any range: clipped to [0, pi]),
+    compared as cosines (no arccos) with 1e-12 for rounding."""
+    return (c >= np.cos(np.clip(hi, 0.0, np.pi)) - 1e-12) & (c <= np.cos(np.clip(lo, 0.0, np.pi)) + 1e-12)
+
+
 def _tilt_ok(f: Frames, tg, full: np.ndarray) -> np.ndarray:
     """(C, T'): the tilt of joint n's axis to joint 1's fits the targets full's rotations."""
     C, n = len(f.t), f.t.shape[1] - 1
     eps = np.minimum(tg.tol_r[full], np.pi)
     lo, hi = _tilt(f, _polar(f.R[:, n - 1, :, 2]), n - 2) if n > 1 else (np.zeros(C), np.zeros(C))
-    a = _angle(np.einsum("tij,cj->cti", tg.R[full], f.R[:, n, 2, :]), f.R[:, 0, :, 2][:, None])
-    return (a >= lo[:, None] - eps - SLACK) & (a <= hi[:, None] + eps + SLACK)
+    c = (_turned(tg.R[full], f.R[:, n, 2, :]) * f.R[:, 0, :, 2][:, None]).sum(-1)
+    return _cos_within(c, lo[:, None] - eps - SLACK, hi[:, None] + eps + SLACK)
 
 
 def _pointing_ok(f: Frames, tg, point: np.ndarray) -> np.ndarray:
@@ -197,8 +203,8 @@ def _pointing_ok(f: Frames, tg, point: np.ndarray) -> np.ndarray:
     n = f.t.shape[1] - 1
     eps = np.minimum(tg.tol_r[point], np.pi)
     lo, hi = _tilt(f, _polar(f.R[:, n, :, 0]), n - 1)
-    a = _angle(tg.axis[point][None], f.R[:, 0, :, 2][:, None])
-    return (a >= lo[:, None] - eps - SLACK) & (a <= hi[:, None] + eps + SLACK)
+    c = f.R[:, 0, :, 2] @ tg.axis[point].T
+    return _cos_within(c, lo[:, None] - eps - SLACK, hi[:, None] + eps + SLACK)
 
 
 def _wrist(f: Frames, tg, full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -206,7 +212,7 @@ def _wrist(f: Frames, tg, full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.
     n = f.t.shape[1] - 1
     eps = np.minimum(tg.tol_r[full], np.pi)
     u = np.einsum("cji,cj->ci", f.R[:, n], f.t[:, n])  # joint n's origin to tool0, in the tool frame
-    wrist = tg.xyz[full][None] - np.einsum("tij,cj->cti", tg.R[full], u)
+    wrist = tg.xyz[full][None] - _turned(tg.R[full], u)
     tol = tg.tol_p[full][None] + 2 * np.sin(eps / 2)[None] * np.linalg.norm(u, axis=-1)[:, None] + SLACK
     return wrist, tol, eps
 
@@ -232,8 +238,8 @@ def _spin(f: Frames, tg, full: np.ndarray) -> np.ndarray:
         return np.ones((len(f.t), len(full)), bool)
     wrist, tol, eps = _wrist(f, tg, full)
     R0, p1 = f.R[:, 0], f.t[:, 0]
-    W = np.einsum("cji,ctj->cti", R0, wrist - p1[:, None])  # the wrist in joint 1's frame
-    Z = np.einsum("cji,ctj->cti", R0, np.einsum("tij,cj->cti", tg.R[full], f.R[:, 3, 2, :]))
+    W = (wrist - p1[:, None]) @ R0  # the wrist in joint 1's frame
+    Z = _turned(tg.R[full], f.R[:, 3, 2, :]) @ R0
     gamma = _polar(Z)
     t1, t2, c1 = f.t[:, 1], f.t[:, 2], f.R[:, 1, 2, :]  # c1 = R(K_1)^T e_z
     th = np.arange(SPIN) * (2 * np.pi / SPIN)
