@@ -93,6 +93,9 @@ def test_a_reached_pose_moved_within_its_tolerances_is_never_excluded(n):
             # every target at once, each test on the settings the cheaper ones left: the same answer
             some = tg.take(np.arange(0, C, 37))
             assert (bounds.posed(f, some, every=True) == bounds.posed(f, some).all(-1)).all()
+            # targets sharing a rotation (a region's points) are tested once: the same columns
+            twice = bounds.posed(f, tg.take(np.array([3, 5, 3, 3])))
+            assert (twice[:, 0] == twice[:, 2]).all() and (twice[:, :2] == ok[:, [3, 5]]).all()
             if n <= 3 and not pointed:
                 assert (~ok).mean() > 0.5  # a 6-D pose is out of most settings' reach
 

@@ -192,10 +192,13 @@ def _cos_within(c: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 def _tilt_ok(f: Frames, tg, full: np.ndarray) -> np.ndarray:
     """(C, T'): the tilt of joint n's axis to joint 1's fits the targets full's rotations."""
     C, n = len(f.t), f.t.shape[1] - 1
-    eps = np.minimum(tg.tol_r[full], np.pi)
+    # the test depends on the rotation and its tolerance only: once per distinct pair (a region's
+    # points share theirs)
+    keys, back = np.unique(np.column_stack([tg.R[full].reshape(-1, 9), tg.tol_r[full]]), axis=0, return_inverse=True)
+    eps = np.minimum(keys[:, 9], np.pi)
     lo, hi = _tilt(f, _polar(f.R[:, n - 1, :, 2]), n - 2) if n > 1 else (np.zeros(C), np.zeros(C))
-    c = (_turned(tg.R[full], f.R[:, n, 2, :]) * f.R[:, 0, :, 2][:, None]).sum(-1)
-    return _cos_within(c, lo[:, None] - eps - SLACK, hi[:, None] + eps + SLACK)
+    c = (_turned(keys[:, :9].reshape(-1, 3, 3), f.R[:, n, 2, :]) * f.R[:, 0, :, 2][:, None]).sum(-1)
+    return _cos_within(c, lo[:, None] - eps - SLACK, hi[:, None] + eps + SLACK)[:, back.reshape(-1)]
 
 
 def _pointing_ok(f: Frames, tg, point: np.ndarray) -> np.ndarray:
