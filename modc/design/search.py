@@ -4,7 +4,8 @@ Complete within its bounds: every setting of a shape is either screened (batched
 within the joint limits, then the obstacle screen) or excluded by a sound bound - whole
 families of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free),
 then setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0
-within tolerance of some target). Exact reductions (modc.design.space) remove settings that
+within tolerance of some target, or meets its orientation with its position - bounds.posed,
+first). Exact reductions (modc.design.space) remove settings that
 cannot change tool0. A shape whose families left alive hold more than dominance.FIRST settings
 is searched level by level - fewest nonzero twists first - and closed by a dominance bound as
 soon as its kept settings cannot be beaten by any setting left (modc.design.dominance); only
