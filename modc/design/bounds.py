@@ -20,6 +20,19 @@ tool position the suffix can reach are the target's distance apart:
   distance range), p_j (j > 2) within the interval of |p_j - p_2| of the circle;
 - the tool's height along joint 1's axis, z_1 . (tool - p_1) = e_z . v_1, does not depend on
   theta_1: exact range for two joints, a triangle bound after.
+
+A target's orientation (posed): the tool's rotation is R = R(K_0) Rz(theta_1) R(K_1) … Rz(theta_n)
+R(K_n), and a rotation within eps of the target's R_t turns no vector more than eps (and moves
+a point at distance r by at most the chord 2 sin(eps / 2) r). Two exact consequences:
+
+- tilt: the angle between joint 1's axis z_1 and a vector w fixed in the tool (w = R(K_n)^T e_z,
+  joint n's axis, for a full orientation; tool0's x axis for `pointing`) does not depend on
+  theta_1, and its range over the other joints is exact (angles of a vector turned about e_z
+  keep their tilt, see _tilt): the angle between z_1 and R_t w must lie within eps of it;
+- wrist: joint n's origin p_n = x - R R(K_n)^T t(K_n) follows from the tool's pose, so with a full
+  orientation it lies within tol + chord |R(K_n)^T t(K_n)| of x_t - R_t R(K_n)^T t(K_n), and the
+  chain of the first n - 1 joints (K_0 … K_(n-1)) must bring its end there (possible, per
+  setting). A 3-joint arm meets a 6-D pose only on a 3-D set: this rules out most settings.
 """
 from __future__ import annotations
 
@@ -112,9 +125,9 @@ def possible(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float, flo
     n = k - 1 if tail is None else k  # joints whose origin p_j is fixed by f
     p1 = f.t[:, 0]  # (C, 3)
     z1 = f.R[:, 0, :, 2]
-    x = xyz[None]  # (1, T, 3)
-    tl = tol[None] + 1e-9  # rounding: a target exactly at an interval's end stays possible
-    ok = np.ones((C, len(xyz)), bool)
+    x = xyz if xyz.ndim == 3 else xyz[None]  # (C or 1, T, 3): a target per setting, or shared
+    tl = (tol if tol.ndim == 2 else tol[None]) + 1e-9  # rounding: a target exactly at an interval's end stays possible
+    ok = np.ones((C, x.shape[1]), bool)
     # D_1: p_1 fixed
     dx = x - p1[:, None]
     d1 = _norm(dx)
@@ -176,6 +189,147 @@ def possible_all(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float,
         return alive
     out = np.zeros_like(alive)
     out[rows] = np.logical_and.reduceat(possible(Frames(f.R[rows], f.t[rows]), xyz, tol, tail), starts, axis=1)
+    return out
+
+
+def _tilt(f: Frames, gamma: np.ndarray, top: int) -> tuple[np.ndarray, np.ndarray]:
+    """Range (lo, hi) of the angle between e_z and R(K_1) Rz R(K_2) … R(K_top) Rz v over every
+    joint angle, for v at angle gamma (C,) from e_z. Turning v about e_z keeps its tilt gamma and
+    frees its azimuth, so against c = R(K_j)^T e_z (tilt b) the angle takes every value in
+    [|b - gamma|, pi - |pi - b - gamma|]: over a range of gamma, its distance to b, and pi less
+    the distance of pi - b to it (exact; the joint limits only shrink the set)."""
+    lo = hi = gamma
+    for j in range(top, 0, -1):
+        b = _polar(f.R[:, j, 2, :])
+        lo, hi = np.maximum.reduce([np.zeros_like(b), lo - b, b - hi]), np.pi - np.maximum.reduce(
+            [np.zeros_like(b), lo - (np.pi - b), (np.pi - b) - hi])
+    return lo, hi
+
+
+def _polar(v: np.ndarray) -> np.ndarray:
+    """Angles between unit vectors v (..., 3) and e_z (atan2: arccos loses 1e-8 rad near 0 and pi)."""
+    return np.arctan2(np.hypot(v[..., 0], v[..., 1]), v[..., 2])
+
+
+SLACK = 1e-7  # rad and m: rounding never excludes a pose at the edge of its tolerances
+SPIN = 128  # joint 2's angles a 3-joint chain's wrist scan samples (Lipschitz margins cover the gaps)
+
+
+def _turned(R: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """R[t] v[c] (C, T, 3) for rotations R (T, 3, 3) and vectors v (C, 3): one matrix product."""
+    return (v @ R.reshape(-1, 3).T).reshape(len(v), len(R), 3)
+
+
+def _cos_within(c: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Whether the angles whose cosines are c lie in [lo, hi] (rad, any range: clipped to [0, pi]),
+    compared as cosines (no arccos) with 1e-12 for rounding."""
+    return (c >= np.cos(np.clip(hi, 0.0, np.pi)) - 1e-12) & (c <= np.cos(np.clip(lo, 0.0, np.pi)) + 1e-12)
+
+
+def _tilt_ok(f: Frames, tg, full: np.ndarray) -> np.ndarray:
+    """(C, T'): the tilt of joint n's axis to joint 1's fits the targets full's rotations."""
+    C, n = len(f.t), f.t.shape[1] - 1
+    # the test depends on the rotation and its tolerance only: once per distinct pair (a region's
+    # points share theirs)
+    keys, back = np.unique(np.column_stack([tg.R[full].reshape(-1, 9), tg.tol_r[full]]), axis=0, return_inverse=True)
+    eps = np.minimum(keys[:, 9], np.pi)
+    lo, hi = _tilt(f, _polar(f.R[:, n - 1, :, 2]), n - 2) if n > 1 else (np.zeros(C), np.zeros(C))
+    c = (_turned(keys[:, :9].reshape(-1, 3, 3), f.R[:, n, 2, :]) * f.R[:, 0, :, 2][:, None]).sum(-1)
+    return _cos_within(c, lo[:, None] - eps - SLACK, hi[:, None] + eps + SLACK)[:, back.reshape(-1)]
+
+
+def _pointing_ok(f: Frames, tg, point: np.ndarray) -> np.ndarray:
+    """(C, T'): the tilt of tool0's x axis (R(K_n) e_x) to joint 1's axis fits the targets' axes."""
+    n = f.t.shape[1] - 1
+    eps = np.minimum(tg.tol_r[point], np.pi)
+    lo, hi = _tilt(f, _polar(f.R[:, n, :, 0]), n - 1)
+    c = f.R[:, 0, :, 2] @ tg.axis[point].T
+    return _cos_within(c, lo[:, None] - eps - SLACK, hi[:, None] + eps + SLACK)
+
+
+def _wrist(f: Frames, tg, full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where the targets full's poses put joint n's origin (C, T', 3), within tol (C, T'); eps (T')."""
+    n = f.t.shape[1] - 1
+    eps = np.minimum(tg.tol_r[full], np.pi)
+    u = np.einsum("cji,cj->ci", f.R[:, n], f.t[:, n])  # joint n's origin to tool0, in the tool frame
+    wrist = tg.xyz[full][None] - _turned(tg.R[full], u)
+    tol = tg.tol_p[full][None] + 2 * np.sin(eps / 2)[None] * np.linalg.norm(u, axis=-1)[:, None] + SLACK
+    return wrist, tol, eps
+
+
+def _wrist_ok(f: Frames, tg, full: np.ndarray) -> np.ndarray:
+    """(C, T'): joint n's origin, where the targets full's poses put it, within reach of the
+    first n - 1 joints."""
+    n = f.t.shape[1] - 1
+    wrist, tol, _ = _wrist(f, tg, full)
+    if n == 1:  # p_1 is fixed
+        return np.linalg.norm(wrist - f.t[:, 0][:, None], axis=-1) <= tol
+    return possible(Frames(f.R[:, :n], f.t[:, :n]), wrist, tol)
+
+
+def _spin(f: Frames, tg, full: np.ndarray) -> np.ndarray:
+    """(C, T'), 3 joints: some theta_2 puts p_3 at the wrist's height along z_1 and distance from
+    p_1 (within tol) and joint 3's axis at its tilt to z_1 (within eps) - the three at once. In
+    joint 1's frame a = t(K_1) + R(K_1) Rz(theta_2) t(K_2) is p_3 - p_1 and b = R(K_1) Rz(theta_2)
+    R(K_2) e_z is z_3; a_z, |a|^2 and b_z are each m + A cos(theta_2 - phi), so between the SPIN
+    samples each moves by at most A pi / SPIN from the nearest one: a sample within the bands so
+    widened stands for every angle near it. Other chains: True."""
+    if f.t.shape[1] != 4:
+        return np.ones((len(f.t), len(full)), bool)
+    wrist, tol, eps = _wrist(f, tg, full)
+    R0, p1 = f.R[:, 0], f.t[:, 0]
+    W = (wrist - p1[:, None]) @ R0  # the wrist in joint 1's frame
+    Z = _turned(tg.R[full], f.R[:, 3, 2, :]) @ R0
+    gamma = _polar(Z)
+    t1, t2, c1 = f.t[:, 1], f.t[:, 2], f.R[:, 1, 2, :]  # c1 = R(K_1)^T e_z
+    th = np.arange(SPIN) * (2 * np.pi / SPIN)
+    cs, sn = np.cos(th), np.sin(th)
+
+    def wave(p: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """p . Rz(theta) v at the samples (C, SPIN), and its amplitude's reach between them (C,)."""
+        a = p[:, 0] * v[:, 0] + p[:, 1] * v[:, 1]
+        b = p[:, 1] * v[:, 0] - p[:, 0] * v[:, 1]
+        return (p[:, 2] * v[:, 2])[:, None] + a[:, None] * cs + b[:, None] * sn, np.hypot(a, b) * np.pi / SPIN
+
+    h, dh = wave(c1, t2)
+    d, dd = wave(np.einsum("cji,cj->ci", f.R[:, 1], t1), t2)
+    z, dz = wave(c1, f.R[:, 2, :, 2])
+    h = h + t1[:, 2:3]
+    d = (t1 * t1).sum(-1)[:, None] + (t2 * t2).sum(-1)[:, None] + 2 * d
+    rho = np.linalg.norm(W, axis=-1)
+
+    def within(x: np.ndarray, dx: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        return (x[:, None] >= lo[..., None] - dx[:, None, None] - SLACK) & (
+            x[:, None] <= hi[..., None] + dx[:, None, None] + SLACK)
+
+    ok = within(h, dh, W[..., 2] - tol, W[..., 2] + tol)
+    ok &= within(d, 2 * dd, np.maximum(rho - tol, 0.0) ** 2, (rho + tol) ** 2)
+    ok &= within(z, dz, np.cos(np.minimum(gamma + eps, np.pi)), np.cos(np.maximum(gamma - eps, 0.0)))
+    return np.asarray(ok.any(-1))
+
+
+def posed(f: Frames, tg, every: bool = False) -> np.ndarray:
+    """(C, T): False where no joint vector (limits or not) meets target t's orientation within its
+    tolerance and its position with it (tilt and wrist in the module docstring); True for the
+    targets without an orientation. tg: a reach.Targets. every: (C,) whether every target may be
+    met, each test on the settings the cheaper ones left."""
+    C, T = len(f.t), len(tg.xyz)
+    pointed = tg.pointed if len(tg.pointed) else np.zeros(T, bool)
+    full = np.flatnonzero(tg.oriented & ~pointed)
+    point = np.flatnonzero(tg.oriented & pointed)
+    tests = [(idx, test) for idx, test in ((full, _tilt_ok), (point, _pointing_ok), (full, _wrist_ok),
+                                                    (full, _spin)) if idx.size]
+    if not every:
+        ok = np.ones((C, T), bool)
+        for idx, test in tests:
+            ok[:, idx] &= test(f, tg, idx)
+        return ok
+    alive = np.arange(C)
+    for idx, test in tests:
+        if alive.size:
+            alive = alive[test(Frames(f.R[alive], f.t[alive]), tg, idx).all(-1)]
+    out = np.zeros(C, bool)
+    out[alive] = True
     return out
 
 

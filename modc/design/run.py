@@ -70,8 +70,9 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
         found = len(out.designs)
         tasks.plan_all(out, top, seed, deadline, _stopping, rejected, _planning(out, progress))
         # every candidate failed its tasks: search on for more of them while there may be more (the
-        # search stopped once `enough` designs ranked first, or it returned as many as asked)
-        exhausted = found < n and enough[0] >= n
+        # search stopped once `enough` designs ranked first, or it returned as many as asked); with
+        # fewer than `enough` it searched every shape, and a second search would find the same
+        exhausted = found < n and (enough[0] >= n or found < enough[0])
         if out.designs or out.stopped or exhausted or n >= MAX_CANDIDATES:
             break
         n = enough[0] = min(n * 4, MAX_CANDIDATES)

@@ -4,7 +4,8 @@ Complete within its bounds: every setting of a shape is either screened (batched
 within the joint limits, then the obstacle screen) or excluded by a sound bound - whole
 families of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free),
 then setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0
-within tolerance of some target). Exact reductions (modc.design.space) remove settings that
+within tolerance of some target, or meets its orientation with its position - bounds.posed,
+first). Exact reductions (modc.design.space) remove settings that
 cannot change tool0. A shape whose families left alive hold more than dominance.FIRST settings
 is searched level by level - fewest nonzero twists first - and closed by a dominance bound as
 soon as its kept settings cannot be beaten by any setting left (modc.design.dominance); only
@@ -40,6 +41,7 @@ from .space import Shape, port_free, twist_values
 COMPLETE = 2_000_000  # settings of a shape searched in full up to this many
 BLOCK = 4096  # settings screened together (numpy amortisation)
 WORK = 65536  # settings per unit of work
+ORIENTED = True  # the orientation bounds (bounds.posed) screen settings before the IK (off: tests compare)
 KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
 
 STOP = threading.Event()  # set by Ctrl-C in this process: blocks end at the next boundary
@@ -284,7 +286,11 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         end = min(start + BLOCK, hi)
         piv, por = settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
-        ok = bounds.possible(bounds.frames(g), tg.xyz, tg.tol_p).all(-1)
+        f = bounds.frames(g)
+        # the orientation bounds first where they apply: cheaper per setting, and most settings fail them
+        ok = bounds.posed(f, tg, every=True) if ORIENTED and tg.oriented.any() else np.ones(len(piv), bool)
+        if ok.any():
+            ok[ok] = bounds.possible(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p).all(-1)
         excluded += int((~ok).sum())
         upto = end
         for tick in TICK:
