@@ -203,7 +203,7 @@ def _plan(spec: Spec, shape: Shape) -> Plan:
     free = port_free(spec.problem, shape, lib)
     lv = prefix.levels(types, links, twist_values(lib.twists.pivot), twist_values(lib.twists.port), free,
                        transform(tool.xyz, tool.rpy))
-    fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p)
+    fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p, tg=spec.targets)
     total = full.count
     if fam.settings <= dominance.FIRST:
         ranges = _split(fam.ranges()) or ((),)
