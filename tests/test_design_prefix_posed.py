@@ -1,4 +1,4 @@
-"""The orientation (tilt) bounds per family of settings (modc.design.prefix.tilted) are sound: a
+"""The orientation (tilt and wrist) bounds per family of settings (modc.design.prefix.fits) are sound: a
 pose some setting reaches, moved within the target's tolerances, never excludes the families
 that hold that setting - at any depth, with any cap - checked against the chain's product
 K_0 Rz(q_1) K_1 … Rz(q_n) K_n over random shapes, settings and joint vectors; and a posed cell
@@ -83,14 +83,16 @@ def test_a_reached_pose_never_excludes_the_families_of_its_setting(n):
             excluded = 0
             for k in range(1, n + 2):  # the family fixing K_0 … K_(k-1), every level after free
                 R = np.stack([lv[j].R[idx[:, j]] for j in range(k)], 1)
-                ok = np.array([prefix.tilted(lv, R[c:c + 1], prefix._keys(tg.take(np.array([c]))))[0]
+                t = np.stack([lv[j].t[idx[:, j]] for j in range(k)], 1)
+                ok = np.array([prefix.fits(lv, R[c:c + 1], t[c:c + 1], prefix._keys(tg.take(np.array([c]))))[0]
                                for c in range(len(R))])
                 assert ok.all(), (n, trial, pointed, k, np.flatnonzero(~ok)[:5])
                 # the same families against other settings' targets: some are excluded
-                other = np.array([prefix.tilted(lv, R[c:c + 1], prefix._keys(tg.take(np.array([(c + 1) % len(R)]))))[0]
+                other = np.array([prefix.fits(lv, R[c:c + 1], t[c:c + 1],
+                                              prefix._keys(tg.take(np.array([(c + 1) % len(R)]))))[0]
                                   for c in range(len(R))])
                 excluded += int((~other).sum())
-            if n <= 3 and not pointed:
+            if not pointed:
                 assert excluded > 0
             # refine, at any cap, keeps the family that holds each setting
             sizes = [len(level.t) for level in lv]

@@ -21,6 +21,10 @@ interval; over a free level it takes b_j's hull [min, max] of the options (the d
 interval to a hull of b is at most its distance to each b), and the start gamma its hull too: a
 superset of every setting's range. The tested vector w = R(K_n)^T e_z depends on K_n alone, so
 a family is out for a target when no option of K_n puts R_t w within eps of that range.
+The wrist (bounds._wrist_ok) likewise: each option of K_n puts joint n's origin at one point per
+posed target, and some option must bring every target's within reach of K_0 … K_(n-1) (the
+free ones bounded by the tails of that shorter chain). Such families are refined DEEP times
+further: deep families pay (for a 3-unit region cell 2 in 3 of them go).
 """
 from __future__ import annotations
 
@@ -35,6 +39,9 @@ POSED = True  # the orientation (tilt) bounds per family (off: tests compare)
 CAP = 200_000  # live families per level (memory: ~100 bytes each per fixed transform)
 TOGETHER = 4 * CAP  # families refined at once for several target sets (refine_many), at most
 SPREAD = 32  # targets the family bounds test at most (a region of 400 points: 12x less work)
+WRISTS = 4  # posed targets the family wrist test takes (spread; each costs every K_n option)
+DEEP = 8  # cap's multiple with posed targets
+CHUNK = 50_000  # families per wrist test (memory)
 
 
 @dataclass(frozen=True)
@@ -136,15 +143,21 @@ def spread(xyz: np.ndarray, tol: np.ndarray, k: int = SPREAD) -> tuple[np.ndarra
     """At most k of the targets, spread out (farthest-point order from the first): a family that
     cannot reach one of them cannot reach them all, so bounding by these is sound; a region's
     hundreds of neighbouring points would cost the bounds hundreds of times over for little more."""
+    picked = _picks(xyz, k)
+    return xyz[picked], tol[picked]
+
+
+def _picks(xyz: np.ndarray, k: int) -> list[int]:
+    """spread's targets, by index."""
     if len(xyz) <= k:
-        return xyz, tol
+        return list(range(len(xyz)))
     picked = [0]
     gap = np.linalg.norm(xyz - xyz[0], axis=1)
     for _ in range(k - 1):
         i = int(np.argmax(gap))
         picked.append(i)
         gap = np.minimum(gap, np.linalg.norm(xyz - xyz[i], axis=1))
-    return xyz[picked], tol[picked]
+    return picked
 
 
 def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP, tg=None) -> Families:
@@ -152,6 +165,7 @@ def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP, tg
     (against at most SPREAD of the targets, spread; and, with tg a reach.Targets, against the
     orientations of every target's, once per distinct one)."""
     keys = _keys(tg)
+    cap = cap * DEEP if keys is not None and len(keys[4]) else cap
     xyz, tol = spread(np.asarray(xyz, float), np.asarray(tol, float))
     n = len(lv) - 1
     U = tails(lv)
@@ -166,7 +180,7 @@ def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP, tg
         ok = bounds.possible_all(bounds.Frames(R, t), xyz, tol, tail)[:, 0]
         if keys is not None:
             rows = np.flatnonzero(ok)
-            ok[rows] = tilted(lv, R[rows], keys)
+            ok[rows] = fits(lv, R[rows], t[rows], keys)
         R, t, alive = R[ok], t[ok], alive[ok]
         if depth == n + 1 or len(alive) == 0 or len(alive) * sizes[depth] > cap:
             break
@@ -192,6 +206,7 @@ def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap:
     if len(sets) <= 1 or any(len(x) == 0 for x, _ in sets):
         return [refine(lv, x, t, cap, g) for (x, t), g in zip(sets, tgs, strict=True)]
     keys = [_keys(g) for g in tgs]
+    caps = [cap * DEEP if kk is not None and len(kk[4]) else cap for kk in keys]
     picked = [spread(np.asarray(x, float), np.asarray(t, float)) for x, t in sets]
     n = len(lv) - 1
     U = tails(lv)
@@ -211,12 +226,12 @@ def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap:
         for j, s in enumerate(going):
             if keys[s] is not None:
                 rows = np.flatnonzero(mask[:, j])
-                mask[rows, j] = tilted(lv, R[rows], keys[s])
+                mask[rows, j] = fits(lv, R[rows], t[rows], keys[s])
         per = total // int(np.prod(sizes[:depth], dtype=object))
         stay = []
         for j, s in enumerate(going):
             k = int(mask[:, j].sum())
-            if depth == n + 1 or k == 0 or k * sizes[depth] > cap:
+            if depth == n + 1 or k == 0 or k * sizes[depth] > caps[s]:
                 out[s] = Families(depth, alive[mask[:, j]], int(per))
             else:
                 stay.append(j)
@@ -240,14 +255,17 @@ def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap:
 
 def _keys(tg):
     """The distinct orientations of tg's targets: full ones (rotations (K, 3, 3), eps (K,)) and
-    `pointing` ones (axes (P, 3), eps (P,)); None without any (or with POSED off)."""
+    `pointing` ones (axes (P, 3), eps (P,)), and WRISTS of the full ones, spread (positions,
+    rotations, tol_p, eps); None without any (or with POSED off)."""
     if tg is None or not POSED or not tg.oriented.any():
         return None
     pointed = tg.pointed if len(tg.pointed) else np.zeros(len(tg.xyz), bool)
     full, point = tg.oriented & ~pointed, tg.oriented & pointed
     a = np.unique(np.column_stack([tg.R[full].reshape(-1, 9), tg.tol_r[full]]), axis=0)
     b = np.unique(np.column_stack([tg.axis[point].reshape(-1, 3), tg.tol_r[point]]), axis=0)
-    return (a[:, :9].reshape(-1, 3, 3), np.minimum(a[:, 9], np.pi), b[:, :3], np.minimum(b[:, 3], np.pi))
+    w = np.flatnonzero(full)[_picks(tg.xyz[full], WRISTS)]
+    return (a[:, :9].reshape(-1, 3, 3), np.minimum(a[:, 9], np.pi), b[:, :3], np.minimum(b[:, 3], np.pi),
+            tg.xyz[w], tg.R[w], tg.tol_p[w], np.minimum(tg.tol_r[w], np.pi))
 
 
 def _hull(v: np.ndarray) -> tuple[float, float]:
@@ -284,7 +302,7 @@ def tilted(lv: list[Level], R: np.ndarray, keys) -> np.ndarray:
     of every orientation of keys (_keys) - False: no setting of it can (bounds._tilt_ok,
     bounds._pointing_ok)."""
     n, k = len(lv) - 1, R.shape[1]
-    rot, eps, axis, eps_p = keys
+    rot, eps, axis, eps_p = keys[:4]
     z1 = R[:, 0, :, 2]
     ok = np.ones(len(R), bool)
     if len(rot):
@@ -304,4 +322,32 @@ def tilted(lv: list[Level], R: np.ndarray, keys) -> np.ndarray:
         lo, hi = _range(lv, R, _start(lv, R, n, 0), n - 1)
         c = z1 @ axis.T
         ok &= bounds._cos_within(c, lo[:, None] - eps_p - bounds.SLACK, hi[:, None] + eps_p + bounds.SLACK).all(-1)
+    return ok
+
+
+def wristed(lv: list[Level], R: np.ndarray, t: np.ndarray, keys) -> np.ndarray:
+    """(C,): whether some option of K_n puts joint n's origin, for every wrist target of keys
+    (_keys), within reach of the family's K_0 … K_(n-1) (module docstring)."""
+    n, k = len(lv) - 1, R.shape[1]
+    x, Rt, tol_p, eps = keys[4:]
+    if len(x) == 0:
+        return np.ones(len(R), bool)
+    u = np.unique(np.einsum("mji,mj->mi", lv[n].R, lv[n].t), axis=0)  # joint n's origin to tool0, tool frame
+    W = (x[:, None] - np.einsum("tij,mj->tmi", Rt, u)).reshape(-1, 3)  # (T * M, 3)
+    tol = (tol_p[:, None] + 2 * np.sin(eps / 2)[:, None] * np.linalg.norm(u, axis=-1)[None]).reshape(-1) + bounds.SLACK
+    if n == 1:  # p_1 is fixed
+        ok = np.linalg.norm(W[None] - t[:, 0][:, None], axis=-1) <= tol
+    elif k >= n:
+        ok = bounds.possible(bounds.Frames(R[:, :n], t[:, :n]), W, tol)
+    else:
+        ok = bounds.possible(bounds.Frames(R, t), W, tol, tails(lv[:n])[k - 1])
+    return ok.reshape(len(R), len(x), len(u)).all(1).any(-1)
+
+
+def fits(lv: list[Level], R: np.ndarray, t: np.ndarray, keys) -> np.ndarray:
+    """(C,): tilted, then wristed on the families it leaves, CHUNK at a time."""
+    ok = tilted(lv, R, keys)
+    for i in range(0, len(R), CHUNK):
+        rows = i + np.flatnonzero(ok[i:i + CHUNK])
+        ok[rows] = wristed(lv, R[rows], t[rows], keys)
     return ok
