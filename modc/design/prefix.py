@@ -177,10 +177,10 @@ def refine(lv: list[Level], xyz: np.ndarray, tol: np.ndarray, cap: int = CAP, tg
     depth = 1
     while True:
         tail = U[depth - 1] if depth <= n else None
-        ok = bounds.possible_all(bounds.Frames(R, t), xyz, tol, tail)[:, 0]
-        if keys is not None:
-            rows = np.flatnonzero(ok)
-            ok[rows] = fits(lv, R[rows], t[rows], keys)
+        # the orientation first: its few targets cost less than the position's SPREAD
+        rows = np.arange(len(R)) if keys is None else np.flatnonzero(fits(lv, R, t, keys))
+        ok = np.zeros(len(R), bool)
+        ok[rows] = bounds.possible_all(bounds.Frames(R[rows], t[rows]), xyz, tol, tail)[:, 0]
         R, t, alive = R[ok], t[ok], alive[ok]
         if depth == n + 1 or len(alive) == 0 or len(alive) * sizes[depth] > cap:
             break
