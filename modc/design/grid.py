@@ -198,7 +198,8 @@ def _opened(specs: list[Spec], shape: space.Shape, skip: frozenset[int]) -> _Sha
             near.append(i)
     if near:  # the family bounds of every pose in reach in one pass (prefix.refine_many)
         options = _options(specs[near[0]], shape)
-        families = prefix.refine_many(options, [(specs[i].targets.xyz, specs[i].targets.tol_p) for i in near])
+        families = prefix.refine_many(options, [(specs[i].targets.xyz, specs[i].targets.tol_p) for i in near],
+                                      tgs=[specs[i].targets for i in near])
         for i, fam in zip(near, families, strict=True):
             live[i], out = _live(specs[i], shape, fam)
             excluded += out

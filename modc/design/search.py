@@ -152,7 +152,7 @@ def _digest(spec: Spec) -> str:
     """What a plan depends on: the problem (its library, tool and targets) and the targets screened."""
     tg = spec.targets
     return hashlib.sha256(_problem_text(spec.problem) + tg.xyz.tobytes() + tg.tol_p.tobytes()
-                          + np.asarray(tg.oriented).tobytes()).hexdigest()
+                          + np.asarray(tg.oriented).tobytes() + bytes([prefix.POSED])).hexdigest()
 
 
 def plan(spec: Spec, shape: Shape) -> Plan:
@@ -203,7 +203,7 @@ def _plan(spec: Spec, shape: Shape) -> Plan:
     free = port_free(spec.problem, shape, lib)
     lv = prefix.levels(types, links, twist_values(lib.twists.pivot), twist_values(lib.twists.port), free,
                        transform(tool.xyz, tool.rpy))
-    fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p)
+    fam = prefix.refine(lv, spec.targets.xyz, spec.targets.tol_p, tg=spec.targets)
     total = full.count
     if fam.settings <= dominance.FIRST:
         ranges = _split(fam.ranges()) or ((),)
