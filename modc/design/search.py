@@ -152,7 +152,8 @@ def _digest(spec: Spec) -> str:
     """What a plan depends on: the problem (its library, tool and targets) and the targets screened."""
     tg = spec.targets
     return hashlib.sha256(_problem_text(spec.problem) + tg.xyz.tobytes() + tg.tol_p.tobytes()
-                          + np.asarray(tg.oriented).tobytes() + bytes([prefix.POSED])).hexdigest()
+                          + np.asarray(tg.oriented).tobytes() + tg.R.tobytes() + tg.tol_r.tobytes()
+                          + tg.axis.tobytes() + bytes([prefix.POSED])).hexdigest()
 
 
 def plan(spec: Spec, shape: Shape) -> Plan:
