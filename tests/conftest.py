@@ -21,6 +21,17 @@ design small {
     modules H1, L3
 }
 """
+# the design benchmark's cell (benchmarks/bench_design.CELL): three targets, a shelf and a post
+THREE_TARGETS = """design three {
+    payload 100 g
+    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
+    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
+    target a at (0.30, 0.10, 0.25) m
+    target b at (0.25, -0.15, 0.30) m
+    target c at (0.10, 0.30, 0.45) m
+    units 2 to 3
+}
+"""
 EXAMPLES = sorted((ROOT / "examples").glob("*.mod"))
 # examples with at least one arm (farm_cell.mod holds only a `design` problem)
 ARM_EXAMPLES = [

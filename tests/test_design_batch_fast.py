@@ -13,20 +13,11 @@ import warnings
 
 import numpy as np
 import pytest
-from conftest import SMALL_CELL
+from conftest import SMALL_CELL, THREE_TARGETS
 
 from modc.compiler import check_text
 
-THREE = """design three {
-    payload 100 g
-    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
-    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    target c at (0.10, 0.30, 0.45) m
-    units 2 to 3
-}
-"""
+THREE = THREE_TARGETS
 
 TWO = """design two {
     target a at (0.35, 0.10, 0.20) m

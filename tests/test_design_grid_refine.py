@@ -5,20 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import THREE_TARGETS
 
 from modc.compiler import check_text
 
-CELL = """design grid {
-    payload 100 g
-    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
-    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    target c at (0.10, 0.30, 0.45) m
-    units 2 to 3
-    base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 100 mm yaw 0 to 90 deg step 45 deg
-}
-"""
+CELL = THREE_TARGETS.replace("    units 2 to 3\n", "    units 2 to 3\n    base within box size (0.2, 0.2, 0) m at "
+                            "(0, 0, 0) m step 100 mm yaw 0 to 90 deg step 45 deg\n")
 
 
 def problem(text: str = CELL):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import THREE_TARGETS
 
 from modc.compiler import check_text
 
@@ -112,16 +113,7 @@ def test_with_margin_ranked_every_shape_as_light_as_the_design_is_searched(monke
         return real(spec, shape, *a, **kw)
 
     monkeypatch.setattr(search, "search_part", counted)
-    p = problem("""design shelf {
-    payload 100 g
-    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
-    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    target c at (0.10, 0.30, 0.45) m
-    units 3
-}
-""")
+    p = problem(THREE_TARGETS.replace("    units 2 to 3\n", "    units 3\n"))
     assert "margin" in p.rank
     o = run.design(p, top=1)
     assert len(o.designs) == 1
