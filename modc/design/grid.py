@@ -198,8 +198,9 @@ def _opened(specs: list[Spec], shape: space.Shape, skip: frozenset[int]) -> _Sha
             near.append(i)
     if near:  # the family bounds of every pose in reach in one pass (prefix.refine_many)
         options = _options(specs[near[0]], shape)
-        families = prefix.refine_many(options, [(specs[i].targets.xyz, specs[i].targets.tol_p) for i in near],
-                                      tgs=[specs[i].targets for i in near])
+        # position only: the orientation bounds per family (prefix.refine's tg) cost a base grid's
+        # every pose as much as a whole search's budget; the settings get them (bounds.posed)
+        families = prefix.refine_many(options, [(specs[i].targets.xyz, specs[i].targets.tol_p) for i in near])
         for i, fam in zip(near, families, strict=True):
             live[i], out = _live(specs[i], shape, fam)
             excluded += out
@@ -224,7 +225,11 @@ def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadl
                   skip: frozenset[int] = frozenset()) -> list[ShapeResult]:
     """The shapes searched over every pose but those in skip, a level at a time (see the
     module's docstring)."""
-    open_ = [_opened(specs, shape, skip) for shape in shapes]
+    open_: list[_Shape] = []
+    for shape in shapes:  # the family bounds of a shape at every pose take seconds: the budget between them
+        if stopping():
+            break
+        open_.append(_opened(specs, shape, skip))
     todo = [s for s in open_ if s.live]
     while todo and not stopping():
         upto = {id(s): _next(s) for s in todo}
