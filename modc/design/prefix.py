@@ -143,6 +143,8 @@ def spread(xyz: np.ndarray, tol: np.ndarray, k: int = SPREAD) -> tuple[np.ndarra
     """At most k of the targets, spread out (farthest-point order from the first): a family that
     cannot reach one of them cannot reach them all, so bounding by these is sound; a region's
     hundreds of neighbouring points would cost the bounds hundreds of times over for little more."""
+    if len(xyz) <= k:
+        return xyz, tol
     picked = _picks(xyz, k)
     return xyz[picked], tol[picked]
 
@@ -219,14 +221,8 @@ def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap:
     mask = np.ones((sizes[0], len(going)), bool)  # (families, sets going): alive at that set so far
     depth = 1
     while True:
-        tail = U[depth - 1] if depth <= n else None
-        mask &= bounds.possible_all(bounds.Frames(R, t), np.concatenate([picked[s][0] for s in going]),
-                                    np.concatenate([picked[s][1] for s in going]), tail,
-                                    np.cumsum([0] + [len(picked[s][0]) for s in going[:-1]]))
-        for j, s in enumerate(going):
-            if keys[s] is not None:
-                rows = np.flatnonzero(mask[:, j])
-                mask[rows, j] = fits(lv, R[rows], t[rows], keys[s])
+        _test(lv, R, t, mask, [picked[s] for s in going], [keys[s] for s in going],
+              U[depth - 1] if depth <= n else None)
         per = total // int(np.prod(sizes[:depth], dtype=object))
         stay = []
         for j, s in enumerate(going):
@@ -251,6 +247,19 @@ def refine_many(lv: list[Level], sets: list[tuple[np.ndarray, np.ndarray]], cap:
         mask = np.repeat(mask, m, 0)
         depth += 1
     return [out[s] for s in range(len(sets))]
+
+
+def _test(lv: list[Level], R: np.ndarray, t: np.ndarray, mask: np.ndarray, picked: list, keys: list,
+          tail: tuple[float, float] | None) -> None:
+    """refine_many's bounds at one depth, in place: mask (families, sets going) keeps the families
+    each set's spread targets (picked) and orientations (keys) leave alive."""
+    mask &= bounds.possible_all(bounds.Frames(R, t), np.concatenate([x for x, _ in picked]),
+                                np.concatenate([tl for _, tl in picked]), tail,
+                                np.cumsum([0] + [len(x) for x, _ in picked[:-1]]))
+    for j, k in enumerate(keys):
+        if k is not None:
+            rows = np.flatnonzero(mask[:, j])
+            mask[rows, j] = fits(lv, R[rows], t[rows], k)
 
 
 def _keys(tg):
