@@ -104,11 +104,15 @@ def test_the_bounds_norm_has_numpys_bits():
     assert np.array_equal(bounds._floor(a, b), np.maximum.reduce([np.zeros_like(a), a, b]))
 
 
-def test_the_bounds_by_group_of_targets_are_the_bounds_per_target_grouped():
-    """bounds.possible_all (D_1 first, the other tests on the rows left) is possible()'s answer
-    for every group of targets: families of real shapes, at the poses' targets stacked."""
+@pytest.mark.parametrize("elements", [None, 100])
+def test_the_bounds_by_group_of_targets_are_the_bounds_per_target_grouped(monkeypatch, elements):
+    """bounds.possible_all (D_1 first, the other tests on the rows left; rows a memory-bounded
+    chunk at a time) is possible()'s answer for every group of targets: families of real
+    shapes, at the poses' targets stacked."""
     from modc.design import bounds, grid, prefix, space
 
+    if elements is not None:  # a few rows at a time: a 25-pose cell's refine once took 24 GB
+        monkeypatch.setattr(bounds, "ELEMENTS", elements)
     p = problem()
     specs = _specs(p)[::6]
     xyz = np.concatenate([s.targets.xyz for s in specs])
