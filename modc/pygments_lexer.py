@@ -39,7 +39,7 @@ STATEMENTS = ("allow", "base", "box", "chain", "compare", "cylinder", "dh", "lib
               "tool", "units")
 #: Keywords inside a statement (`fit-links` is the grammar's named terminal DH_FIT).
 CLAUSES = ("at", "fit-links", "from", "grid", "length", "pointing", "radius", "rpy", "size", "step",
-           "straight", "to", "visit", "with", "within", "x", "yaw")
+           "straight", "to", "turned", "visit", "with", "within", "x", "yaw")
 #: Every keyword of the language.
 KEYWORDS = frozenset(DECLARATIONS + STATEMENTS + CLAUSES)
 #: Units of measure (modc.model.quantities.ALL).

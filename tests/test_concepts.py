@@ -203,3 +203,14 @@ def test_the_design_searchs_ik_seeds_are_the_planners():
         ours = np.array(ik.seeds(np.zeros(3), lower, upper, 12, seed))
         assert np.array_equal(reach.seeds(3, 12, lower, upper, seed), ours)
     assert np.array_equal(ours[0], [0.0, 0.0, 0.5])  # the zero pose, clipped to the limits
+
+
+def test_rotations_have_one_home_below_the_model():
+    """The URDF rpy convention lives in modc.rotation: the kinematics builds frames from it and the
+    model turns a region's box with it (the model may not import the kinematics)."""
+    from modc import kinematics, rotation
+
+    assert kinematics.rpy_matrix is rotation.rpy_matrix and kinematics.matrix_rpy is rotation.matrix_rpy
+    assert kinematics.Rx is rotation.Rx and kinematics.Ry is rotation.Ry and kinematics.Rz is rotation.Rz
+    rpy = (0.1, -0.7, 2.5)
+    assert rotation.matrix_rpy(rotation.rpy_matrix(rpy)) == pytest.approx(rpy)

@@ -1,6 +1,5 @@
 """`modc design` with tasks: the cell's tasks planned and timed for the designs the static search
-returns, `rank … cycle_time` / `energy`, the trajectory and task keys written, and the design
-statement not searched yet (`base within … yaw` with a region) refused with a diagnostic."""
+returns, `rank … cycle_time` / `energy`, the trajectory and task keys written."""
 from __future__ import annotations
 
 import json
@@ -136,22 +135,6 @@ def test_modc_design_writes_the_timed_task(tmp_path):
     assert plan["task"] == "serve"
     assert sum(s["duration_s"] for s in plan["segments"] if s["kind"] != "approach") == \
         pytest.approx(d["cycle_time_s"], abs=1e-5)
-
-
-@pytest.mark.parametrize("statement, what", [
-    ("region r box size (0.1, 0, 0) m at (0.3, 0, 0.2) m grid 2 x 1 x 1\n"
-     "    base within box size (0.2, 0.2, 0) m at (0, 0, 0) m step 50 mm yaw 0 to 90 deg step 90 deg",
-     "`base within … yaw` with a region"),
-])
-def test_statements_not_searched_yet_are_refused(tmp_path, statement, what):
-    text = TASKED.replace("    rank modules, cycle_time\n", f"    {statement}\n")
-    r = _design(tmp_path, text)
-    assert r.returncode == 1
-    assert "Traceback" not in r.stderr
-    assert f"error[design-unsupported]: {what} is parsed but not searched yet by modc design" in r.stderr
-    line = text.splitlines().index(f"    {statement.splitlines()[-1].strip()}") + 1
-    assert f"cell.mod:{line}:" in r.stderr
-    assert not (tmp_path / "out").exists()
 
 
 def test_a_reference_arm_that_passes_is_planned_timed_and_written(tmp_path):

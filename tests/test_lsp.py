@@ -702,7 +702,8 @@ def test_keyword_classes_are_read_from_the_grammar():
     )
     assert language.statements("dh") == ("row",)
     assert language.clause_keywords() == {"at", "rpy", "size", "radius", "length", "fit-links", "within", "to", "step",
-                                          "grid", "x", "visit", "from", "straight", "yaw", "with", "pointing"}
+                                          "grid", "x", "visit", "from", "straight", "yaw", "with", "pointing",
+                                          "turned"}
     assert language.statements("design") == (
         "library", "base", "tool", "payload", "box", "sphere", "cylinder", "target", "allow", "region", "task", "path",
         "units", "modules", "links", "rank", "compare",

@@ -240,21 +240,16 @@ def _needs_full() -> None:
 
 
 def _checked(file: str, library: str | None):
-    """FILE checked, its diagnostics printed; exit here when it has errors or a statement the
-    search would ignore (refused: ignoring it would mislead)."""
+    """FILE checked, its diagnostics printed; exit here when it has errors."""
     from ..compiler import InputError, check_file
-    from ..diagnostics import Severity, codes
-    from ..records import replace
 
     try:
         checked = check_file(file, library)
     except InputError as e:
         _print_diagnostics([e.diagnostic], {})
         raise SystemExit(EXIT_USAGE) from None
-    refused = [replace(d, severity=Severity.ERROR) if d.code == codes.DESIGN_UNSUPPORTED.name else d
-               for d in checked.diagnostics]
-    _print_diagnostics(refused, checked.sources)
-    if not checked.ok or any(d.is_error for d in refused):
+    _print_diagnostics(checked.diagnostics, checked.sources)
+    if not checked.ok:
         raise SystemExit(EXIT_ERRORS)
     return checked
 

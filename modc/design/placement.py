@@ -65,14 +65,25 @@ def _turn(R: np.ndarray, d) -> Vec | None:
     return (float(v[0]), float(v[1]), float(v[2]))
 
 
+def _box(R: np.ndarray, turned: Vec | None) -> Vec | None:
+    """A region box's axes (rpy in the cell frame, None: the cell's) in the base frame."""
+    from ..kinematics import matrix_rpy, rpy_matrix
+
+    R_base_box = R.T @ rpy_matrix(turned if turned is not None else (0.0, 0.0, 0.0))
+    if np.allclose(R_base_box, np.eye(3), rtol=0.0, atol=1e-12):
+        return None
+    return matrix_rpy(R_base_box)
+
+
 _R = TypeVar("_R", bound=Robot)
 
 
 def cell_at(cell: _R, pose: Transform) -> _R:
     """The cell written in the frame of a base at `pose` (cell frame), with `base at` the pose.
 
-    Regions are axis-aligned boxes: a yawed base keeps them only at yaw 0 (modc.model.lower_task
-    refuses `base within … yaw` with regions), so a region moves, it does not turn."""
+    A region's box turns with the base: `turned` is its axes in the base frame (None when they
+    are the base frame's, so a region at yaw 0 stays as written), and its points are the same
+    points of the cell."""
     R, p = _frame(pose)
     obstacles = []
     for o in cell.obstacles:
@@ -86,7 +97,8 @@ def cell_at(cell: _R, pose: Transform) -> _R:
     regions = []
     for r in cell.regions:
         xyz, rpy = _to_base(R, p, r.center, r.rpy)
-        regions.append(r.model_copy(update={"center": xyz, "rpy": rpy, "pointing": _turn(R, r.pointing)}))
+        regions.append(r.model_copy(update={"center": xyz, "rpy": rpy, "pointing": _turn(R, r.pointing),
+                                            "turned": _box(R, r.turned)}))
     return cell.model_copy(update={"base": pose, "obstacles": tuple(obstacles), "targets": tuple(targets),
                                    "regions": tuple(regions)})
 

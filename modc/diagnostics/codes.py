@@ -296,10 +296,6 @@ DUPLICATE_OBJECTIVE = _register("duplicate-objective", E, "`rank` naming one obj
 OBJECTIVE_NEEDS_TASK = _register("objective-needs-task", E, "`rank` naming a task objective in a cell without a task",
     "objective '{name}' ranks the cell's tasks, but design '{block}' has no `task` and no `path`",
     "add `task NAME {{ visit a, b }}` or `path NAME from a to b straight`, or rank by {static}")
-DESIGN_UNSUPPORTED = _register("design-unsupported", W,
-    "a design-block statement the language has but `modc design` does not search yet (it refuses the block)",
-    "{what} is parsed but not searched yet by modc design",
-    "remove it from design '{name}' to search the block; `modc design` refuses it until it is searched")
 DESIGN_NO_TARGETS = _register("design-no-targets", E, "a design block without any target",
     "design '{name}' has no targets: nothing to design the arm for", "add `target NAME at (x, y, z) m` to the block")
 NO_DESIGN = _register("no-design", E, "`modc design` found no chain that does every task of the cell",

@@ -56,6 +56,7 @@ QUANTITY_KINDS = {
     "step": "a length",
     "yaw": "an angle",  # `base within … yaw 0 to 90 deg step 45 deg`
     "pointing": "a direction",  # `pointing (0, 0, -1)`: no unit
+    "turned": "an angle",  # a region's `turned (0, 0, 45) deg`
 }
 # Name-taking statements whose name refers to something (a joint) rather than declaring one.
 REFERS = frozenset({"limit", "rank"})  # rank names objectives, not things it declares
@@ -103,8 +104,10 @@ KEYWORDS = {
     "to": "`… to …` — the upper end of a range (`units 1 to 3`, `links 150 mm to 300 mm`).",
     "step": "`step 50 mm` — the spacing of the link lengths a design search tries.",
     "within": "`within 5 mm, 2 deg` — a target's position (and orientation) tolerance (default 5 mm, 2°).",
-    "region": "`region NAME box size (x, y, z) m at (x, y, z) m grid NX x NY x NZ [rpy (…) deg] [within 5 mm, 2 deg]` "
-    "— targets evenly spaced over a box, faces included, named NAME[i,j,k] (0-based).",
+    "region": "`region NAME box size (x, y, z) m at (x, y, z) m [turned (r, p, y) deg] grid NX x NY x NZ [rpy (…) deg] "
+    "[within 5 mm, 2 deg]` — targets evenly spaced over a box, faces included, named NAME[i,j,k] (0-based).",
+    "turned": "`turned (0, 0, 45) deg` — a region's box turned (fixed-axis rpy, as an obstacle's): its points turn "
+    "with it; the tool's orientation (`rpy`, `pointing`) does not.",
     "task": "`task NAME { visit a, tray, tray[1,0,0] }` — collision-free joint-space motions through the targets (a "
     "region: its points in order); `modc plan FILE --task NAME` plans and times it.",
     "path": "`path NAME from a to b straight` — tool0 along the straight segment a -> b (orientation interpolated), "

@@ -311,7 +311,7 @@ class _Lowerer:
         elif acc["base_within"]:
             from .lower_task import base_grid
 
-            bounds["base_grid"] = base_grid(self, acc["base_within"][0], acc["regions"], _say(d.name))
+            bounds["base_grid"] = base_grid(self, acc["base_within"][0])
         if not (named and acc["named"]):
             return None
         cell = Robot(name=d.name.text, span=d.span, name_span=d.name.span, **self._lists(acc), **fields)

@@ -40,6 +40,7 @@ def region(low, st: ast.Region) -> Region | None:
     size = low.vec3(st.size, "a length", f"size of {what}")
     at = low.vec3(st.at, "a length", f"position of {what}")
     rpy = low.vec3(st.rpy, "an angle", f"orientation of {what}") if st.rpy is not None else None
+    turned = low.vec3(st.turned, "an angle", f"turn of {what}'s box") if st.turned is not None else None
     tol = _tolerances(low, st.within, what)
     pointing = direction(low, st.pointing, f"approach of {what}")
     ok = st.pointing is None or pointing is not None
@@ -67,10 +68,17 @@ def region(low, st: ast.Region) -> Region | None:
                 low.error(codes.REGION_GRID.at(st.span, what=f"{what} has size 0 along {axis} but {n} points there",
                                                hint=f"give the box a size along {axis}, or 1 point (its centre)"))
                 ok = False
-    if not low.name(st.name, "region") or not ok or size is None or at is None or (st.rpy is not None and rpy is None):
+    if not low.name(st.name, "region") or not ok or size is None or at is None or (st.rpy is not None and rpy is None) \
+            or (st.turned is not None and turned is None):
         return None
     return Region(name=st.name.text, size=size, center=at, grid=(grid[0], grid[1], grid[2]), rpy=rpy,
-                  pointing=pointing, span=st.span, **tol)
+                  pointing=pointing, turned=_turn(turned), span=st.span, **tol)
+
+
+def _turn(rpy: tuple[float, float, float] | None) -> tuple[float, float, float] | None:
+    """`turned (0, 0, 0) deg` is no turn: the model holds None, so such a region is written as an
+    axis-aligned one (a region the base grid turns by a yaw of 0 stays byte-identical)."""
+    return None if rpy is None or not any(rpy) else rpy
 
 
 def direction(low, v: ast.Vector | None, what: str) -> tuple[float, float, float] | None:
@@ -91,9 +99,9 @@ def direction(low, v: ast.Vector | None, what: str) -> tuple[float, float, float
     return (v.values[0] / n, v.values[1] / n, v.values[2] / n)
 
 
-def base_grid(low, st: ast.BaseWithin, regions=(), block: str = "") -> BaseGrid | None:
-    """The base grid; a yawed base with regions is refused (an axis-aligned region box would turn
-    with the base, which its statement cannot say in the emitted robot's base frame)."""
+def base_grid(low, st: ast.BaseWithin) -> BaseGrid | None:
+    """The base grid (a yawed base turns the regions' boxes in each emitted robot's base_link:
+    `turned`, modc.design.placement.cell_at)."""
     size = low.vec3(st.size, "a length", "size of the base's box")
     at = low.vec3(st.at, "a length", "position of the base's box")
     step = low.quantity(st.step, "a length", "base step")
@@ -115,9 +123,6 @@ def base_grid(low, st: ast.BaseWithin, regions=(), block: str = "") -> BaseGrid 
         low.error(codes.DESIGN_BOUND.at(st.span, what=f"{n:,} base poses are too many to search",
                                         hint=f"use a coarser step or a smaller box: at most {MAX_BASE_POSES:,} poses"))
         return None
-    if regions and any(abs(math.remainder(y, 2 * math.pi)) > 1e-12 for y in yaws):
-        low.error(codes.DESIGN_UNSUPPORTED.at(st.yaw.span if st.yaw is not None else st.span,
-                                              what="`base within … yaw` with a region", name=block))
     return grid
 
 

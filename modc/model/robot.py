@@ -132,12 +132,14 @@ MAX_REGION_POINTS = 10_000  # per region: a tray of a few dozen cells is real; b
 
 
 class Region(Value):
-    """`region NAME box size … at … grid nx x ny x nz`: targets evenly spaced over an axis-aligned
-    box, faces included; an axis with one point holds it at the box's centre."""
+    """`region NAME box size … at … [turned …] grid nx x ny x nz`: targets evenly spaced over a
+    box, faces included; an axis with one point holds it at the box's centre. The box is
+    axis-aligned in base_link unless `turned` (fixed-axis rpy, as an obstacle's): its axes, and so
+    its points, turn with it; the points' tool orientation (rpy, pointing) does not."""
 
     _names = ("name",)
     _convert = (("size", vec3), ("center", vec3), ("grid", grid3), ("rpy", optional(vec3)),
-                ("position_tolerance", float), ("orientation_tolerance", float))
+                ("turned", optional(vec3)), ("position_tolerance", float), ("orientation_tolerance", float))
 
     name: Name
     size: Vec3  # m, full extents
@@ -145,6 +147,7 @@ class Region(Value):
     grid: tuple[int, int, int]
     rpy: Vec3 | None = None  # every point's tool0 orientation
     pointing: Vec3 | None = None  # or every point's approach direction only (Target.pointing)
+    turned: Vec3 | None = None  # rad: the box's axes in base_link (None: base_link's own)
     position_tolerance: float = POSITION_TOLERANCE
     orientation_tolerance: float = ORIENTATION_TOLERANCE
     span: Span = hidden(NOWHERE)
@@ -162,6 +165,11 @@ class Region(Value):
         xyz = []
         for c, s, n, i in zip(self.center, self.size, self.grid, index, strict=True):
             xyz.append(c if n == 1 else c - s / 2 + s * i / (n - 1))
+        if self.turned is not None:  # the same offsets from the centre, along the box's own axes
+            from ..rotation import rpy_matrix
+
+            offset = rpy_matrix(self.turned) @ [x - c for x, c in zip(xyz, self.center, strict=True)]
+            xyz = [c + float(d) for c, d in zip(self.center, offset, strict=True)]
         return Target.model_construct(name=self.point_name(index), xyz=(xyz[0], xyz[1], xyz[2]), rpy=self.rpy,
                                       pointing=self.pointing, position_tolerance=self.position_tolerance,
                                       orientation_tolerance=self.orientation_tolerance, span=self.span)

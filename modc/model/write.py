@@ -130,7 +130,10 @@ def task_lines(robot: Robot) -> list[str]:
     lines = []
     for r in robot.regions:
         s = (f"    region {r.name} box size {vec([_num(v) for v in r.size], 'm')} at "
-             f"{vec([_num(v) for v in r.center], 'm')} grid {r.grid[0]} x {r.grid[1]} x {r.grid[2]}")
+             f"{vec([_num(v) for v in r.center], 'm')}")
+        if r.turned is not None:
+            s += " turned " + vec([_num(math.degrees(v)) for v in r.turned], "deg")
+        s += f" grid {r.grid[0]} x {r.grid[1]} x {r.grid[2]}"
         if r.rpy is not None:
             s += " rpy " + vec([_num(math.degrees(v)) for v in r.rpy], "deg")
         s += _pointing(r.pointing)

@@ -189,7 +189,7 @@ class PointRef(Record, kw_only=False):
 
 
 class Region(Record, kw_only=False):
-    """`region tray box size (…) m at (…) m grid 3 x 2 x 1 [rpy …] [within …]`: a grid of targets."""
+    """`region tray box size (…) m at (…) m [turned (…) deg] grid 3 x 2 x 1 [rpy …] [within …]`: a grid of targets."""
 
     name: Name
     size: Vector
@@ -199,6 +199,7 @@ class Region(Record, kw_only=False):
     rpy: Vector | None = None
     within: Within | None = None
     pointing: Vector | None = None  # as a target's
+    turned: Vector | None = None  # the box's own orientation (fixed-axis rpy), as an obstacle's
 
 
 class Task(Record, kw_only=False):

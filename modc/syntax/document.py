@@ -84,6 +84,7 @@ class RegionDoc(_Doc):
     rpy: Vector | None = None
     within: str | None = Field(None, description='tolerances: "5 mm" or "5 mm, 2 deg"')
     pointing: Vector | None = Field(None, description='instead of rpy: tool0\'s x axis only, e.g. "(0, 0, -1)"')
+    turned: Vector | None = Field(None, description='the box\'s orientation (fixed-axis rpy), e.g. "(0, 0, 45) deg"')
 
 
 class PathDoc(_Doc):

@@ -169,12 +169,17 @@ class ToAst:
     def point_ref(self, meta, items):
         return ast.PointRef(self._name(items[0]), items[1] if len(items) > 1 else None, self._span(meta))
 
+    def turned(self, meta, items):
+        return ("turned", items[0])
+
     def region(self, meta, items):
-        name, size, at, nx, ny, nz, *rest = items
+        name, size, at, *rest = items
+        turned = rest.pop(0)[1] if isinstance(rest[0], tuple) and rest[0][0] == "turned" else None
+        nx, ny, nz, *rest = rest
         opt = dict(rest)
         grid = (self._count(nx), self._count(ny), self._count(nz))
         return ast.Region(self._name(name), size, at[1], grid, self._span(meta), opt.get("rpy"), opt.get("within"),
-                          opt.get("pointing"))
+                          opt.get("pointing"), turned)
 
     def task(self, meta, items):
         return ast.Task(self._name(items[0]), tuple(items[1:]), self._span(meta))

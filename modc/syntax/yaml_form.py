@@ -244,13 +244,15 @@ class _Reader:
             grid = self._grid(reg.grid, p + ("grid",))
             within = self._within(reg.within, p + ("within",))
             pointing = self._vec(reg.pointing, p + ("pointing",))
+            turned = self._vec(reg.turned, p + ("turned",))
             if reg.rpy is not None and reg.pointing is not None:
                 self.diags.append(codes.YAML_SCHEMA.at(self.span(p), detail=f"{_dotted(p)}: rpy or pointing, not both"))
                 continue
-            if size is not None and at is not None and grid is not None and (reg.rpy is None or rpy is not None) \
-                    and (reg.pointing is None or pointing is not None):
+            given = (reg.rpy, rpy), (reg.pointing, pointing), (reg.turned, turned)
+            if size is not None and at is not None and grid is not None and all(v is None or a is not None
+                                                                                 for v, a in given):
                 body.append(ast.Region(ast.Name(name, self.span(p + ("__key__",))), size, at, grid, self.span(p), rpy,
-                                       within, pointing))
+                                       within, pointing, turned))
         for name, visits in r.tasks.items():
             p = path + ("tasks", name)
             refs = [self._ref(v, p + (i,)) for i, v in enumerate(visits)]

@@ -8,6 +8,8 @@ design cell {
 #                                                                    ^ keyword.other.x.mod
     region cups box size (0.1, 0, 0) m at (0.3, 0, 0.1) m grid 2 x 1 x 1 pointing (0, 0, -1) within 5 mm, 5 deg
 #                                                                        ^^^^^^^^ keyword.other.pointing.mod
+    region slot box size (0.1, 0, 0) m at (0.3, 0, 0.1) m turned (0, 0, 30) deg grid 2 x 1 x 1
+#                                                         ^^^^^^ keyword.other.turned.mod
     task serve { visit plant, tray, tray[1,0,0] }
 #   ^^^^ keyword.control.task.mod
 #        ^^^^^ entity.name.function.task.mod
