@@ -138,3 +138,46 @@ def test_coverage_searches_at_most_a_few_points_one_at_a_time():
     assert out is not None and out.designs == []
     assert 1 < len(asked) <= tasks.POINT_SEARCHES and len(set(asked)) == len(asked)
     assert asked[0] == "pair_0_0_0" and asked[-1] > "pair_90"  # from the first point to the far end
+
+
+def test_with_coverage_a_straight_paths_region_end_stays_required():
+    """A path must reach its ends (coverage.missing_ends): with `rank coverage` the static search
+    screens a region point a path ends at, also when it searches the points one at a time (it
+    returned arms that missed the end, each then refused by its planning: "no design" after
+    planning them all, where the search can tell at once)."""
+    from modc.design import tasks
+
+    text = PAIR.replace("    task pick", "    path drop from rest to pair[1,0,0] straight\n    task pick")
+    p = problem(text)
+    screen, names = tasks.with_points(p)
+    assert [names[t.name] for t in screen.cell.targets if t.name in names and "[" in names[t.name]] == ["pair[1,0,0]"]
+    one, names = tasks.with_points(p, only="pair[0,0,0]")
+    assert sorted(v for v in names.values() if "[" in v) == ["pair[0,0,0]", "pair[1,0,0]"]
+    every, names = tasks.with_points(p, every=True)
+    assert sorted(v for v in names.values() if "[" in v) == ["pair[0,0,0]", "pair[1,0,0]"]
+    # without a path the points stay optional
+    _, names = tasks.with_points(problem())
+    assert not [v for v in names.values() if "[" in v]
+
+
+def test_coverage_starts_the_planners_ik_at_the_joint_values_the_search_verified(monkeypatch):
+    """A point the search reached (and verified) is measured from its own joint values first: the
+    planner's seeds around home can miss a pose its seeds found (a tool pointing down)."""
+    import modc.plan as plan
+    from modc.design import coverage
+
+    arm = PAIR.replace("design cov {", "robot cov {\n    chain H1 - L3 - L4").replace("    units 3\n", "")
+    arm = arm.replace("    modules H1, L3, L4\n", "").replace("    rank coverage, modules\n", "")
+    c = check_text(arm, "arm.mod")
+    assert c.ok, [d.message for d in c.diagnostics]
+    robot = c.design.resolved_robots()[0]
+    starts: dict[str, np.ndarray] = {}
+
+    def clear(robot, checker, target, start, seed):
+        starts[target.name] = np.asarray(start, float)
+        return None
+
+    monkeypatch.setattr(plan, "clear_solution", clear)
+    q = [0.1, 0.2, 0.3]
+    assert coverage.reached(robot, 0, known={"pair[1,0,0]": q}) == (set(), 2)
+    assert np.allclose(starts["pair[1,0,0]"], q) and not np.allclose(starts["pair[0,0,0]"], q)

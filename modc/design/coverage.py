@@ -8,16 +8,18 @@ others are dropped from the visits of its robot file, which keeps the regions wh
 design is ranked by the share, larger first (modc.objectives.coverage)."""
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 
 from ..model import ResolvedRobot, Robot
 
 
-def reached(robot: ResolvedRobot, seed: int,
-            stopping: Callable[[], str | None] | None = None) -> tuple[set[str], int] | None:
+def reached(robot: ResolvedRobot, seed: int, stopping: Callable[[], str | None] | None = None,
+            known: Mapping[str, Sequence[float]] | None = None) -> tuple[set[str], int] | None:
     """The names of the region points the robot reaches clear of the cell, and how many there are;
     None when stopping() says to stop (the time budget, Ctrl-C) before every point is tried: a
-    region may hold 10,000 points, each an IK run."""
+    region may hold 10,000 points, each an IK run. known: joint values the design search found
+    (and verified) at some points, the planner's IK's first start there (its seeds around home
+    can miss a pose such as a tool pointing down that the search's seeds found)."""
     from ..physical.checker import CollisionChecker
     from ..plan import clear_solution, start_pose
 
@@ -30,7 +32,8 @@ def reached(robot: ResolvedRobot, seed: int,
     for t in points:
         if stopping is not None and stopping():
             return None
-        if clear_solution(robot, checker, t, home, seed) is not None:
+        start = home if known is None or t.name not in known else known[t.name]
+        if clear_solution(robot, checker, t, start, seed) is not None:
             got.add(t.name)
     return got, len(points)
 

@@ -36,21 +36,26 @@ def with_points(problem, every: bool = False, only: str | None = None):
     """The problem whose cell also holds every region point as a target when every point is
     required (no `rank coverage`, or `every`), so that the static search screens them; and the
     names given to them (a point's own name, `tray[1,0,0]`, is no identifier), new name -> point
-    name. only: that one point (its name, as `tray[1,0,0]`) of the regions, no other."""
+    name. only: that one point (its name, as `tray[1,0,0]`) of the regions, no other. With `rank
+    coverage` the points a straight path starts or ends at stay required (a path is: a design
+    that misses its end fails its planning, modc.design.coverage.missing_ends)."""
     cell = problem.cell
     taken = {t.name for t in cell.targets} | {r.name for r in cell.regions} | set(task_names(cell))
     names: dict[str, str] = {}
     extra = _path_points(cell, taken, names)
-    if ("coverage" in problem.rank and not every and only is None) or not cell.regions:
+    if not cell.regions:
         return _with(problem, extra), names
+    wanted = None if only is None else {only}
+    if "coverage" in problem.rank and not every:
+        wanted = (wanted or set()) | {e for p in cell.paths for e in (p.start, p.end)}
     for r in cell.regions:
         for ix in r.indices():
+            if wanted is not None and r.point_name(ix) not in wanted:
+                continue
             stem = f"{r.name}_{ix[0]}_{ix[1]}_{ix[2]}"[:60]
             name, k = stem, 2
             while name in taken:
                 name, k = f"{stem}_{k}", k + 1
-            if only is not None and r.point_name(ix) != only:
-                continue
             taken.add(name)
             names[name] = r.point_name(ix)
             extra.append(r.point(ix).model_copy(update={"name": name}))
@@ -149,7 +154,7 @@ def by_points(problem, search, n: int, seed: int, stopping=None):
         return None
     scored = []
     for d in seen.values():
-        measured = cov.reached(d.verified.robot, seed, stopping)
+        measured = cov.reached(d.verified.robot, seed, stopping, known(d))
         if measured is None:  # out of time: rank the designs measured so far
             out.stopped = out.stopped or stopping()
             break
@@ -158,6 +163,11 @@ def by_points(problem, search, n: int, seed: int, stopping=None):
         scored.append((-len(got), d.modules, round(d.mass, 9), d.chain(), replace(d, coverage=share)))
     out.designs = [x[-1] for x in sorted(scored, key=lambda x: x[:4]) if x[0] < 0][:n]
     return out
+
+
+def known(d: Design) -> dict[str, list[float]]:
+    """The joint values the search verified d at, by target or region point name."""
+    return {name: x["q"] for name, x in d.verified.targets.items() if x.get("q") is not None}
 
 
 def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = False, stopping=None,
@@ -171,7 +181,7 @@ def plan_design(d: Design, seed: int, deadline: float | None, coverage: bool = F
 
     robot = d.verified.robot
     if coverage and robot.regions:
-        measured = cov.reached(robot, seed, stopping)
+        measured = cov.reached(robot, seed, stopping, known(d))
         if measured is None:
             return None
         points, total = measured
