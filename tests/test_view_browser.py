@@ -465,3 +465,31 @@ def test_a_page_opened_on_a_broken_file_frames_the_arm_once_fixed(browser, tmp_p
         before = settled(browser)
         arm = arm_pixels(browser, view, before, panel_left(browser))
         assert box_share(arm) >= 0.25, f"the arm covers {box_share(arm):.0%} of the 3D view"
+
+
+REGION = ("robot arm {\n    chain H1 - L4(pivot=-90deg, port=45deg) - L3(link=180mm)\n"
+          "    target plant at (0.3, 0.1, 0.25) m\n"
+          "    region tray box size (0.2, 0.1, 0) m at (0.1, -0.4, 0.1) m turned (0, 0, 30) deg grid 3 x 2 x 1\n}\n")
+
+
+@pytest.mark.slow
+def test_a_region_shows_its_points_in_the_picture(browser, tmp_path):
+    """The region's points (and its box) are drawn in the target's red: the same arm without the
+    region shows only the one target's."""
+    from modc.physical.cell import TARGET_RGBA
+
+    red = tuple(round(255 * c) for c in TARGET_RGBA[:3])
+    counts = []
+    for k, text in enumerate((REGION, REGION.replace(REGION.splitlines()[3] + "\n", ""))):
+        f = tmp_path / f"arm{k}.mod"
+        f.write_text(text, encoding="utf-8")
+        page = Page([Source(f)])
+        server, view = start(page, port=0)
+        try:
+            img, left = open_page(browser, server, view, 3)
+            browser.screenshot(tmp_path / f"region{k}.png")
+            counts.append(colour_pixels(img, red, left))
+        finally:
+            server.stop()
+    with_region, without = counts
+    assert with_region > without + 100, counts

@@ -120,7 +120,8 @@ class Arm:
 
     def extent(self, q) -> np.ndarray:
         """Points (world) whose bounding box is what a picture of the arm at q with its cell shows:
-        the corners of every part's box, of every obstacle's box, the targets, the payload."""
+        the corners of every part's box, of every obstacle's box, the targets and region points, the
+        payload."""
         from ..physical.assembly import PAYLOAD_RADIUS
         from ..physical.cell import TARGET_RADIUS
 
@@ -137,6 +138,7 @@ class Arm:
             T_ob = transform(ob.origin.xyz, ob.origin.rpy)
             pts.append((signs * half) @ T_ob[:3, :3].T + T_ob[:3, 3])
         marks: list[tuple[Any, float]] = [(t.xyz, TARGET_RADIUS) for t in self.robot.targets]
+        marks += [(p.xyz, TARGET_RADIUS) for r in self.robot.regions for p in r.points()]
         marks.append((T["tool0"][:3, 3], AXES))
         if "payload" in T:
             marks.append((T["payload"][:3, 3], PAYLOAD_RADIUS))

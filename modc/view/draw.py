@@ -4,7 +4,8 @@ arm's root node (base_link). Look: physical/cell.py, as every other picture of t
 A target is its marker (a sphere of TARGET_RADIUS), a translucent sphere of its position
 tolerance when that is larger than the marker, the tool0 axes it asks for when it has an
 orientation, and a label with its name and tolerances, lifted above the marker (and above the
-labels of targets that would overlap it on screen).
+labels of targets that would overlap it on screen). A region is its points (one point cloud: it
+may hold thousands) inside its box's wireframe, labelled with its name at the box's centre.
 """
 from __future__ import annotations
 
@@ -68,8 +69,8 @@ def label_lifts(targets, cam: Camera, T_world_base: np.ndarray) -> list[np.ndarr
 
 
 def cell(scene, base: str, arm: Arm, cam: Camera) -> tuple[list, dict]:
-    """Obstacles and targets under base (base_link), labels placed for the view cam; returns the
-    handles, and the labels' by target name."""
+    """Obstacles, targets and regions under base (base_link), labels placed for the view cam;
+    returns the handles, and the targets' labels by name."""
     out, labels = [], {}
     for ob in arm.robot.obstacles:
         T_ob = transform(ob.origin.xyz, ob.origin.rpy)
@@ -95,7 +96,29 @@ def cell(scene, base: str, arm: Arm, cam: Camera) -> tuple[list, dict]:
         labels[t.name] = scene.add_label(f"{base}/target_labels/{t.name}", target_label(t), anchor="bottom-center",
                                          position=np.asarray(t.xyz) + lift, font_screen_scale=1.2)
         out.append(labels[t.name])
-    return out, labels
+    return out + regions(scene, base, arm), labels
+
+
+REGION_POINT = 0.012  # m: a region point's dot (a region may hold thousands: one point cloud each)
+REGION_EDGE = 0.002  # m: the thickness a flat region's box is drawn with
+
+
+def regions(scene, base: str, arm: Arm) -> list:
+    """Each region as its points (one cloud) in its box (a wireframe, turned as the region's box
+    is), labelled with its name and number of points at the box's centre; in base_link."""
+    out = []
+    for r in arm.robot.regions:
+        name = f"{base}/regions/{r.name}"
+        T = transform(r.center, r.turned if r.turned is not None else (0.0, 0.0, 0.0))
+        out.append(scene.add_box(f"{name}/box", color=TARGET_RGB, dimensions=tuple(max(s, REGION_EDGE) for s in r.size),
+                                 wireframe=True, position=T[:3, 3], wxyz=wxyz(T)))
+        points = np.array([p.xyz for p in r.points()], dtype=np.float32)
+        out.append(scene.add_point_cloud(f"{name}/points", points=points, colors=TARGET_RGB, point_size=REGION_POINT,
+                                         point_shape="circle"))
+        n = len(points)
+        out.append(scene.add_label(f"{base}/region_labels/{r.name}", f"{r.name} ({n} point{'s' if n != 1 else ''})",
+                                   anchor="bottom-center", position=T[:3, 3], font_screen_scale=1.2))
+    return out
 
 
 def tool_and_payload(scene, base: str, arm: Arm) -> list:
