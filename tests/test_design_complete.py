@@ -358,3 +358,20 @@ def test_family_bounds_test_a_spread_subset_of_many_targets():
     assert corners <= {(round(p[0], 9), round(p[1], 9)) for p in sub}  # the extremes are among them
     few = xyz[:5]
     assert prefix.spread(few, tol[:5])[0] is few
+
+
+def test_a_search_stopped_before_any_design_does_not_claim_that_none_exists():
+    """Stopped by the budget with every target reached alone: only the chains searched are known
+    to fail together (it said "no chain reaches all of them", as a complete search does)."""
+    from modc.design.outcome import Outcome
+
+    p = _problem("design d {\n    box wall size (0.1, 0.1, 0.1) m at (0.5, 0.5, 0) m\n"
+                 "    target a at (0.3, 0.1, 0.3) m\n    target b at (0.2, -0.2, 0.3) m\n    units 1 to 3\n}\n")
+    alone = {"reached_alone": True}
+    o = Outcome(p, [], targets={"a": alone, "b": alone})
+    assert "no chain reaches all of them without touching the cell" in o.why_none()
+    o.stopped = "time budget"
+    why = o.why_none()
+    assert why.startswith("the search stopped (time budget) before finding one")
+    assert "no chain searched before it stopped reaches all of them" in why and "--time-budget" in why
+    assert "no chain reaches" not in why

@@ -212,7 +212,10 @@ def why_none(o) -> str:
     if o.rejections:
         return head + (f"every target can be reached alone; {counted(len(o.rejections), 'chain')} reach every "
                        f"target, but none passes the checks (first: {o.rejections[0]})")
+    # stopped: only the chains searched are known not to (the others were not tried)
+    which = "no chain searched before it stopped" if o.stopped else "no chain"
+    more = "; give it more time (--time-budget)" if o.stopped else ""
     if not o.problem.cell.obstacles:
-        return head + ("every target can be reached alone, but no chain reaches all of them with one arm "
-                       "(within its joint limits, clear of itself)")
-    return head + "every target can be reached alone, but no chain reaches all of them without touching the cell"
+        return head + (f"every target can be reached alone, but {which} reaches all of them with one arm "
+                       f"(within its joint limits, clear of itself){more}")
+    return head + f"every target can be reached alone, but {which} reaches all of them without touching the cell{more}"
