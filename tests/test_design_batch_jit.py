@@ -277,8 +277,11 @@ def test_the_compiled_kernel_is_cached_outside_the_source_tree(tmp_path):
     before = sorted(str(p) for p in (root / "modc").rglob("*.nb[ic]"))
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env.update(XDG_CACHE_HOME=str(tmp_path), PYTHONPATH=str(root))
-    r = subprocess.run([sys.executable, "-c", "from modc.design import reach_jit; reach_jit._s3(1.0, 2.0, 3.0, False)"],
+    r = subprocess.run([sys.executable, "-c", "import numpy as np; from modc.design import reach_jit, reach_jit_pose; "
+                        "reach_jit._s3(1.0, 2.0, 3.0, False); reach_jit_pose._dot(np.ones(6), np.ones(6), 6, False)"],
                        env=env, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
-    assert list((tmp_path / "modc-numba").rglob("*.nbi"))  # compiled once, kept for the next process
+    # compiled once, kept for the next process: both kernels' modules
+    assert list((tmp_path / "modc-numba").rglob("reach_jit._s3*.nbi"))
+    assert list((tmp_path / "modc-numba").rglob("reach_jit_pose._dot*.nbi"))
     assert sorted(str(p) for p in (root / "modc").rglob("*.nb[ic]")) == before
