@@ -264,6 +264,25 @@ def test_numpy_summing_in_another_order_keeps_the_numpy_path(monkeypatch):
     assert not reach.jit(1)
 
 
+def test_numpy_with_its_own_arccos_keeps_oriented_batches_on_the_numpy_path(monkeypatch, posed):
+    """Where numpy's arccos or arctan2 are not the C library's (its AVX-512 builds), the pose kernel
+    could not return numpy's bits: oriented batches stay in numpy, position-only ones compile."""
+    from modc.design import reach_jit_pose
+
+    assert reach_jit_pose.matches_numpy()  # here they are
+    monkeypatch.setattr(reach_jit_pose, "matches_numpy", lambda: False)
+    calls = []
+    monkeypatch.setattr(reach_jit_pose, "solve", lambda *a, **k: calls.append(1))
+    g = _candidates(posed, (1, 4, 3), 20)
+    lo, hi = np.full(3, posed.lower), np.full(3, posed.upper)
+    q0 = reach.seeds(3, 2, lo, hi, 0)
+    a = _solve(monkeypatch, True, g, posed.targets, q0, lo, hi)
+    assert not calls and a[2].any()
+    position = posed.targets.take(np.array([2]))
+    assert np.array_equal(_solve(monkeypatch, True, g, position, q0, lo, hi)[1],
+                          _solve(monkeypatch, False, g, position, q0, lo, hi)[1])
+
+
 @pytest.mark.slow
 def test_the_compiled_kernel_is_cached_outside_the_source_tree(tmp_path):
     """numba's default cache is a __pycache__ beside the source (the checkout, or site-packages):

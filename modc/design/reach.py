@@ -199,6 +199,13 @@ def jit(runs: int = 0) -> bool:
     return _JIT[0]
 
 
+def _pose_jit() -> bool:
+    """Whether batches with oriented targets take the compiled path too (once jit() says so)."""
+    from . import reach_jit_pose
+
+    return reach_jit_pose.matches_numpy()
+
+
 def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS,
           rows: np.ndarray | None = None):
     """Runs from every seed q0 (S, n), or per candidate (C, S, n), towards every target, for
@@ -216,10 +223,11 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
     ep_all, er_all = np.empty(B), np.zeros(B)
-    if jit(B):
+    oriented = bool(np.asarray(tg.oriented).any())
+    if jit(B) and (not oriented or _pose_jit()):
         # the same runs compiled, bit for bit (reach_jit's and reach_jit_pose's docstrings)
         give_up = np.asarray(tg.tol_p, float)[t_idx] * STALL_FACTOR
-        if not bool(np.asarray(tg.oriented).any()):
+        if not oriented:
             from . import reach_jit
 
             q_all, ep_all = reach_jit.solve_position(g.joints, c_idx, t_idx, tg.xyz, give_up, q_all, lo, hi,

@@ -268,12 +268,19 @@ def _solve_position(joints, c_idx, t_idx, xyz, give_up, q, lo, hi, iterations, s
 
 
 def matches_numpy() -> bool:
-    """Whether numpy's einsum here sums as _s3 and reach_jit_pose._dot assume (in order over a batch;
-    two lanes, (a + c) + b, for a batch of one, as its SIMD kernels of 2, 4 or 8 lanes do for three
-    terms; two lanes for six terms too; two lanes over a batch stored batch-major, as reach's
-    rotation residual is): else the kernels would not return numpy's bits, and reach.jit keeps the
-    numpy path."""
+    """Whether numpy's cos and sin are the C library's (which numba calls) and its einsum sums as
+    _s3 and reach_jit_pose._dot assume (in order over a batch; two lanes, (a + c) + b, for a batch
+    of one, as its SIMD kernels of 2, 4 or 8 lanes do for three terms; two lanes for six terms
+    too; two lanes over a batch stored batch-major, as reach's rotation residual is): else the
+    kernels would not return numpy's bits, and reach.jit keeps the numpy path."""
+    import math
+
     rng = np.random.default_rng(0)
+    for size in (1, 3, 8, 67, 1000):  # cos and sin: the C library's, as numba calls them (not numpy's SIMD)
+        a = rng.uniform(-4.0, 4.0, size)
+        if not (np.array_equal(np.cos(a), [math.cos(v) for v in a])
+                and np.array_equal(np.sin(a), [math.sin(v) for v in a])):
+            return False
 
     def lanes(t):
         return sum(t[2::2], t[0]) + sum(t[3::2], t[1])

@@ -273,6 +273,26 @@ def _solve(joints, c_idx, t_idx, xyz, G, oriented, pointed, axis, give_up, q, lo
     return q_out, ep_out, er_out
 
 
+_MATCHES: list[bool] = []
+
+
+def matches_numpy() -> bool:
+    """Whether numpy's arccos and arctan2 here are the C library's, which the kernel calls: not
+    where numpy runs its own SIMD versions (builds for AVX-512). Else batches with oriented targets
+    keep the numpy path (reach.solve asks; reach_jit.matches_numpy checks the sums and cos, sin)."""
+    if not _MATCHES:
+        import math
+
+        rng = np.random.default_rng(0)
+        ok = True
+        for size in (1, 3, 8, 67, 1000):
+            x, y = rng.uniform(-1.0, 1.0, size), np.abs(rng.normal(size=size))
+            ok &= np.array_equal(np.arccos(x), [math.acos(v) for v in x])
+            ok &= np.array_equal(np.arctan2(y, x), [math.atan2(a, b) for a, b in zip(y, x, strict=True)])
+        _MATCHES.append(bool(ok))
+    return _MATCHES[0]
+
+
 def solve(joints: np.ndarray, c_idx: np.ndarray, t_idx: np.ndarray, tg, give_up: np.ndarray, q: np.ndarray,
           lo: np.ndarray, hi: np.ndarray, iterations: int, stall_every: int, stall_gain: float, lambda0: float,
           w: float):
