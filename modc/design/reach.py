@@ -179,7 +179,7 @@ def jit(runs: int = 0) -> bool:
     """Whether `runs` runs take the compiled path (modc.design.reach_jit, reach_jit_pose: numba).
     Both paths return the same bits, so when to switch is a matter of cost only: importing numba
     and loading the cached kernel take ~0.9 s CPU per process, so a process switches once it has
-    solved JIT_AFTER runs with numpy (~0.5 s; oriented runs cost 2-5x more each, and their kernel
+    solved JIT_AFTER runs with numpy (~0.5 s; more with oriented runs, which cost more each; their kernel
     another ~0.5 s to load, when the first oriented batch comes) - a short search never pays for it.
     Oriented and position-only runs count alike. MODC_JIT=0 never switches, MODC_JIT=1 at once;
     without numba installed the numpy path always runs."""
