@@ -176,11 +176,13 @@ _NUMPY_RUNS = [0]
 
 
 def jit(runs: int = 0) -> bool:
-    """Whether `runs` position-only runs take the compiled path (modc.design.reach_jit, numba).
+    """Whether `runs` runs take the compiled path (modc.design.reach_jit, reach_jit_pose: numba).
     Both paths return the same bits, so when to switch is a matter of cost only: importing numba
     and loading the cached kernel take ~0.9 s CPU per process, so a process switches once it has
-    solved JIT_AFTER runs with numpy (~0.5 s) - a short search never pays for it. MODC_JIT=0
-    never switches, MODC_JIT=1 at once; without numba installed the numpy path always runs."""
+    solved JIT_AFTER runs with numpy (~0.5 s; more with oriented runs, which cost more each; their kernel
+    another ~0.5 s to load, when the first oriented batch comes) - a short search never pays for it.
+    Oriented and position-only runs count alike. MODC_JIT=0 never switches, MODC_JIT=1 at once;
+    without numba installed the numpy path always runs."""
     import os
 
     mode = os.environ.get("MODC_JIT", "")
@@ -197,6 +199,13 @@ def jit(runs: int = 0) -> bool:
         else:
             _JIT.append(reach_jit.numba is not None and reach_jit.matches_numpy())
     return _JIT[0]
+
+
+def _pose_jit() -> bool:
+    """Whether batches with oriented targets take the compiled path too (once jit() says so)."""
+    from . import reach_jit_pose
+
+    return reach_jit_pose.matches_numpy()
 
 
 def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: int = ITERATIONS,
@@ -216,13 +225,21 @@ def solve(g: Geometry, tg: Targets, q0: np.ndarray, lower, upper, iterations: in
     q_all = np.ascontiguousarray((np.tile(q0, (C * T, 1)) if q0.ndim == 2 else
                                   np.repeat(q0[:, None], T, axis=1).reshape(B, n)).T)  # (n, B)
     ep_all, er_all = np.empty(B), np.zeros(B)
-    if not bool(np.asarray(tg.oriented).any()) and jit(B):
-        from . import reach_jit
+    oriented = bool(np.asarray(tg.oriented).any())
+    if jit(B) and (not oriented or _pose_jit()):
+        # the same runs compiled, bit for bit (reach_jit's and reach_jit_pose's docstrings)
+        give_up = np.asarray(tg.tol_p, float)[t_idx] * STALL_FACTOR
+        if not oriented:
+            from . import reach_jit
 
-        # the same runs compiled (bit for bit: reach_jit's docstring); 6-D targets stay here
-        q_all, ep_all = reach_jit.solve_position(g.joints, c_idx, t_idx, tg.xyz, np.asarray(tg.tol_p, float)[t_idx]
-                                                 * STALL_FACTOR, q_all, lo, hi, iterations, STALL_EVERY,
-                                                 STALL_GAIN, LAMBDA0)
+            q_all, ep_all = reach_jit.solve_position(g.joints, c_idx, t_idx, tg.xyz, give_up, q_all, lo, hi,
+                                                     iterations, STALL_EVERY, STALL_GAIN, LAMBDA0)
+        else:
+            from . import reach_jit_pose
+
+            q_all, ep_all, er_all = reach_jit_pose.solve(g.joints, c_idx, t_idx, tg, give_up, q_all, lo, hi,
+                                                         iterations, STALL_EVERY, STALL_GAIN, LAMBDA0,
+                                                         ROTATION_WEIGHT)
         return q_all.T.reshape(C, T, S, n), ep_all.reshape(C, T, S), er_all.reshape(C, T, S)
     w = ROTATION_WEIGHT
     live = np.arange(B)

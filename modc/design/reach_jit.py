@@ -1,4 +1,5 @@
-"""The position-only IK of modc.design.reach.solve compiled with numba, when numba is installed.
+"""The position-only IK of modc.design.reach.solve compiled with numba, when numba is installed
+(batches with oriented targets: modc.design.reach_jit_pose, the same way).
 
 The numpy path streams ~100 whole-batch array operations per iteration (0.7 µs per run and
 iteration at 4,096 runs); here one run's iteration stays in registers. It is the same
@@ -267,10 +268,23 @@ def _solve_position(joints, c_idx, t_idx, xyz, give_up, q, lo, hi, iterations, s
 
 
 def matches_numpy() -> bool:
-    """Whether numpy's einsum here sums three terms as _s3 assumes (in order over a batch; (a + c)
-    + b for a batch of one, as its SIMD kernels of 2, 4 or 8 lanes do): else the kernel would not
-    return numpy's bits, and reach.jit keeps the numpy path."""
+    """Whether numpy's cos and sin are the C library's (which numba calls) and its einsum sums as
+    _s3 and reach_jit_pose._dot assume (in order over a batch; two lanes, (a + c) + b, for a batch
+    of one, as its SIMD kernels of 2, 4 or 8 lanes do for three terms; two lanes for six terms
+    too; two lanes over a batch stored batch-major, as reach's rotation residual is): else the
+    kernels would not return numpy's bits, and reach.jit keeps the numpy path."""
+    import math
+
     rng = np.random.default_rng(0)
+    for size in (1, 3, 8, 67, 1000):  # cos and sin: the C library's, as numba calls them (not numpy's SIMD)
+        a = rng.uniform(-4.0, 4.0, size)
+        if not (np.array_equal(np.cos(a), [math.cos(v) for v in a])
+                and np.array_equal(np.sin(a), [math.sin(v) for v in a])):
+            return False
+
+    def lanes(t):
+        return sum(t[2::2], t[0]) + sum(t[3::2], t[1])
+
     for B in (1, 2, 5):
         for _ in range(16):
             J, e = rng.normal(size=(3, 3, B)), rng.normal(size=(3, B))
@@ -280,6 +294,14 @@ def matches_numpy() -> bool:
             want_sq = (sq[0] + sq[2]) + sq[1] if B == 1 else (sq[0] + sq[1]) + sq[2]
             if not (np.array_equal(np.einsum("ikb,kb->ib", J, e), want)
                     and np.array_equal(np.einsum("ib,ib->b", e, e), want_sq)):
+                return False
+            J6, e6 = rng.normal(size=(2, 6, B)), rng.normal(size=(6, B))
+            t = [J6[0, k] * J6[1, k] for k in range(6)]
+            u = [J6[:, k] * e6[k] for k in range(6)]
+            et = np.moveaxis(np.ascontiguousarray(e.T), -1, 0)  # (3, B), the batch outermost in memory
+            if not (np.array_equal(np.einsum("ikb,jkb->ijb", J6, J6)[0, 1], lanes(t) if B == 1 else sum(t[1:], t[0]))
+                    and np.array_equal(np.einsum("ikb,kb->ib", J6, e6), lanes(u) if B == 1 else sum(u[1:], u[0]))
+                    and np.array_equal(np.einsum("ib,ib->b", et, et), (sq[0] + sq[2]) + sq[1])):
                 return False
     return True
 
