@@ -63,13 +63,18 @@ def test_gradient_is_the_outward_normal_of_each_shape():
 
 
 def test_escape_leads_out_of_the_deepest_obstacle():
-    # two obstacles: a thin wall the arm grazes, a block it goes 4 cm into; escape names the block
+    # two obstacles: a thin wall the arm stays clear of, a block it goes 1 cm into: escape names the block
     obs = Obstacles.of([_box((0.0, 0.3, 0.2), (1.0, 0.02, 1.0)), _box((0.5, 0.0, 0.2), (0.1, 0.1, 1.0))])
     frames = np.zeros((1, 1, 4, 3))
     frames[0, 0] = [(0, 0, 0), (0.0, 0.0, 0.1), (0.2, 0.0, 0.2), (0.44, 0.0, 0.2)]  # the bar ends in the block
     radii = np.array([0.03, 0.03, 0.02])
     assert collides(obs, frames, radii)[0]
-    np.testing.assert_allclose(escape(obs, frames, radii), [[-1.0, 0.0, 0.0]], atol=1e-6)
+    way, depth = escape(obs, frames, radii)
+    np.testing.assert_allclose(way, [[-1.0, 0.0, 0.0]], atol=1e-6)
+    np.testing.assert_allclose(depth, [0.01], atol=1e-9)  # the bar (2 cm in radius) ends 1 cm short of it
+    # the first actuator (joint 1's axis) in the block: no joint clears it
+    frames[0, 0, 1:3, 0] += 0.45
+    assert escape(obs, frames, radii)[1][0] == np.inf
 
 
 # --- the retry in the screen ----------------------------------------------------------------------

@@ -33,7 +33,7 @@ SEEDS = 4  # IK starts per target (the zero pose first)
 FEW = 2048  # candidates left for a target: their remaining seeds run in one batch
 VERIFY_MARGIN = 0.001  # m kept from the cell and between links in the chosen poses
 RETRY_SHARE = 0.9  # of a position tolerance: how far off its centre a colliding run's retry aims
-RETRY_ITERATIONS = 20  # IK iterations of that retry (it starts a tolerance away, from a solution)
+RETRY_ITERATIONS = 12  # IK iterations of that retry (it starts a tolerance away, from a solution)
 RETRY = True  # that retry (off: tests compare)
 
 
@@ -148,33 +148,36 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
             start = q[need, warm, first][:, None] if group == [SEEDS] else q0[group]
             qt, ept, ert = reach.solve(g, _sub_targets(tg, t), start, lo, hi, rows=need)
             got = np.zeros(need.size, bool)
+            redo: list[tuple] = []  # per seed: the runs that reached the target only in collision
             for j, s in enumerate(group):
                 r = ept[:, 0, j] / max(tg.tol_p[t], 1e-12)
                 if tg.oriented[t]:
                     r = np.maximum(r, ert[:, 0, j] / max(tg.tol_r[t], 1e-12))
                 h = r <= 1.0
                 ik_hit[need, t] |= h
-                qj, epj = qt[:, 0, j], ept[:, 0, j]
-                bad = np.zeros(0, int)
                 if h.any() and len(spec.obstacles.shape):
                     # only the runs that reached their target are worth a collision test
                     c = np.flatnonzero(h)
                     one = g.take(need[c])
-                    _, _, _, pts = forward(one, qj[c][:, None, None, :], points=True)
-                    hits = collides(spec.obstacles, pts[:, 0, 0], spec.radii)
-                    h[c] = ~hits
-                    bad, frames = c[hits], pts[hits, 0, 0]
+                    _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
+                    bad = collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+                    h[c] = ~bad
+                    if bad.any():
+                        redo.append((s, c[bad], pts[bad, 0, 0]))
+                q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r
                 direct[need, t, s] = h
-                if RETRY and bad.size and tg.tol_p[t] > 0:
-                    qk, epk, rk, ok = clear_within(spec, g, int(t), need[bad], qj[bad], frames, lo, hi)
-                    k = bad[ok]
-                    qj, epj, r = qj.copy(), epj.copy(), r.copy()
-                    qj[k], epj[k], r[k], h[k] = qk[ok], epk[ok], rk[ok], True
-                q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qj, epj, h, r
-                # a retried hit does not end the candidate's seeds: its tool0 lies off the centre and
-                # the exact check may still refuse it, so the runs the screen made without the retry
-                # are all kept (their solutions come first: smaller share of the tolerance)
-                got |= direct[need, t, s]
+                got |= h
+            if RETRY and redo and tg.tol_p[t] > 0:
+                # the seeds' collided runs in one call; a retried hit does not end the candidate's
+                # seeds: its tool0 lies off the centre and the exact check may still refuse it, so
+                # the runs the screen made without the retry all run (their solutions come first)
+                slot = np.concatenate([np.full(len(k), s) for s, k, _ in redo])
+                k = np.concatenate([k for _, k, _ in redo])
+                qk, epk, rk, ok = clear_within(spec, g, int(t), need[k], q[need[k], t, slot],
+                                               np.concatenate([f for _, _, f in redo]), lo, hi)
+                rows, slot = need[k[ok]], slot[ok]
+                q[rows, t, slot], ep[rows, t, slot], ratio[rows, t, slot] = qk[ok], epk[ok], rk[ok]
+                hit[rows, t, slot] = True
             need = need[~got]
         live = live[hit[live, t].any(-1)]
     reached = hit.any(-1)  # (C, T)
@@ -211,21 +214,32 @@ def clear_within(spec: Spec, g: Geometry, t: int, rows: np.ndarray, q0: np.ndarr
     (m,), the error as a share of the tolerances (m,), and whether the run is kept: within both
     tolerances and clear by the same screen."""
     tg = _sub_targets(spec.targets, t)
-    d = escape(spec.obstacles, frames, spec.radii) * (RETRY_SHARE * float(tg.tol_p[0]))
+    shift = RETRY_SHARE * float(tg.tol_p[0])
+    way, depth = escape(spec.obstacles, frames, spec.radii)
+    # a run in deeper than the shift (and the screen's 1 mm) would need some part of the arm to
+    # move farther than tool0: it is left as it is (an extra try, not a search); so is one whose
+    # first actuator collides (no joint moves it)
+    try_ = np.flatnonzero(depth <= shift + 1e-3)
+    m = len(rows)
+    qn, ep, r, ok = q0.copy(), np.full(m, np.inf), np.full(m, np.inf), np.zeros(m, bool)
+    if not try_.size:
+        return qn, ep, r, ok
+    rows, q0, d = rows[try_], q0[try_], way[try_] * shift
     moved = g.take(rows)
     pre = moved.pre.copy()
     pre[:, 0, :3, 3] -= d
-    qn, _, er = reach.solve(Geometry(pre, moved.post, moved.t1, moved.flange_tool), tg, q0[:, None, :], lower, upper,
-                            RETRY_ITERATIONS)
-    qn = qn[:, 0, 0]
-    _, _, T, pts = forward(g.take(rows), qn[:, None, None, :], points=True)
-    ep = np.linalg.norm(T[:, 0, 0, :3, 3] - tg.xyz[0], axis=-1)
-    r = ep / max(float(tg.tol_p[0]), 1e-12)
+    q, _, er = reach.solve(Geometry(pre, moved.post, moved.t1, moved.flange_tool), tg, q0[:, None, :], lower, upper,
+                           RETRY_ITERATIONS)
+    got = q[:, 0, 0]
+    _, _, T, pts = forward(g.take(rows), got[:, None, None, :], points=True)
+    e = np.linalg.norm(T[:, 0, 0, :3, 3] - tg.xyz[0], axis=-1)
+    share = e / max(float(tg.tol_p[0]), 1e-12)
     if tg.oriented[0]:
-        r = np.maximum(r, er[:, 0, 0] / max(float(tg.tol_r[0]), 1e-12))
-    ok = r <= 1.0
-    if ok.any():
-        ok[ok] = ~collides(spec.obstacles, pts[ok, 0, 0], spec.radii)
+        share = np.maximum(share, er[:, 0, 0] / max(float(tg.tol_r[0]), 1e-12))
+    fine = share <= 1.0
+    if fine.any():
+        fine[fine] = ~collides(spec.obstacles, pts[fine, 0, 0], spec.radii)
+    qn[try_], ep[try_], r[try_], ok[try_] = got, e, share, fine
     return qn, ep, r, ok
 
 

@@ -143,13 +143,16 @@ def collides(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: 
 
 
 
-def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: float = 0.02) -> np.ndarray:
+def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray,
+           step: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
     """frames (R, n, 4, 3) as for collides, of poses that collide: per pose the unit direction
     (R, 3) that leads out of the obstacle the arm goes deepest into - the gradient of that
     obstacle's signed distance at the arm's deepest sample (the segments sampled as collides
-    samples them, the first unit's twist unit left out). Moving tool0 that way moves the part
-    of the arm near it the same way: the screen's retry inside a target's tolerance
-    (modc.design.evaluate.screen_batch) aims there."""
+    samples them, the first unit's twist unit left out) - and how deep (R,) m. Moving tool0 that
+    way moves the part of the arm near it the same way: the screen's retry inside a target's
+    tolerance (modc.design.evaluate.clear_within) aims there. The depth is inf where the first
+    unit's actuator (twist1 -> joint 1, on joint 1's axis: no joint moves it) collides: no joint
+    vector clears that pose."""
     R, n = frames.shape[:2]
     a, b = frames[:, :, :3, :], frames[:, :, 1:, :]  # (R, n, 3, 3)
     m = int(np.ceil(0.25 / step)) + 1
@@ -160,6 +163,6 @@ def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: fl
     flat = d.reshape(R, -1)
     best = flat.argmin(1)
     K = d.shape[-1]
-    k = best % K
     where = pts.reshape(R, -1, 3)[np.arange(R), best // K]
-    return obstacles.gradient(k, where)
+    depth = np.where((d[:, 0, 1] < -1e-3).any((-1, -2)), np.inf, -flat[np.arange(R), best])
+    return obstacles.gradient(best % K, where), depth
