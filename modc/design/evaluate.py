@@ -99,7 +99,10 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     """Targets one at a time, farthest from the base first: a candidate leaves the batch at the
     first target it cannot reach (most twist settings miss the hardest one), so the rest of the
     work is spent on candidates that may pass. interrupted() is asked before each target (a
-    region of thousands of points makes one batch long): True abandons the batch (None)."""
+    region of thousands of points makes one batch long): True abandons the batch (None).
+    A run that reaches a target only in collision gets one retry inside the tolerance
+    (clear_within): it only adds hits, every run made without it still runs (RETRY off: the
+    screen as it was, for the tests to compare)."""
     lib = spec.problem.cell.library
     if g is None:
         types = [lib.units[k] for k in shape.kinds]
