@@ -2,8 +2,10 @@
 and the exact check of one design with modc's own analyses (verify).
 
 screen_batch: batched IK per target within the joint limits (position, or 6-D with an
-orientation), then the sphere-swept obstacle screen on the solutions found. Fast and
-approximate: it decides what is worth checking.
+orientation), then the sphere-swept obstacle screen on the solutions found; a solution that
+collides gets one retry aimed off the target's centre, inside its tolerance, away from the
+obstacle (clear_within: a target is met anywhere within its tolerance). Fast and approximate:
+it decides what is worth checking.
 
 verify: the one place a design is accepted. It writes the design as a robot, checks it with the
 compiler's passes and analyses (check_text: assembly rules, twists, poses within limits, the
@@ -24,12 +26,15 @@ import numpy as np
 from ..model import Pose, ResolvedProblem, ResolvedRobot, Robot, UnitSpec
 from . import reach
 from .batch import Geometry, forward, geometry
-from .screen import Obstacles, collides, segment_radii
+from .screen import Obstacles, collides, escape, segment_radii
 from .space import Shape
 
 SEEDS = 4  # IK starts per target (the zero pose first)
 FEW = 2048  # candidates left for a target: their remaining seeds run in one batch
 VERIFY_MARGIN = 0.001  # m kept from the cell and between links in the chosen poses
+RETRY_SHARE = 0.9  # of a position tolerance: how far off its centre a colliding run's retry aims
+RETRY_ITERATIONS = 12  # IK iterations of that retry (it starts a tolerance away, from a solution)
+RETRY = True  # that retry (off: tests compare)
 
 
 @dataclass(frozen=True)
@@ -57,7 +62,8 @@ class Screened:
     """Per candidate (C): feasible; a score (0 when feasible; else how far from it); per target
     the closest position error (C, T), whether an IK run got within tolerance at all (C, T,
     collisions aside), whether the target was tried; per feasible candidate its worst error as
-    a share of the tolerance (0: dead on, 1: at the edge) and the joint vectors that pass the
+    a share of the tolerance (0: dead on, 1: at the edge; 1 + the share where a target was met
+    only by the retry inside its tolerance, clear_within) and the joint vectors that pass the
     screen, best first (solution(j), built on demand: a search keeps a few of thousands)."""
 
     feasible: np.ndarray
@@ -93,7 +99,10 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     """Targets one at a time, farthest from the base first: a candidate leaves the batch at the
     first target it cannot reach (most twist settings miss the hardest one), so the rest of the
     work is spent on candidates that may pass. interrupted() is asked before each target (a
-    region of thousands of points makes one batch long): True abandons the batch (None)."""
+    region of thousands of points makes one batch long): True abandons the batch (None).
+    A run that reaches a target only in collision gets one retry inside the tolerance
+    (clear_within): it only adds hits, every run made without it still runs (RETRY off: the
+    screen as it was, for the tests to compare)."""
     lib = spec.problem.cell.library
     if g is None:
         types = [lib.units[k] for k in shape.kinds]
@@ -111,6 +120,7 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     ep = np.full((C, T, S), np.inf)
     ratio = np.full((C, T, S), np.inf)
     hit = np.zeros((C, T, S), bool)
+    direct = np.zeros((C, T, S), bool)  # hit at the IK's own end (without clear_within's retry)
     ik_hit = np.zeros((C, T), bool)
     tried = np.zeros((C, T), bool)
     live = np.arange(C)
@@ -135,9 +145,13 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
             # iterations more than its runs)
             group = seeds if seeds[0] < SEEDS and need.size <= FEW else seeds[:1]
             seeds = seeds[len(group):]
-            start = q[need, warm, hit[need, warm].argmax(-1)][:, None] if group == [SEEDS] else q0[group]
+            # the first direct hit as before (a retried one only when there is none): the runs of
+            # the screen without the retry all still run, from the same starts
+            first = np.where(direct[need, warm].any(-1), direct[need, warm].argmax(-1), hit[need, warm].argmax(-1))
+            start = q[need, warm, first][:, None] if group == [SEEDS] else q0[group]
             qt, ept, ert = reach.solve(g, _sub_targets(tg, t), start, lo, hi, rows=need)
             got = np.zeros(need.size, bool)
+            redo: list[tuple] = []  # per seed: the runs that reached the target only in collision
             for j, s in enumerate(group):
                 r = ept[:, 0, j] / max(tg.tol_p[t], 1e-12)
                 if tg.oriented[t]:
@@ -149,9 +163,24 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
                     c = np.flatnonzero(h)
                     one = g.take(need[c])
                     _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
-                    h[c] = ~collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+                    bad = collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+                    h[c] = ~bad
+                    if bad.any():
+                        redo.append((s, c[bad], pts[bad, 0, 0]))
                 q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r
+                direct[need, t, s] = h
                 got |= h
+            if RETRY and redo and tg.tol_p[t] > 0:
+                # the seeds' collided runs in one call; a retried hit does not end the candidate's
+                # seeds: its tool0 lies off the centre and the exact check may still refuse it, so
+                # the runs the screen made without the retry all run (their solutions come first)
+                slot = np.concatenate([np.full(len(k), s) for s, k, _ in redo])
+                k = np.concatenate([k for _, k, _ in redo])
+                qk, epk, rk, ok = clear_within(spec, g, int(t), need[k], q[need[k], t, slot],
+                                               np.concatenate([f for _, _, f in redo]), lo, hi)
+                rows, slot = need[k[ok]], slot[ok]
+                q[rows, t, slot], ep[rows, t, slot], ratio[rows, t, slot] = qk[ok], epk[ok], rk[ok]
+                hit[rows, t, slot] = True
             need = need[~got]
         live = live[hit[live, t].any(-1)]
     reached = hit.any(-1)  # (C, T)
@@ -160,10 +189,61 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
     # how far from feasible: metres missed on the targets tried, plus a metre per target not reached
     excess = np.where(np.isfinite(closest), np.maximum(closest - tg.tol_p[None], 0.0), 0.0)
     score = np.where(feasible, 0.0, excess.sum(-1) + (~reached).sum(-1) * 1.0)
-    # the worst target's best run that passed, as a share of the tolerance (min and max are exact)
-    worst = np.where(hit[feasible], ratio[feasible], np.inf).min(-1).max(-1) if T else np.zeros(int(feasible.sum()))
+    # the worst target's best run that passed, as a share of the tolerance (min and max are exact);
+    # a target reached only by clear_within's retry counts 1 + its share: such a setting orders
+    # after every setting the IK reached directly (search.order_key, dominance's 0.0), so the
+    # settings a shape kept without the retry are kept, and checked, first
+    if T:
+        own = np.where(direct[feasible], ratio[feasible], np.inf).min(-1)
+        worst = np.where(np.isfinite(own), own, 1.0 + np.where(hit[feasible], ratio[feasible], np.inf).min(-1)).max(-1)
+    else:
+        worst = np.zeros(int(feasible.sum()))
     return Screened(np.asarray(feasible), np.asarray(score), closest, ik_hit, tried, np.asarray(worst, float),
                     np.asarray(reached), (q, ratio, hit))
+
+
+def clear_within(spec: Spec, g: Geometry, t: int, rows: np.ndarray, q0: np.ndarray, frames: np.ndarray,
+                 lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Runs of candidates `rows` that reached target t at q0 (m, n) but collide (frames: their
+    unit frames there, as screen.collides takes them): one more try each, inside the tolerance.
+
+    A target is met anywhere within its position tolerance (verify measures tool0 against it),
+    while the IK aims at its centre: an arm whose last unit grazes an obstacle there may be clear
+    with tool0 a few millimetres off. Each run is re-solved from q0, a few iterations, towards
+    the target moved RETRY_SHARE of its tolerance along screen.escape (out of the obstacle the arm
+    goes deepest into); its orientation and tolerances stay. Moving a target by d is moving the
+    chain by -d (the translation of its first fixed transform), so every run keeps its own
+    target in one batched IK call. Returns q (m, n), the position error from the real target
+    (m,), the error as a share of the tolerances (m,), and whether the run is kept: within both
+    tolerances and clear by the same screen."""
+    tg = _sub_targets(spec.targets, t)
+    shift = RETRY_SHARE * float(tg.tol_p[0])
+    way, depth = escape(spec.obstacles, frames, spec.radii)
+    # a run in deeper than the shift (and the screen's 1 mm) would need some part of the arm to
+    # move farther than tool0: it is left as it is (an extra try, not a search); so is one whose
+    # first actuator collides (no joint moves it)
+    try_ = np.flatnonzero(depth <= shift + 1e-3)
+    m = len(rows)
+    qn, ep, r, ok = q0.copy(), np.full(m, np.inf), np.full(m, np.inf), np.zeros(m, bool)
+    if not try_.size:
+        return qn, ep, r, ok
+    rows, q0, d = rows[try_], q0[try_], way[try_] * shift
+    moved = g.take(rows)
+    pre = moved.pre.copy()
+    pre[:, 0, :3, 3] -= d
+    q, _, er = reach.solve(Geometry(pre, moved.post, moved.t1, moved.flange_tool), tg, q0[:, None, :], lower, upper,
+                           RETRY_ITERATIONS)
+    got = q[:, 0, 0]
+    _, _, T, pts = forward(g.take(rows), got[:, None, None, :], points=True)
+    e = np.linalg.norm(T[:, 0, 0, :3, 3] - tg.xyz[0], axis=-1)
+    share = e / max(float(tg.tol_p[0]), 1e-12)
+    if tg.oriented[0]:
+        share = np.maximum(share, er[:, 0, 0] / max(float(tg.tol_r[0]), 1e-12))
+    fine = share <= 1.0
+    if fine.any():
+        fine[fine] = ~collides(spec.obstacles, pts[fine, 0, 0], spec.radii)
+    qn[try_], ep[try_], r[try_], ok[try_] = got, e, share, fine
+    return qn, ep, r, ok
 
 
 @dataclass(frozen=True)

@@ -60,6 +60,21 @@ class Obstacles:
             d = np.minimum(d, self._one(k, self.shape[k], pts))
         return d
 
+    def gradient(self, k: np.ndarray, pts: np.ndarray, h: float = 1e-6) -> np.ndarray:
+        """Unit gradients (P, 3) of obstacle k[i]'s signed distance at pts[i] (central differences:
+        the distance is 1-Lipschitz and smooth off the faces' medial planes; on one, either side's
+        direction leads out). A point exactly at a box's or sphere's centre gets some unit vector."""
+        out = np.zeros(pts.shape)
+        for j in np.unique(k):
+            at = np.flatnonzero(k == j)
+            x = pts[at]
+            for a in range(3):
+                e = np.zeros(3)
+                e[a] = h
+                out[at, a] = self._one(int(j), int(self.shape[j]), x + e) - self._one(int(j), int(self.shape[j]), x - e)
+        norm = np.linalg.norm(out, axis=1, keepdims=True)
+        return np.where(norm > 1e-12, out / np.maximum(norm, 1e-300), np.array([0.0, 0.0, 1.0]))
+
     def _one(self, k: int, shape: int, pts: np.ndarray) -> np.ndarray:
         # component by component: reductions over an axis of 2 or 3 cost more than the arithmetic
         x = (pts - self.centre[k]) @ self.R[k]  # R^T (p - c), row-wise
@@ -126,3 +141,28 @@ def collides(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray, step: 
     return out
 
 
+
+
+def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray,
+           step: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
+    """frames (R, n, 4, 3) as for collides, of poses that collide: per pose the unit direction
+    (R, 3) that leads out of the obstacle the arm goes deepest into - the gradient of that
+    obstacle's signed distance at the arm's deepest sample (the segments sampled as collides
+    samples them, the first unit's twist unit left out) - and how deep (R,) m. Moving tool0 that
+    way moves the part of the arm near it the same way: the screen's retry inside a target's
+    tolerance (modc.design.evaluate.clear_within) aims there. The depth is inf where the first
+    unit's actuator (twist1 -> joint 1, on joint 1's axis: no joint moves it) collides: no joint
+    vector clears that pose."""
+    R, n = frames.shape[:2]
+    a, b = frames[:, :, :3, :], frames[:, :, 1:, :]  # (R, n, 3, 3)
+    m = int(np.ceil(0.25 / step)) + 1
+    ts = np.linspace(0.0, 1.0, m)
+    pts = a[..., None, :] + (b - a)[..., None, :] * ts[:, None]  # (R, n, 3, m, 3)
+    d = obstacles.distance(pts.reshape(-1, 3)).reshape(R, n, 3, m, -1) - radii[None, None, :, None, None]
+    d[:, 0, 0] = np.inf
+    flat = d.reshape(R, -1)
+    best = flat.argmin(1)
+    K = d.shape[-1]
+    where = pts.reshape(R, -1, 3)[np.arange(R), best // K]
+    depth = np.where((d[:, 0, 1] < -1e-3).any((-1, -2)), np.inf, -flat[np.arange(R), best])
+    return obstacles.gradient(best % K, where), depth
