@@ -153,34 +153,15 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
             got = np.zeros(need.size, bool)
             redo: list[tuple] = []  # per seed: the runs that reached the target only in collision
             for j, s in enumerate(group):
-                r = ept[:, 0, j] / max(tg.tol_p[t], 1e-12)
-                if tg.oriented[t]:
-                    r = np.maximum(r, ert[:, 0, j] / max(tg.tol_r[t], 1e-12))
-                h = r <= 1.0
-                ik_hit[need, t] |= h
-                if h.any() and len(spec.obstacles.shape):
-                    # only the runs that reached their target are worth a collision test
-                    c = np.flatnonzero(h)
-                    one = g.take(need[c])
-                    _, _, _, pts = forward(one, qt[c, 0, j][:, None, None, :], points=True)
-                    bad = collides(spec.obstacles, pts[:, 0, 0], spec.radii)
-                    h[c] = ~bad
-                    if bad.any():
-                        redo.append((s, c[bad], pts[bad, 0, 0]))
+                ik, h, r, bad, frames = _passes(spec, g, int(t), need, qt[:, 0, j], ept[:, 0, j], ert[:, 0, j])
+                ik_hit[need, t] |= ik
+                if bad.size:
+                    redo.append((s, bad, frames))
                 q[need, t, s], ep[need, t, s], hit[need, t, s], ratio[need, t, s] = qt[:, 0, j], ept[:, 0, j], h, r
                 direct[need, t, s] = h
                 got |= h
             if RETRY and redo and tg.tol_p[t] > 0:
-                # the seeds' collided runs in one call; a retried hit does not end the candidate's
-                # seeds: its tool0 lies off the centre and the exact check may still refuse it, so
-                # the runs the screen made without the retry all run (their solutions come first)
-                slot = np.concatenate([np.full(len(k), s) for s, k, _ in redo])
-                k = np.concatenate([k for _, k, _ in redo])
-                qk, epk, rk, ok = clear_within(spec, g, int(t), need[k], q[need[k], t, slot],
-                                               np.concatenate([f for _, _, f in redo]), lo, hi)
-                rows, slot = need[k[ok]], slot[ok]
-                q[rows, t, slot], ep[rows, t, slot], ratio[rows, t, slot] = qk[ok], epk[ok], rk[ok]
-                hit[rows, t, slot] = True
+                _retry(spec, g, int(t), need, redo, (q, ep, ratio, hit), lo, hi)
             need = need[~got]
         live = live[hit[live, t].any(-1)]
     reached = hit.any(-1)  # (C, T)
@@ -200,6 +181,45 @@ def screen_batch(spec: Spec, shape: Shape, pivots: np.ndarray, ports: np.ndarray
         worst = np.zeros(int(feasible.sum()))
     return Screened(np.asarray(feasible), np.asarray(score), closest, ik_hit, tried, np.asarray(worst, float),
                     np.asarray(reached), (q, ratio, hit))
+
+
+def _passes(spec: Spec, g: Geometry, t: int, rows: np.ndarray, qt: np.ndarray, ept: np.ndarray,
+            ert: np.ndarray) -> tuple[np.ndarray, ...]:
+    """One seed's runs of candidates `rows` at target t (joint vectors qt, position and rotation
+    errors): whether each got within the tolerances (the IK's hit), whether it did clear of the
+    cell, its error as a share of the tolerances, and the runs that hit only in collision
+    (indices into rows) with their unit frames (for clear_within)."""
+    tg = spec.targets
+    r = ept / max(tg.tol_p[t], 1e-12)
+    if tg.oriented[t]:
+        r = np.maximum(r, ert / max(tg.tol_r[t], 1e-12))
+    ik = r <= 1.0
+    h = ik.copy()
+    bad, frames = np.zeros(0, int), np.zeros((0, g.dof, 4, 3))
+    if h.any() and len(spec.obstacles.shape):
+        # only the runs that reached their target are worth a collision test
+        c = np.flatnonzero(h)
+        _, _, _, pts = forward(g.take(rows[c]), qt[c][:, None, None, :], points=True)
+        collided = collides(spec.obstacles, pts[:, 0, 0], spec.radii)
+        h[c] = ~collided
+        bad, frames = c[collided], pts[collided, 0, 0]
+    return ik, h, r, bad, frames
+
+
+def _retry(spec: Spec, g: Geometry, t: int, need: np.ndarray, redo: list[tuple], runs: tuple[np.ndarray, ...],
+           lo: np.ndarray, hi: np.ndarray) -> None:
+    """The seeds' collided runs (redo: slot, indices into need, frames) retried in one call
+    (clear_within), their hits written into runs = (q, ep, ratio, hit). A retried hit does not end
+    the candidate's seeds: its tool0 lies off the centre and the exact check may still refuse it,
+    so the runs the screen made without the retry all run (their solutions come first)."""
+    q, ep, ratio, hit = runs
+    slot = np.concatenate([np.full(len(k), s) for s, k, _ in redo])
+    k = np.concatenate([k for _, k, _ in redo])
+    qk, epk, rk, ok = clear_within(spec, g, t, need[k], q[need[k], t, slot], np.concatenate([f for _, _, f in redo]),
+                                   lo, hi)
+    rows, slot = need[k[ok]], slot[ok]
+    q[rows, t, slot], ep[rows, t, slot], ratio[rows, t, slot] = qk[ok], epk[ok], rk[ok]
+    hit[rows, t, slot] = True
 
 
 def clear_within(spec: Spec, g: Geometry, t: int, rows: np.ndarray, q0: np.ndarray, frames: np.ndarray,
