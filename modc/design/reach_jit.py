@@ -132,18 +132,9 @@ def _forward(K, q, p, z, t, n, R, R2, one):
 
 
 @_inline
-def _step(p, z, t, e, lam, n, qn, q, lo, hi, J, A, rhs, L, d, y, one):
-    """qn = clip(q + dq) with (J^T J + lam I) dq = J^T e: reach._step's order of operations."""
-    for i in range(n):
-        b0, b1, b2 = t[0] - p[i, 0], t[1] - p[i, 1], t[2] - p[i, 2]
-        J[i, 0] = z[i, 1] * b2 - z[i, 2] * b1
-        J[i, 1] = z[i, 2] * b0 - z[i, 0] * b2
-        J[i, 2] = z[i, 0] * b1 - z[i, 1] * b0
-    for i in range(n):
-        for j in range(i, n):
-            A[i, j] = _s3(J[i, 0] * J[j, 0], J[i, 1] * J[j, 1], J[i, 2] * J[j, 2], one)
-        A[i, i] = A[i, i] + lam
-        rhs[i] = _s3(J[i, 0] * e[0], J[i, 1] * e[1], J[i, 2] * e[2], one)
+def _ldl_clip(A, rhs, n, qn, q, lo, hi, L, d, y):
+    """qn = clip(q + dq, lo, hi) with A dq = rhs, A's upper triangle symmetric positive definite:
+    reach._ldl_solve's element-wise LDL^T, then the clip (both kernels' last part of a step)."""
     for j in range(n):
         dj = A[j, j]
         for k in range(j):
@@ -171,6 +162,22 @@ def _step(p, z, t, e, lam, n, qn, q, lo, hi, J, A, rhs, L, d, y, one):
         if v > hi[i]:
             v = hi[i]
         qn[i] = v
+
+
+@_inline
+def _step(p, z, t, e, lam, n, qn, q, lo, hi, J, A, rhs, L, d, y, one):
+    """qn = clip(q + dq) with (J^T J + lam I) dq = J^T e: reach._step's order of operations."""
+    for i in range(n):
+        b0, b1, b2 = t[0] - p[i, 0], t[1] - p[i, 1], t[2] - p[i, 2]
+        J[i, 0] = z[i, 1] * b2 - z[i, 2] * b1
+        J[i, 1] = z[i, 2] * b0 - z[i, 0] * b2
+        J[i, 2] = z[i, 0] * b1 - z[i, 1] * b0
+    for i in range(n):
+        for j in range(i, n):
+            A[i, j] = _s3(J[i, 0] * J[j, 0], J[i, 1] * J[j, 1], J[i, 2] * J[j, 2], one)
+        A[i, i] = A[i, i] + lam
+        rhs[i] = _s3(J[i, 0] * e[0], J[i, 1] * e[1], J[i, 2] * e[2], one)
+    _ldl_clip(A, rhs, n, qn, q, lo, hi, L, d, y)
 
 
 @_jit

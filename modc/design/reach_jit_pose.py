@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .reach_jit import _inline, _jit, _s3
+from .reach_jit import _inline, _jit, _ldl_clip, _s3
 
 
 @_inline
@@ -155,33 +155,7 @@ def _step(p, z, Rt, t, ep, er, oriented, pointed, w, lam, n, qn, q, lo, hi, J, e
             A[i, j] = _dot(J[i], J[j], 6, one)
         A[i, i] = A[i, i] + lam
         rhs[i] = _dot(J[i], e, 6, one)
-    for j in range(n):
-        dj = A[j, j]
-        for k in range(j):
-            dj = dj - L[j, k] * L[j, k] * d[k]
-        d[j] = dj
-        for i in range(j + 1, n):
-            a = A[j, i]
-            for k in range(j):
-                a = a - L[i, k] * L[j, k] * d[k]
-            L[i, j] = a / dj
-    for i in range(n):
-        yi = rhs[i]
-        for k in range(i):
-            yi = yi - L[i, k] * y[k]
-        y[i] = yi
-    for i in range(n - 1, -1, -1):
-        xi = y[i] / d[i]
-        for k in range(i + 1, n):
-            xi = xi - L[k, i] * qn[k]
-        qn[i] = xi
-    for i in range(n):
-        v = qn[i] + q[i]
-        if v < lo[i]:
-            v = lo[i]
-        if v > hi[i]:
-            v = hi[i]
-        qn[i] = v
+    _ldl_clip(A, rhs, n, qn, q, lo, hi, L, d, y)
 
 
 @_jit
