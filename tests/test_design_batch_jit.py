@@ -202,25 +202,6 @@ def test_a_process_loads_the_compiled_path_only_after_enough_runs(monkeypatch):
     assert not reach.jit(1)
 
 
-def test_a_design_run_ranks_the_same_with_either_path(monkeypatch):
-    """End to end on a small cell: the designs, their joint vectors (the candidates' solutions, to
-    the bit) and the search's counts."""
-    from conftest import SMALL_CELL
-
-    from modc.design import run
-
-    c = check_text(SMALL_CELL, "small.mod")
-    assert c.ok, c.diagnostics
-    out = {}
-    for mode in ("0", "1"):
-        monkeypatch.setenv("MODC_JIT", mode)
-        o = run.design(c.design.problems[0], top=3, seed=0)
-        out[mode] = ([(d.chain(), d.mass, d.margin, d.candidate.solutions) for d in o.designs], o.evaluated,
-                     o.excluded, o.complete)
-    assert out["0"][0]
-    assert out["0"] == out["1"]
-
-
 def _posed_cell() -> str:
     """A full pose and a direction that an H1 - L3 - L3 arm meets with its own twists."""
     from modc.design.batch import forward
@@ -241,11 +222,15 @@ def _posed_cell() -> str:
             "    units 2 to 3\n    modules H1, L3\n}\n")
 
 
-def test_an_oriented_design_run_ranks_the_same_with_either_path(monkeypatch):
-    """End to end with a full pose and a direction: the design, its joint vectors, the counts."""
+@pytest.mark.parametrize("cell", ["small", "posed"])
+def test_a_design_run_ranks_the_same_with_either_path(monkeypatch, cell):
+    """End to end on a small cell, and on one with a full pose and a direction: the designs, their
+    joint vectors (the candidates' solutions, to the bit) and the search's counts."""
+    from conftest import SMALL_CELL
+
     from modc.design import run
 
-    c = check_text(_posed_cell(), "posed.mod")
+    c = check_text(SMALL_CELL if cell == "small" else _posed_cell(), "cell.mod")
     assert c.ok, c.diagnostics
     out = {}
     for mode in ("0", "1"):
