@@ -181,3 +181,35 @@ def test_coverage_starts_the_planners_ik_at_the_joint_values_the_search_verified
     q = [0.1, 0.2, 0.3]
     assert coverage.reached(robot, 0, known={"pair[1,0,0]": q}) == (set(), 2)
     assert np.allclose(starts["pair[1,0,0]"], q) and not np.allclose(starts["pair[0,0,0]"], q)
+
+
+# the region lies across the arm's front, a wall behind it: the arms that reach `home` by the
+# simplest twists serve none of its points, so the search must look for those that do
+BEHIND_A_WALL = """design walled {
+    payload 100 g
+    box wall size (0.02, 0.6, 0.5) m at (0.45, 0, 0.25) m
+    target home at (0.25, 0.0, 0.30) m
+    region far box size (0.3, 0, 0) m at (0.3, 0.0, 0.2) m turned (0, 0, 90) deg grid 4 x 1 x 1
+    task serve { visit home, far, home }
+    base within box size (0.1, 0.1, 0) m at (0, 0, 0) m step 100 mm yaw 0 to 180 deg step 90 deg
+    units 3
+    modules H1, L3
+    rank coverage, cycle_time
+}
+"""
+
+
+@pytest.mark.slow
+def test_coverage_with_a_base_grid_searches_for_arms_that_serve_the_region():
+    """`rank coverage` with `base within` planned only the arms found for the targets alone (it
+    skipped the search for arms serving the region's points): "no design", every candidate
+    reaching no point. Now the grid is searched for them as one pose is."""
+    from modc.design import run
+
+    o = run.design(problem(BEHIND_A_WALL), top=1, seed=0)
+    assert o.designs, o.why_none()
+    d = o.designs[0]
+    assert d.coverage > 0 and d.plans and d.plans[0].task == "serve"
+    robot = d.verified.robot
+    served = [v for v in next(t for t in robot.tasks if t.name == "serve").visits if v.startswith("far[")]
+    assert len(served) == round(d.coverage * 4) and o.bases_searched > 1

@@ -53,20 +53,24 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
     def many(p: ResolvedProblem, cells: list[ResolvedProblem], units: int | None, k: int) -> Outcome:
         return grid.search(p, cells, units, k, seed, executor, by[0], enough=enough[0], progress=progress)
 
+    def static_search(p: ResolvedProblem, k: int, diagnosing: bool = True) -> Outcome:
+        """p's static search: at the base as written, or over the base grid (placement)."""
+        if problem.base_grid is None:
+            return one(p, max_units, k, diagnosing)
+        hi = min(max_units or problem.max_units, problem.cell.library.rules.max_dof)
+        return placement.search(p, max_units, k, longest_reach(problem, hi),
+                                lambda s, u, m: one(s, u, m, diagnosing), many)
+
     rejected: dict[str, tuple[str, str | None]] = {}  # chain -> why (and which task) it could not be planned: once only
     while True:
         by[0] = _search_deadline(deadline, n) if tasked else deadline
-        if problem.base_grid is None:
-            out = one(screen, max_units, n)
-        else:
-            hi = min(max_units or problem.max_units, problem.cell.library.rules.max_dof)
-            out = placement.search(screen, max_units, n, longest_reach(problem, hi), one, many)
+        out = static_search(screen, n)
         out.problem = problem
         tasks.restore(out, points)
         if not tasked:
             break
         if _optional_points(problem) and not out.stopped:
-            out = _covering(problem, out, one, max_units, n, top, seed, deadline)
+            out = _covering(problem, out, static_search, n, top, seed, deadline)
         found = len(out.designs)
         tasks.plan_all(out, top, seed, deadline, _stopping, rejected, _planning(out, progress))
         # every candidate failed its tasks: search on for more of them while there may be more (the
@@ -102,19 +106,19 @@ def _planning(out: Outcome, progress: Callable[..., None] | None) -> Callable[[i
     return tick
 
 
-def _covering(problem: ResolvedProblem, out: Outcome, one, max_units: int | None, n: int, top: int,
-              seed: int, deadline: float | None) -> Outcome:
+def _covering(problem: ResolvedProblem, out: Outcome, search, n: int, top: int, seed: int,
+              deadline: float | None) -> Outcome:
     """`rank coverage`: the candidates to plan are those that serve every region point when some
     do (coverage 1, the most there is), else those serving at least one (tasks.by_points), and
-    only when none serves any, out's (the cell's targets alone: they are then told what they miss)."""
+    only when none serves any, out's (the cell's targets alone: they are then told what they miss).
+    search(problem, k, diagnosing): the static search, at one base pose or over the base grid."""
     from . import tasks
 
     every, names = tasks.with_points(problem, every=True)
-    whole = one(_static_screen(every, problem), max_units, n, diagnosing=False)
+    whole = search(_static_screen(every, problem), n, False)
     tasks.restore(whole, names)
     picked = whole if whole.designs or whole.stopped else tasks.by_points(
-        problem, lambda s: one(_static_screen(s, problem), max_units, top, diagnosing=False), n, seed,
-        lambda: _stopping(deadline))
+        problem, lambda s: search(_static_screen(s, problem), top, False), n, seed, lambda: _stopping(deadline))
     if picked is None or not picked.designs:
         return out
     picked.problem = problem
@@ -130,8 +134,9 @@ def _static_screen(screen: ResolvedProblem, problem: ResolvedProblem) -> Resolve
 
 
 def _optional_points(problem: ResolvedProblem) -> bool:
-    """`rank coverage` with regions, no base grid: the static search screened no region point."""
-    return "coverage" in problem.rank and bool(problem.cell.regions) and problem.base_grid is None
+    """`rank coverage` with regions: the static search screened no region point (but the ends
+    of straight paths)."""
+    return "coverage" in problem.rank and bool(problem.cell.regions)
 
 
 # re-exported: the search's outcome and where tests reach the static search (run._search, _tiers,
