@@ -49,7 +49,7 @@ def test_a_turn_without_an_angle_unit_is_a_diagnostic():
                          "r.mod")
     assert not checked.ok
     d = next(d for d in checked.diagnostics if d.is_error)
-    assert d.span.line == 3 and "turn of region 'tray'" in d.message
+    assert d.span.line == 3 and "turn of the box of region 'tray'" in d.message
 
 
 def test_the_written_robot_and_the_yaml_form_hold_the_same_turned_points(tmp_path):

@@ -40,7 +40,7 @@ def region(low, st: ast.Region) -> Region | None:
     size = low.vec3(st.size, "a length", f"size of {what}")
     at = low.vec3(st.at, "a length", f"position of {what}")
     rpy = low.vec3(st.rpy, "an angle", f"orientation of {what}") if st.rpy is not None else None
-    turned = low.vec3(st.turned, "an angle", f"turn of {what}'s box") if st.turned is not None else None
+    turned = low.vec3(st.turned, "an angle", f"turn of the box of {what}") if st.turned is not None else None
     tol = _tolerances(low, st.within, what)
     pointing = direction(low, st.pointing, f"approach of {what}")
     ok = st.pointing is None or pointing is not None
