@@ -130,31 +130,64 @@ def bench_base(tops: tuple[int, ...] = (1,)) -> dict:
     return out
 
 
+def bench_task_cells() -> dict:
+    """The issue's task goals (bench_task's visit and region cells: the static search, the exact
+    check, the planning and timing of every surviving design) with their base as written and on
+    the same 25-pose grid: CPU s each (and the static search's share apart), and the ratios. One
+    run each side (seconds each, so load moves the ratio less than the static cell's)."""
+    from bench_task import GOALS, bench_goal
+
+    out = {}
+    for name in ("visit", "region"):
+        text, goal = GOALS[name]
+        grid = text.replace("    units 2 to 3\n", "    units 2 to 3\n" + GRID)
+        assert grid != text
+        one, many = bench_goal(text, goal), bench_goal(grid, goal)
+        out[name] = {"one_pose": one, "poses_25": many,
+                     "ratio_cpu": round(many["seconds_cpu"] / max(one["seconds_cpu"], 1e-9), 2),
+                     "ratio_static_search_cpu": round(many["static_search_cpu_s"]
+                                                      / max(one["static_search_cpu_s"], 1e-9), 2)}
+    return out
+
+
+def _lines(res: dict, tasks: dict) -> list[str]:
+    lines = [f"  compiled IK: {res.pop('compiled_ik')}; load average {res.pop('load_average')}"]
+    for k, v in res.items():
+        a, b = v["one_pose"], v["poses_25"]
+        lines.append(f"  static cell {k}: 1 pose {a['seconds_cpu']:.1f} s ({a['best']}); 25 poses "
+                     f"{b['seconds_cpu']:.1f} s ({b['bases_searched']} searched, {b['bases_pruned']} pruned; best "
+                     f"{b['best']} at {b['best_base_m']}); ratio {v['ratio_cpu']:.2f}")
+    for k, v in tasks.items():
+        a, b = v["one_pose"], v["poses_25"]
+        lines.append(f"  task cell {k}: 1 pose {a['seconds_cpu']:.1f} s (search {a['static_search_cpu_s']:.1f} s, "
+                     f"{a['best']}, {a['cycle_time_s']} s); 25 poses {b['seconds_cpu']:.1f} s (search "
+                     f"{b['static_search_cpu_s']:.1f} s, {b['best']}, {b['cycle_time_s']} s); ratio "
+                     f"{v['ratio_cpu']:.2f} (search alone {v['ratio_static_search_cpu']:.2f})")
+    return lines
+
+
 def main() -> None:
     from _common import pin_one_core
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--json", nargs="?", const="-", default=None)
     ap.add_argument("--top", type=int, nargs="+", default=[1], help="--top values to measure (5: minutes)")
+    ap.add_argument("--static-only", action="store_true", help="only the static three-target cell (seconds)")
     args = ap.parse_args()
     core = pin_one_core()
     res = bench_base(tuple(args.top))
+    tasks = {} if args.static_only else bench_task_cells()
     if args.json is not None:
         import json
 
-        text = json.dumps({"core": core, "base_placement": res}, indent=2)
+        text = json.dumps({"core": core, "base_placement": res, "task_cells": tasks}, indent=2)
         if args.json == "-":
             print(text)
         else:
             Path(args.json).write_text(text + "\n", encoding="utf-8")
         return
     print(f"base placement, one core ({core}): CPU s, 1 pose vs 25 poses (goal: ratio <= 5)")
-    print(f"  compiled IK: {res.pop('compiled_ik')}; load average {res.pop('load_average')}")
-    for k, v in res.items():
-        a, b = v["one_pose"], v["poses_25"]
-        print(f"  {k}: 1 pose {a['seconds_cpu']:.1f} s ({a['best']}); 25 poses {b['seconds_cpu']:.1f} s "
-              f"({b['bases_searched']} searched, {b['bases_pruned']} pruned; best {b['best']} at {b['best_base_m']}); "
-              f"ratio {v['ratio_cpu']:.2f}")
+    print("\n".join(_lines(res, tasks)))
 
 
 if __name__ == "__main__":

@@ -134,3 +134,17 @@ def test_the_designs_kept_have_the_alternatives_their_own_pose_checks():
 def test_the_best_designs_of_two_poses_merge_as_each_pose_alone():
     designs = _same_as_brute_force(TWO, 2)
     assert len({d.verified.robot.base.xyz for d in designs}) == 2
+
+
+def test_the_grid_search_shows_progress_within_a_group_of_shapes():
+    """A group of shapes of equal least mass is searched at every pose before its results come
+    in (minutes in a large cell): the display's count of settings moves while it runs, not only
+    when the group is done, and it ends at the outcome's count."""
+    from modc.design import run
+
+    seen: list = []
+    out = run.design(_problem(THREE), top=1, seed=0, progress=lambda st, force=False: seen.append(st))
+    during = [st.screened for st in seen if st.shapes_done == 0]
+    assert during and max(during) > 0  # before the first group of shapes came back
+    counts = [st.screened for st in seen]
+    assert counts == sorted(counts) and counts[-1] == out.evaluated

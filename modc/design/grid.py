@@ -166,11 +166,22 @@ def _work(specs: list[Spec], s: _Shape, lo: int, hi: int) -> list[tuple[int, tup
 
 
 def _run(specs: list[Spec], work: list[tuple[int, tuple]], seed: int, deadline: float | None,
-         executor: Executor | None) -> list[tuple[int, Part]]:
+         executor: Executor | None, seen: Callable[[int], None] = lambda k: None) -> list[tuple[int, Part]]:
+    """Every unit of work, in order; seen(k) with each Part's settings screened or excluded as
+    it comes back (the progress display: a round over every pose takes minutes in a large cell)."""
+    out: list[tuple[int, Part]] = []
     if executor is None:
-        return [(i, p) for i, w in work for p in search_chunk(specs[i], [w], seed, deadline)]
+        for i, w in work:
+            for p in search_chunk(specs[i], [w], seed, deadline):
+                out.append((i, p))
+                seen(p.screened + p.excluded)
+        return out
     futures = [(i, executor.submit(search_chunk, specs[i], [w], seed, deadline)) for i, w in work]
-    return [(i, p) for i, f in futures for p in f.result()]
+    for i, f in futures:
+        for p in f.result():
+            out.append((i, p))
+            seen(p.screened + p.excluded)
+    return out
 
 
 def walled(spec: Spec, longest: float) -> bool:
@@ -222,19 +233,21 @@ def _level_done(s: _Shape, c: int) -> None:
 
 def search_shapes(specs: list[Spec], shapes: list[space.Shape], seed: int, deadline: float | None,
                   executor: Executor | None, stopping: Callable[[], str | None],
-                  skip: frozenset[int] = frozenset()) -> list[ShapeResult]:
+                  skip: frozenset[int] = frozenset(),
+                  seen: Callable[[int], None] = lambda k: None) -> list[ShapeResult]:
     """The shapes searched over every pose but those in skip, a level at a time (see the
-    module's docstring)."""
+    module's docstring). seen(k): k more settings screened or excluded (progress)."""
     open_: list[_Shape] = []
     for shape in shapes:  # the family bounds of a shape at every pose take seconds: the budget between them
         if stopping():
             break
         open_.append(_opened(specs, shape, skip))
+        seen(open_[-1].excluded)
     todo = [s for s in open_ if s.live]
     while todo and not stopping():
         upto = {id(s): _next(s) for s in todo}
         work = [(s, w) for s in todo for w in _work(specs, s, s.level + 1, upto[id(s)])]
-        parts = _run(specs, [w for _, w in work], seed, deadline, executor)
+        parts = _run(specs, [w for _, w in work], seed, deadline, executor, seen)
         for (s, _), (i, p) in zip(work, parts, strict=True):
             s.parts.append(p)
             s.found += [Placed(f.pivots, f.ports, f.solutions, f.worst, i) for f in p.found]
@@ -319,6 +332,7 @@ class _Grid:
         self.results: list[ShapeResult] = []
         self.skip = frozenset(i for i, spec in enumerate(self.specs)
                               if walled(spec, longest_reach(problem, self.hi)))
+        self.running = 0  # settings screened or excluded in the group of shapes under way
         self.every = [s.label() for n in range(max(problem.min_units, lib.rules.min_dof), self.hi + 1)
                       if space.variant_splits(problem, n) for s in space.shapes(problem, n)]
 
@@ -330,11 +344,15 @@ class _Grid:
         tally, out = self.tally, self.out
         best = distinct(tally.accepted, self.problem.rank)[0].chain() if tally.accepted else ""
         eta = (None if out.stopped else 0.0) if final else None
-        st = Status(len(self.results), len(self.every), out.evaluated, out.screened, best, eta)
+        st = Status(len(self.results), len(self.every), out.evaluated + self.running, out.screened, best, eta)
         if force:
             self.progress(st, True)
         else:
             self.progress(st)
+
+    def _seen(self, k: int) -> None:
+        self.running += k
+        self.report()
 
     def tier(self, n: int, splits, want: int) -> bool:
         """The shapes of n units, a group of equal least mass at a time: True when the search
@@ -345,7 +363,8 @@ class _Grid:
         groups = _mass_groups(self.problem, space.shapes(self.problem, n), splits)
         for g, (_, shapes) in enumerate(groups):
             res = search_shapes(self.specs, shapes, self.seed, self.deadline, self.executor,
-                                lambda: _stopping(self.deadline), self.skip)
+                                lambda: _stopping(self.deadline), self.skip, self._seen)
+            self.running = 0  # the group's results count them now
             for r in res:
                 self.results.append(r)
                 out.shapes += 1
