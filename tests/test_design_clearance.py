@@ -77,6 +77,43 @@ def test_escape_leads_out_of_the_deepest_obstacle():
     assert escape(obs, frames, radii)[1][0] == np.inf
 
 
+def _escape_everywhere(obs, frames, radii, m=14):
+    """escape's reference: every segment sampled against every obstacle, the first least value."""
+    R = frames.shape[0]
+    a, b = frames[:, :, :3, :], frames[:, :, 1:, :]
+    ts = np.linspace(0.0, 1.0, m)
+    pts = a[..., None, :] + (b - a)[..., None, :] * ts[:, None]
+    d = obs.distance(pts.reshape(-1, 3)).reshape(*pts.shape[:-1], -1) - radii[None, None, :, None, None]
+    d[:, 0, 0] = np.inf
+    flat = d.reshape(R, -1)
+    best = flat.argmin(1)
+    K = d.shape[-1]
+    where = pts.reshape(R, -1, 3)[np.arange(R), best // K]
+    depth = np.where((d[:, 0, 1] < -1e-3).any((-1, -2)), np.inf, -flat[np.arange(R), best])
+    return obs.gradient(best % K, where), depth
+
+
+def test_escape_samples_only_the_segments_that_may_collide_and_finds_the_same_deepest_point():
+    # random 3-unit polylines through a cell of boxes, a sphere and a cylinder: of the poses that
+    # collide, escape names the same deepest sample as every segment sampled against every obstacle
+    rng = np.random.default_rng(3)
+    obs = Obstacles.of([_box((0.3, 0.0, 0.2), (0.1, 0.3, 0.05)), _box((0.0, 0.35, 0.3), (0.6, 0.02, 0.6)),
+                        Obstacle(name="ball", shape="sphere", size=(0.05, 0.0, 0.0),
+                                 origin=Transform(xyz=(0.2, -0.2, 0.4), rpy=(0.0, 0.0, 0.0))),
+                        Obstacle(name="post", shape="cylinder", size=(0.02, 0.5, 0.0),
+                                 origin=Transform(xyz=(0.15, 0.15, 0.25), rpy=(0.3, 0.0, 0.0)))])
+    steps = rng.normal(scale=0.08, size=(600, 3 * 4 - 1, 3))
+    pts = np.concatenate([np.zeros((600, 1, 3)), np.cumsum(steps, axis=1)], axis=1)
+    frames = np.stack([pts[:, 0:4], pts[:, 3:7], pts[:, 6:10]], axis=1)  # unit end = next unit's base
+    radii = np.array([0.03, 0.03, 0.02])
+    hit = collides(obs, frames, radii)
+    assert 50 < hit.sum() < 600
+    got, want = escape(obs, frames[hit], radii), _escape_everywhere(obs, frames[hit], radii)
+    np.testing.assert_array_equal(got[1], want[1])
+    np.testing.assert_array_equal(got[0], want[0])
+    assert np.isinf(want[1]).any() and np.isfinite(want[1]).any()
+
+
 # --- the retry in the screen ----------------------------------------------------------------------
 
 SETTING = (np.array([[0.0, 30 * DEG, 30 * DEG]]), np.array([[0.0, 45 * DEG, 0.0]]))  # H2 - H4(30°, 45°) - L1(30°)

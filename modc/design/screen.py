@@ -152,17 +152,36 @@ def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray,
     way moves the part of the arm near it the same way: the screen's retry inside a target's
     tolerance (modc.design.evaluate.clear_within) aims there. The depth is inf where the first
     unit's actuator (twist1 -> joint 1, on joint 1's axis: no joint moves it) collides: no joint
-    vector clears that pose."""
+    vector clears that pose.
+
+    Only the segments collides would sample are: a pose collides, so some sample lies more than
+    1 mm in, and its segment's midpoint bound says so; the deepest sample lies at least as deep.
+    The first of the least values in (unit, segment, sample, obstacle) order is the deepest."""
     R, n = frames.shape[:2]
     a, b = frames[:, :, :3, :], frames[:, :, 1:, :]  # (R, n, 3, 3)
+    mid, half = (a + b) / 2, np.linalg.norm(b - a, axis=-1) / 2
+    near = obstacles.nearest(mid.reshape(-1, 3)).reshape(R, n, 3) - half - radii < -1e-3
+    near[:, 0, 0] = False
+    r_i, n_i, s_i = np.nonzero(near)  # pose by pose, in (unit, segment) order
+    way, depth = np.tile([0.0, 0.0, 1.0], (R, 1)), np.zeros(R)
+    if not r_i.size:
+        return way, depth
     m = int(np.ceil(0.25 / step)) + 1
     ts = np.linspace(0.0, 1.0, m)
-    pts = a[..., None, :] + (b - a)[..., None, :] * ts[:, None]  # (R, n, 3, m, 3)
-    d = obstacles.distance(pts.reshape(-1, 3)).reshape(R, n, 3, m, -1) - radii[None, None, :, None, None]
-    d[:, 0, 0] = np.inf
-    flat = d.reshape(R, -1)
-    best = flat.argmin(1)
-    K = d.shape[-1]
-    where = pts.reshape(R, -1, 3)[np.arange(R), best // K]
-    depth = np.where((d[:, 0, 1] < -1e-3).any((-1, -2)), np.inf, -flat[np.arange(R), best])
-    return obstacles.gradient(best % K, where), depth
+    aa = a[r_i, n_i, s_i]
+    pts = aa[:, None, :] + (b[r_i, n_i, s_i] - aa)[:, None, :] * ts[:, None]  # (M, m, 3)
+    K = len(obstacles.shape)
+    d = obstacles.distance(pts.reshape(-1, 3)).reshape(len(r_i), m * K) - radii[s_i][:, None]
+    first = d.argmin(1)
+    low = d[np.arange(len(r_i)), first]
+    starts = np.flatnonzero(np.r_[True, r_i[1:] != r_i[:-1]])
+    poses = r_i[starts]
+    ends = np.r_[starts[1:], len(r_i)]
+    pick = np.array([s + int(np.argmin(low[s:e])) for s, e in zip(starts, ends, strict=True)])
+    where = pts[pick, first[pick] // K]
+    way[poses] = obstacles.gradient(first[pick] % K, where)
+    stuck = np.zeros(R, bool)
+    act = (n_i == 0) & (s_i == 1)
+    np.logical_or.at(stuck, r_i[act], (d[act] < -1e-3).any(1))
+    depth[poses] = np.where(stuck[poses], np.inf, -low[pick])
+    return way, depth
