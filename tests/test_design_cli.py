@@ -172,3 +172,25 @@ def test_plain_progress_repeats_itself_when_nothing_new_comes(monkeypatch, capsy
         say(Status(4, 4, 40, 1, "H1 - L3", None, "planning and timing design 1 of 2"), True)
     err = capsys.readouterr().err
     assert "planning and timing design 1 of 2 (H1 - L3)" in err
+
+
+def test_plain_progress_says_a_new_status_as_it_is_not_as_still_at_it(monkeypatch, capsys):
+    """Statuses that change faster than a line is printed (a search counting its settings): the
+    next line gives the latest one as it is; "still at it" is for a status that did not change."""
+    import time
+
+    from modc.cli import design_progress
+    from modc.design.run import Status
+
+    monkeypatch.setattr(design_progress, "PLAIN_EVERY", 0.2)
+    with design_progress.progress("plain", "cell") as say:
+        assert say is not None
+        say(Status(0, 4, 10, 0, "", None), True)
+        say(Status(0, 4, 20, 0, "", None))  # within PLAIN_EVERY: not printed now
+        deadline = time.monotonic() + 30
+        err = ""
+        while "20 settings" not in err and time.monotonic() < deadline:
+            time.sleep(0.05)
+            err += capsys.readouterr().err
+    line = next(x for x in err.splitlines() if "20 settings" in x)
+    assert "still at it" not in line

@@ -213,3 +213,37 @@ def test_coverage_with_a_base_grid_searches_for_arms_that_serve_the_region():
     robot = d.verified.robot
     served = [v for v in next(t for t in robot.tasks if t.name == "serve").visits if v.startswith("far[")]
     assert len(served) == round(d.coverage * 4) and o.bases_searched > 1
+
+
+# every point of the tray lies 3 m out: beyond the reach of any arm of 2 to 3 units
+FAR = """design far {
+    target a at (0.30, 0.10, 0.25) m
+    region tray box size (0.10, 0.10, 0) m at (3.0, 0, 0.2) m grid 2 x 2 x 1
+    task serve { visit a, tray }
+    units 2 to 3
+    rank coverage, cycle_time
+}
+"""
+
+
+def test_a_region_beyond_every_arm_is_told_at_once():
+    """`rank coverage` when no point of any region is within reach of the longest arm: no design,
+    said of the region (not of the first arm planned in vain), before any search."""
+    from modc.design import run
+
+    out = run.design(problem(FAR), top=1, seed=0)
+    assert not out.designs and out.evaluated == 0 and set(out.regions_beyond) == {"tray"}
+    assert 1.0 < out.regions_beyond["tray"] < 3.0
+    why = out.why_none()
+    assert "every point of region 'tray' lies beyond the reach of the longest arm" in why and "m at least" in why
+
+
+def test_a_region_is_beyond_only_when_no_base_pose_brings_it_in_reach():
+    from modc.design import run
+
+    near = FAR.replace("at (3.0, 0, 0.2) m", "at (1.2, 0, 0.2) m")
+    assert set(run.regions_beyond(problem(near), 3)) == {"tray"}
+    moved = near.replace("    units 2 to 3\n", "    units 2 to 3\n"
+                         "    base within box size (1.0, 0, 0) m at (0.5, 0, 0) m step 100 mm\n")
+    assert run.regions_beyond(problem(moved), 3) == {}  # from x = 1.0 m the tray is 0.2 m away
+    assert run.regions_beyond(problem(near.replace("rank coverage, cycle_time", "rank cycle_time")), 3) == {}

@@ -36,9 +36,9 @@ def _plain(name: str):
     lock = threading.Lock()
     last: dict[str, Any] = {"at": -1e9, "text": "", "since": time.monotonic()}
 
-    def say(text: str) -> None:
+    def say(text: str, status: str) -> None:
         print(f"modc design: {text}", file=sys.stderr, flush=True)
-        last["at"] = time.monotonic()
+        last["at"], last["said"] = time.monotonic(), status
 
     def plain(st, force: bool = False) -> None:
         with lock:
@@ -46,13 +46,16 @@ def _plain(name: str):
             if text != last["text"]:
                 last["text"], last["since"] = text, time.monotonic()
             if force or time.monotonic() - last["at"] >= PLAIN_EVERY:
-                say(text)
+                say(text, text)
 
     def heartbeat() -> None:
+        # the status as it is now; "still at it" only when it has not changed since the last line
         with lock:
             now = time.monotonic()
-            if last["text"] and now - last["at"] >= PLAIN_EVERY:
-                say(f"{last['text']} (still at it, {_duration(now - last['since'])})")
+            text = last["text"]
+            if text and now - last["at"] >= PLAIN_EVERY:
+                say(text if text != last.get("said") else f"{text} (still at it, {_duration(now - last['since'])})",
+                    text)
 
     with ticking(min(1.0, PLAIN_EVERY / 4), heartbeat, "modc-design-progress"):
         yield plain

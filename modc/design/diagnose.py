@@ -190,6 +190,10 @@ def why_none(o) -> str:
                 f"{counted(len(o.not_planned), 'design')} reaching every target it found (first: "
                 f"{o.not_planned[0]}); give it more time (--time-budget)")
     head = f"the search stopped ({o.stopped}) before finding one; " if o.stopped else ""
+    if o.regions_beyond:
+        told = "; ".join(f"every point of region '{k}' lies beyond the reach of the longest arm in the bounds "
+                         f"(by {_length(d)} at least)" for k, d in o.regions_beyond.items())
+        return head + told + ", and `rank coverage` needs a design to serve some point of the cell's regions"
     if o.bases_searched == 0 and o.bases_touching:
         return head + (f"of the {o.bases_total} base poses, {o.bases_touching} put base_link into the cell and "
                        f"{o.bases_pruned} leave some target beyond the reach of the longest arm in the bounds")

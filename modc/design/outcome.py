@@ -48,6 +48,8 @@ class Outcome:
     bases_total: int = 0  # base poses of the grid
     bases_touching: int = 0  # base poses where base_link sinks into the cell
     bases_kept: list | None = None  # the base poses searched, nearest first (None: the base as written)
+    # `rank coverage`: regions no point of which any arm in the bounds reaches -> m beyond the longest reach
+    regions_beyond: dict[str, float] = field(default_factory=dict)
 
     def why_none(self) -> str:
         return why_none(self)

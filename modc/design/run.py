@@ -34,6 +34,14 @@ def design(problem: ResolvedProblem, *, max_units: int | None = None, top: int =
                              f"'{problem.name}' asks for at least")
         problem = problem.model_copy(update={"max_units": max_units})
     tasked = tasks.has_tasks(problem) or "coverage" in problem.rank
+    beyond = regions_beyond(problem, min(max_units or problem.max_units, problem.cell.library.rules.max_dof))
+    if beyond and len(beyond) == len(problem.cell.regions):
+        # `rank coverage` and no point of any region in reach: no arm serves a point, whichever it
+        # is (the search and the planning of every candidate would only find that out)
+        out = Outcome(problem, [], regions_beyond=beyond)
+        out.reference = reference.evaluate(problem, seed, deadline, None)
+        out.seconds = time.perf_counter() - t0
+        return out
     screen, points = tasks.with_points(problem)  # every region point required: screened as a target
     screen = _static_screen(screen, problem) if tasked else screen
     n = tasks.candidates(problem, top) if tasked else top
@@ -131,6 +139,28 @@ def _static_screen(screen: ResolvedProblem, problem: ResolvedProblem) -> Resolve
     by the planning, not by a static tie-break)."""
     return screen.model_copy(update={"rank": tuple(k for k in static(problem.rank) if k != "margin")
                                      or ("modules", "mass")})
+
+
+def regions_beyond(problem: ResolvedProblem, hi: int) -> dict[str, float]:
+    """`rank coverage` with regions: per region whose every point lies beyond the reach bound of the
+    longest arm of at most hi units (screen.reach_bound, from base_link's origin) from every base
+    pose, how far its nearest point lies beyond it (m). Sound: no design reaches such a point."""
+    if not _optional_points(problem):
+        return {}
+    import numpy as np
+
+    longest = longest_reach(problem, hi)
+    grid = problem.base_grid
+    bases = np.array([(0.0, 0.0, 0.0)] if grid is None else grid.positions(), float).reshape(-1, 3)
+    out = {}
+    for r in problem.cell.regions:
+        pts = r.points()
+        xyz = np.array([p.xyz for p in pts], float)
+        tol = np.array([p.position_tolerance for p in pts], float)
+        gap = (np.linalg.norm(xyz[:, None] - bases[None], axis=-1).min(1) - tol - longest).min()
+        if gap > 0:
+            out[r.name] = float(gap)
+    return out
 
 
 def _optional_points(problem: ResolvedProblem) -> bool:
