@@ -154,15 +154,18 @@ def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray,
     unit's actuator (twist1 -> joint 1, on joint 1's axis: no joint moves it) collides: no joint
     vector clears that pose.
 
-    Only the segments collides would sample are: a pose collides, so some sample lies more than
-    1 mm in, and its segment's midpoint bound says so; the deepest sample lies at least as deep.
-    The first of the least values in (unit, segment, sample, obstacle) order is the deepest."""
+    Only the segments collides would sample are, and each only against the obstacles it may go
+    into: a pose collides, so some sample lies more than 1 mm inside some obstacle, and that
+    (segment, obstacle) pair's midpoint bound says so (a signed distance changes no faster than
+    the distance); the deepest sample lies at least as deep, so in such a pair too. The first of
+    the least values in (unit, segment, sample, obstacle) order is the deepest."""
     R, n = frames.shape[:2]
     a, b = frames[:, :, :3, :], frames[:, :, 1:, :]  # (R, n, 3, 3)
     mid, half = (a + b) / 2, np.linalg.norm(b - a, axis=-1) / 2
-    near = obstacles.nearest(mid.reshape(-1, 3)).reshape(R, n, 3) - half - radii < -1e-3
-    near[:, 0, 0] = False
-    r_i, n_i, s_i = np.nonzero(near)  # pose by pose, in (unit, segment) order
+    K = len(obstacles.shape)
+    pair = obstacles.distance(mid.reshape(-1, 3)).reshape(R, n, 3, K) - (half + radii)[..., None] < -1e-3
+    pair[:, 0, 0] = False
+    r_i, n_i, s_i = np.nonzero(pair.any(-1))  # pose by pose, in (unit, segment) order
     way, depth = np.tile([0.0, 0.0, 1.0], (R, 1)), np.zeros(R)
     if not r_i.size:
         return way, depth
@@ -170,14 +173,23 @@ def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray,
     ts = np.linspace(0.0, 1.0, m)
     aa = a[r_i, n_i, s_i]
     pts = aa[:, None, :] + (b[r_i, n_i, s_i] - aa)[:, None, :] * ts[:, None]  # (M, m, 3)
-    K = len(obstacles.shape)
-    d = obstacles.distance(pts.reshape(-1, 3)).reshape(len(r_i), m * K) - radii[s_i][:, None]
+    rad = radii[s_i]
+    d = np.full((len(r_i), m, K), np.inf)
+    live = pair[r_i, n_i, s_i]  # (M, K)
+    for k in range(K):
+        rows = np.flatnonzero(live[:, k])
+        if rows.size:
+            d[rows, :, k] = (obstacles._one(k, int(obstacles.shape[k]), pts[rows].reshape(-1, 3)).reshape(-1, m)
+                             - rad[rows][:, None])
+    d = d.reshape(len(r_i), m * K)
     first = d.argmin(1)
     low = d[np.arange(len(r_i)), first]
     starts = np.flatnonzero(np.r_[True, r_i[1:] != r_i[:-1]])
     poses = r_i[starts]
-    ends = np.r_[starts[1:], len(r_i)]
-    pick = np.array([s + int(np.argmin(low[s:e])) for s, e in zip(starts, ends, strict=True)])
+    # per pose the first segment holding its least value
+    least = np.repeat(np.minimum.reduceat(low, starts), np.diff(np.r_[starts, len(r_i)]))
+    at = np.flatnonzero(low == least)
+    pick = at[np.unique(r_i[at], return_index=True)[1]]
     where = pts[pick, first[pick] // K]
     way[poses] = obstacles.gradient(first[pick] % K, where)
     stuck = np.zeros(R, bool)
