@@ -163,9 +163,9 @@ def _numpy(P, rt, ht, tol, n, order) -> np.ndarray:
 def reachable(f: Frames, xyz: np.ndarray, tol: np.ndarray, compiled: bool | None = None) -> np.ndarray:
     """(C,) False where no joint vector (limits or not) brings tool0 within tol (T,) of some
     target xyz (T, 3) for a setting of f (2 or 3 joints, no tail; other chains: all True).
-    compiled: the numba kernel (True), the numpy walk (False), or the kernel when modc.design.reach
-    has loaded numba already (None: a short search never pays numba's import for it). The
-    same answer either way."""
+    compiled: the numba kernel (True), the numpy walk (False), or the kernel
+    once reach.jit says so (None: a short search never pays numba's import for it; MODC_JIT=0:
+    never). The same answer either way."""
     C, k = f.t.shape[:2]
     if k not in (3, 4) or C == 0 or len(xyz) == 0:
         return np.ones(C, bool)
@@ -178,7 +178,9 @@ def reachable(f: Frames, xyz: np.ndarray, tol: np.ndarray, compiled: bool | None
     if compiled is None:
         from . import reach
 
-        compiled = bool(reach._JIT and reach._JIT[0])
+        # a (setting, target) pair through the numpy walk costs about one numpy IK run: the pairs
+        # count towards reach.JIT_AFTER, so a long search loads numba for both, a short one never
+        compiled = reach.jit(C * len(xyz))
     if compiled:
         from . import bounds_exact_jit
 
