@@ -49,18 +49,20 @@ MARGIN = 5e-4  # m: a box whose bound is finer than this is not split further (t
 SLACK = 1e-9  # m: rounding never excludes a target at the edge of its tolerance
 GRID = 4  # initial boxes per angle
 LEVELS = 24  # splits per angle at most (pi / 4 / 2^24: far below MARGIN for any real arm)
+STEPS = 6  # Gauss-Newton steps of the witness search (newton)
 
 
 def tables() -> np.ndarray:
-    """(5, LEVELS + 1): per level k, S(delta_k) (chord factor), cos and sin of delta_k (the
-    offset of a level-k box's centre from its parent's), and the initial centres' cos and sin
-    (GRID of them, the rest zero); delta_0 = pi / GRID."""
+    """(6, LEVELS + 1): per level k, S(delta_k) (chord factor), cos and sin of delta_k (the
+    offset of a level-k box's centre from its parent's), the initial centres' cos and sin (GRID
+    of them, the rest zero), delta_k; delta_0 = pi / GRID."""
     half = (np.pi / GRID) / 2.0 ** np.arange(LEVELS + 1)
     centres = -np.pi + (2 * np.arange(GRID) + 1) * (np.pi / GRID)
-    out = np.zeros((5, LEVELS + 1))
+    out = np.zeros((6, LEVELS + 1))
     out[0] = 2.0 * np.sin(half / 2.0)
     out[1], out[2] = np.cos(half), np.sin(half)
     out[3, :GRID], out[4, :GRID] = np.cos(centres), np.sin(centres)
+    out[5] = half
     return out
 
 
@@ -89,20 +91,87 @@ def circles(f: Frames, xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.sqrt(y[..., 0] * y[..., 0] + y[..., 1] * y[..., 1]), y[..., 2]
 
 
-def evaluate(P, rt, ht, c2, s2, c3, s3):
-    """d at a box's centre and r_2 = |w(c_3)_xy| (arrays or scalars: the kernel writes the same
-    operations in the same order)."""
-    wx = P[..., 12] + P[..., 15] * c3 + P[..., 18] * s3
-    wy = P[..., 13] + P[..., 16] * c3 + P[..., 19] * s3
-    wz = P[..., 14] + P[..., 17] * c3 + P[..., 20] * s3
+def box(p, rt, ht, c2, s2, c3, s3, S2, S3, h2, h3):
+    """A box's centre and bounds, for arrays (p = P[rows].T, (22, K)) or one pair (p = P[c], the
+    kernel: the same operations in the same order, no branch). Returns d at the centre, the terms
+    of B (r_2 S(delta_2), r_3 S(delta_3)), and the lower bound of d over the box: the larger of
+    d - B and the second-order bound (docstring)."""
+    wx = p[12] + p[15] * c3 + p[18] * s3
+    wy = p[13] + p[16] * c3 + p[19] * s3
+    wz = p[14] + p[17] * c3 + p[20] * s3
+    gx = p[18] * c3 - p[15] * s3  # dw / dtheta_3
+    gy = p[19] * c3 - p[16] * s3
+    gz = p[20] * c3 - p[17] * s3
     ux = c2 * wx - s2 * wy
     uy = s2 * wx + c2 * wy
-    vx = P[..., 0] + P[..., 3] * ux + P[..., 4] * uy + P[..., 5] * wz
-    vy = P[..., 1] + P[..., 6] * ux + P[..., 7] * uy + P[..., 8] * wz
-    vz = P[..., 2] + P[..., 9] * ux + P[..., 10] * uy + P[..., 11] * wz
-    dr = np.sqrt(vx * vx + vy * vy) - rt
+    vx = p[0] + p[3] * ux + p[4] * uy + p[5] * wz
+    vy = p[1] + p[6] * ux + p[7] * uy + p[8] * wz
+    vz = p[2] + p[9] * ux + p[10] * uy + p[11] * wz
+    ax = p[4] * ux - p[3] * uy  # dv / dtheta_2 = R(K_1) (e_z x u)
+    ay = p[7] * ux - p[6] * uy
+    az = p[10] * ux - p[9] * uy
+    hx = c2 * gx - s2 * gy
+    hy = s2 * gx + c2 * gy
+    bx = p[3] * hx + p[4] * hy + p[5] * gz  # dv / dtheta_3 = R(K_1) Rz(theta_2) dw / dtheta_3
+    by = p[6] * hx + p[7] * hy + p[8] * gz
+    bz = p[9] * hx + p[10] * hy + p[11] * gz
+    rho = np.sqrt(vx * vx + vy * vy)
+    dr = rho - rt
     dh = vz - ht
-    return np.sqrt(dr * dr + dh * dh), np.sqrt(wx * wx + wy * wy)
+    d = np.sqrt(dr * dr + dh * dh)
+    r2 = np.sqrt(wx * wx + wy * wy)
+    r3 = p[21]
+    e2 = r2 * S2
+    e3 = r3 * S3
+    bound = e2 + e3
+    # the linear part DF (c) Delta of (rho, h) moves it along q = (rho_t, h_t) - (rho, h) by at most
+    # |q . a'| + |q . b'| over |q| (a', b' = DF's columns times delta_2, delta_3; |(vx a_x + vy a_y)
+    # / rho| <= |a|: finite)
+    inv = 1.0 / (rho + 1e-300)
+    fa, ga = (vx * ax + vy * ay) * inv * h2, az * h2
+    fb, gb = (vx * bx + vy * by) * inv * h3, bz * h3
+    near = d - (np.abs(dr * fa + dh * ga) + np.abs(dr * fb + dh * gb)) / (d + 1e-300)
+    r2m = r2 + e3
+    lin = r2m * h2 + r3 * h3
+    quad = r2m * h2 * h2 + 2.0 * r3 * h2 * h3 + r3 * h3 * h3
+    rmin = np.maximum(rho - bound, 1e-300)
+    low = np.maximum(d - bound, near - 0.5 * (quad + lin * lin / rmin))
+    return d, e2, e3, low
+
+
+def newton(p, rt, ht, c2, s2, c3, s3):
+    """One damped Gauss-Newton step on (rho, h) = (rho_t, h_t) from the angles whose cos and sin
+    are (c2, s2), (c3, s3) (arrays or one pair, as box): d there, and the next angles' cos and
+    sin. A witness search: d <= tol at any (c, s) of unit length (each step turns them and
+    normalises them, without trig) is a joint vector serving the pair - and the pair's tree
+    says possible too (a box holding it has a lower bound <= its d): the answer is the same with
+    or without it; it spares the walk down to a reachable box."""
+    wx = p[12] + p[15] * c3 + p[18] * s3
+    wy = p[13] + p[16] * c3 + p[19] * s3
+    wz = p[14] + p[17] * c3 + p[20] * s3
+    gx, gy, gz = p[18] * c3 - p[15] * s3, p[19] * c3 - p[16] * s3, p[20] * c3 - p[17] * s3
+    ux, uy = c2 * wx - s2 * wy, s2 * wx + c2 * wy
+    hx, hy = c2 * gx - s2 * gy, s2 * gx + c2 * gy
+    vx = p[0] + p[3] * ux + p[4] * uy + p[5] * wz
+    vy = p[1] + p[6] * ux + p[7] * uy + p[8] * wz
+    vz = p[2] + p[9] * ux + p[10] * uy + p[11] * wz
+    rho = np.sqrt(vx * vx + vy * vy)
+    dr, dh = rho - rt, vz - ht
+    inv = 1.0 / (rho + 1e-300)
+    j00 = (vx * (p[4] * ux - p[3] * uy) + vy * (p[7] * ux - p[6] * uy)) * inv
+    j01 = (vx * (p[3] * hx + p[4] * hy + p[5] * gz) + vy * (p[6] * hx + p[7] * hy + p[8] * gz)) * inv
+    j10, j11 = p[10] * ux - p[9] * uy, p[9] * hx + p[10] * hy + p[11] * gz
+    m00, m01, m11 = j00 * j00 + j10 * j10 + 1e-6, j00 * j01 + j10 * j11, j01 * j01 + j11 * j11 + 1e-6
+    g0, g1 = j00 * dr + j10 * dh, j01 * dr + j11 * dh
+    det = m00 * m11 - m01 * m01
+    d2, d3 = (m01 * g1 - m11 * g0) / det, (m01 * g0 - m00 * g1) / det
+    scale = 0.5 / np.maximum(np.maximum(np.abs(d2), np.abs(d3)), 0.5)  # at most 0.5 rad a step
+    d2, d3 = d2 * scale, d3 * scale
+    a2, a3 = 1.0 - 0.5 * d2 * d2, 1.0 - 0.5 * d3 * d3  # about cos and sin of the step
+    n2, m2 = c2 * a2 - s2 * d2, s2 * a2 + c2 * d2
+    n3, m3 = c3 * a3 - s3 * d3, s3 * a3 + c3 * d3
+    k2, k3 = 1.0 / np.sqrt(n2 * n2 + m2 * m2), 1.0 / np.sqrt(n3 * n3 + m3 * m3)
+    return np.sqrt(dr * dr + dh * dh), n2 * k2, m2 * k2, n3 * k3, m3 * k3
 
 
 def _start(n: int, tab: np.ndarray) -> np.ndarray:
@@ -120,30 +189,38 @@ def _pairs_numpy(P: np.ndarray, rt: np.ndarray, ht: np.ndarray, tol: np.ndarray,
     K = len(P)
     start = _start(n, tab)
     pair = np.repeat(np.arange(K), len(start))
-    box = np.tile(start, (K, 1))
+    boxes = np.tile(start, (K, 1))
     k2 = np.zeros(len(pair), np.int64)
     k3 = np.zeros(len(pair), np.int64)
     out = np.zeros(K, bool)
     tolx = tol + SLACK
+    first = True
     while len(pair):
-        d, r2 = evaluate(P[pair], rt[pair], ht[pair], box[:, 0], box[:, 1], box[:, 2], box[:, 3])
-        e2, e3 = r2 * tab[0, k2], P[pair, 21] * tab[0, k3]
-        bound = e2 + e3
+        d, e2, e3, low = box(P[pair].T, rt[pair], ht[pair], boxes[:, 0], boxes[:, 1], boxes[:, 2], boxes[:, 3],
+                             tab[0, k2], tab[0, k3], tab[5, k2], tab[5, k3])
         t = tol[pair]
-        out[pair[(d <= t) | ((d - bound <= tolx[pair]) & ((bound < MARGIN) | (k2 == LEVELS) | (k3 == LEVELS)))]] = True
-        keep = ~out[pair] & (d - bound <= tolx[pair])
-        pair, box, k2, k3, e2, e3 = pair[keep], box[keep], k2[keep], k3[keep], e2[keep], e3[keep]
+        if first:  # a witness from the two nearest centres of the grid spares most walks
+            first = False
+            near = np.argsort(d.reshape(K, -1), axis=1, kind="stable")[:, :2] + np.arange(K)[:, None] * len(start)
+            for col in range(2):
+                c2, s2, c3, s3 = boxes[near[:, col]].T
+                for _ in range(STEPS + 1):
+                    dn, c2, s2, c3, s3 = newton(P.T, rt, ht, c2, s2, c3, s3)
+                    out |= dn <= tol
+        out[pair[(d <= t) | ((low <= tolx[pair]) & ((e2 + e3 < MARGIN) | (k2 == LEVELS) | (k3 == LEVELS)))]] = True
+        keep = ~out[pair] & (low <= tolx[pair])
+        pair, boxes, k2, k3, e2, e3 = pair[keep], boxes[keep], k2[keep], k3[keep], e2[keep], e3[keep]
         along3 = e3 > e2
         pair = np.repeat(pair, 2)
-        box = np.repeat(box, 2, axis=0)
+        boxes = np.repeat(boxes, 2, axis=0)
         k2, k3, along3 = np.repeat(k2, 2), np.repeat(k3, 2), np.repeat(along3, 2)
         sign = np.tile([1.0, -1.0], len(pair) // 2)
         lv = np.where(along3, k3, k2) + 1
         cd, sd = tab[1, lv], tab[2, lv] * sign
         i = np.where(along3, 2, 0)
         rows = np.arange(len(pair))
-        c, s = box[rows, i], box[rows, i + 1]
-        box[rows, i], box[rows, i + 1] = c * cd - s * sd, s * cd + c * sd
+        c, s = boxes[rows, i], boxes[rows, i + 1]
+        boxes[rows, i], boxes[rows, i + 1] = c * cd - s * sd, s * cd + c * sd
         k2, k3 = np.where(along3, k2, lv), np.where(along3, lv, k3)
     return out
 
