@@ -231,3 +231,24 @@ def test_the_exact_test_changes_no_ranking(monkeypatch, grid):
     off = run.design(p, top=1)
     assert _ranking(on) == _ranking(off)
     assert on.excluded > off.excluded
+
+
+def test_prune_tests_the_rest_of_a_block_only_when_its_sample_says_it_pays():
+    from modc.design import bounds_exact as be
+
+    rng = np.random.default_rng(60)
+    C = 400
+    types, piv, por, f = _settings(rng, 3, C)
+    x, p1, _ = _fk(types, piv, por, rng.uniform(-math.pi, math.pi, (C, 3)))
+    seen = set()
+    # a point out of most settings' reach; one most reach (a wide tolerance)
+    for xyz, tol in (((p1[0] + (x[0] - p1[0]) * 1.5)[None], np.array([0.003])), (x[3:4], np.array([0.3]))):
+        every = be.reachable(f, xyz, tol, compiled=False)
+        got = be.prune(f, xyz, tol, compiled=False)
+        sample = np.zeros(C, bool)
+        sample[::be.SAMPLE] = True
+        assert (got[sample] == every[sample]).all()
+        pays = (~every[sample]).mean() >= be.PAYS
+        seen.add(pays)
+        assert (got == every).all() if pays else got[~sample].all()
+    assert seen == {True, False}

@@ -295,7 +295,7 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         if ok.any():
             ok[ok] = bounds.possible(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p).all(-1)
         if EXACT and shape.n in (2, 3) and ok.any():  # most settings the interval bounds keep miss a target
-            ok[ok] = bounds_exact.reachable(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p)
+            ok[ok] = bounds_exact.prune(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p)
         excluded += int((~ok).sum())
         upto = end
         for tick in TICK:
