@@ -34,7 +34,8 @@ derivative of norm 1 and a second derivative of norm 1 / rho, and rho >= rho(c) 
 so |E| <= (Q + L^2 / (rho(c) - B)) / 2 with L = r_2m delta_2 + r_3 delta_3 (no bound when rho(c)
 <= B). And |F(c) + DF Delta - F_t| >= d(c) - (|q . a| + |q . b|) / d(c), q = F_t - F(c), a and b
 DF's columns times delta_2 and delta_3 (the support of the parallelogram DF Delta along q). The
-box's lower bound is the larger of d(c) - B and that minus |E|. A box is
+box's lower bound is the larger of d(c) - B and that minus |E| (d(c) - B alone for the initial
+grid's boxes, where |E| is of the arm's size). A box is
 
 - reachable when d(c) <= tol: the pair is possible;
 - excluded when its lower bound > tol + SLACK (SLACK covers rounding: 1e-9 m);
@@ -216,6 +217,7 @@ def _pairs_numpy(P: np.ndarray, rt: np.ndarray, ht: np.ndarray, tol: np.ndarray,
         t = tol[pair]
         if first:  # a witness from the two nearest centres of the grid spares most walks
             first = False
+            low = d - (e2 + e3)  # the grid's boxes (delta = pi / 4): first order only, as the kernel
             near = np.argsort(d.reshape(K, -1), axis=1, kind="stable")[:, :2] + np.arange(K)[:, None] * len(start)
             for col in range(2):
                 c2, s2, c3, s3 = boxes[near[:, col]].T
@@ -273,12 +275,18 @@ def reachable(f: Frames, xyz: np.ndarray, tol: np.ndarray, compiled: bool | None
         # a (setting, target) pair through the numpy walk costs about one numpy IK run: the pairs
         # count towards reach.JIT_AFTER, so a long search loads numba for both, a short one never
         compiled = reach.jit(C * len(xyz))
-    if compiled:
-        from . import bounds_exact_jit
+    if compiled and not _BROKEN:
+        try:
+            from . import bounds_exact_jit
 
-        if bounds_exact_jit.numba is not None:
-            return bounds_exact_jit.reachable(P, rt, ht, tol, n, order, tables())
+            if bounds_exact_jit.numba is not None:
+                return bounds_exact_jit.reachable(P, rt, ht, tol, n, order, tables())
+        except Exception:  # noqa: BLE001 - a numba that cannot compile the kernel: the numpy walk, same answer
+            _BROKEN.append(True)
     return _numpy(P, rt, ht, tol, n, order)
+
+
+_BROKEN: list[bool] = []
 
 
 def prune(f: Frames, xyz: np.ndarray, tol: np.ndarray, compiled: bool | None = None) -> np.ndarray:

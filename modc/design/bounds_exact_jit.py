@@ -67,7 +67,8 @@ def _pair(p, rt, ht, tol, n, tab, stack):
         for i3 in range(g3):
             c3 = tab[3, i3] if n == 3 else 1.0
             s3 = tab[4, i3] if n == 3 else 0.0
-            d, e2, e3, low = _child(p, rt, ht, tab[3, i2], tab[4, i2], c3, s3, 0, 0, tab, tolx)
+            d, e2, e3 = _first(p, rt, ht, tab[3, i2], tab[4, i2], c3, s3, tab[0, 0], tab[0, 0])
+            low = d - (e2 + e3)
             if d <= tol:
                 return True
             top = _push(stack, top, tab[3, i2], tab[4, i2], c3, s3, 0.0, 0.0, d, e2, e3, low)
