@@ -10,7 +10,22 @@ import numpy as np
 
 from . import bounds_exact
 from .bounds_exact import GRID, LEVELS, MARGIN, SLACK, STEPS
-from .reach_jit import _inline, _jit, numba
+from .reach_jit import _CACHED, numba
+
+# sha256 of bounds_exact.py, whose box and newton (and constants) these kernels compile in: numba
+# keys a kernel's cache on its own file alone, so a change there must change this file too
+# (tests/test_design_bounds_exact.py checks it)
+SHARED = "b64757902c04837ffa0f6030e967f26f80cbd8490f9d8c77e3fc3d74b560bed2"
+
+
+def _jit(f):
+    # error_model="numpy": a float division by zero gives numpy's inf or nan (the numpy walk's
+    # answer), never an exception, and costs no check
+    return numba.njit(cache=_CACHED, nogil=True, error_model="numpy")(f) if numba is not None else f
+
+
+def _inline(f):
+    return numba.njit(cache=_CACHED, nogil=True, error_model="numpy", inline="always")(f) if numba is not None else f
 
 STACK = GRID * GRID + 2 * (2 * LEVELS + 2)  # depth first: a level leaves at most one sibling behind
 
