@@ -64,8 +64,8 @@ SLACK = 1e-9  # m: rounding never excludes a target at the edge of its tolerance
 GRID = 2  # initial boxes per angle (2 to 8 measured: 2 and 3 the fastest)
 LEVELS = 24  # splits per angle at most (pi / GRID / 2^24: far below MARGIN for any real arm)
 STEPS = 6  # Gauss-Newton steps of the witness search (newton)
-SAMPLE = 8  # prune: every SAMPLE-th setting of a block tested first
-PAYS = 0.5  # prune: the rest too when the sample has at least this share out of reach
+SAMPLE = 16  # prune: every SAMPLE-th setting of a block tested first
+PAYS = 0.6  # prune: the rest too when the sample has at least this share out of reach
 
 
 def tables() -> np.ndarray:
