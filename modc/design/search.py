@@ -1,16 +1,17 @@
 """The twist search of one shape: every pivot and port setting, in blocks.
 
 Complete within its bounds: every setting of a shape is either screened (batched IK per target
-within the joint limits, then the obstacle screen) or excluded by a sound bound - whole
-families of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free),
-then setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0
-within tolerance of some target, or meets its orientation with its position - bounds.posed,
-first). Exact reductions (modc.design.space) remove settings that
-cannot change tool0. A shape whose families left alive hold more than dominance.FIRST settings
-is searched level by level - fewest nonzero twists first - and closed by a dominance bound as
-soon as its kept settings cannot be beaten by any setting left (modc.design.dominance); only
-when the levels listed would pass COMPLETE settings are the levels left searched on a
-deterministic coarse grid of its twists, and the shape reported as not complete.
+within the joint limits, then the obstacle screen) or excluded by a sound bound - whole families
+of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free), then
+setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0 within
+tolerance of some target, or meets its orientation with its position - bounds.posed, first; for
+2- and 3-joint chains modc.design.bounds_exact decides it to within 0.5 mm). Exact reductions
+(modc.design.space) remove settings that cannot change tool0. A shape whose families left alive
+hold more than dominance.FIRST settings is searched level by level - fewest nonzero twists first
+- and closed by a dominance bound as soon as its kept settings cannot be beaten by any setting
+left (modc.design.dominance); only when the levels listed would pass COMPLETE settings are the
+levels left searched on a deterministic coarse grid of its twists, and the shape reported as not
+complete.
 
 A shape's settings are numbered unit by unit (unit 1's pivot outermost, then its port, unit 2's
 pivot, …); a unit of work is a range of those numbers (WORK settings), so a large shape spreads
@@ -32,7 +33,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..kinematics import transform
-from . import bounds, dominance, prefix
+from . import bounds, bounds_exact, dominance, prefix
 from .batch import geometry
 from .evaluate import Spec, screen_batch
 from .settings import COARSE, Axes, axes, coarse_axes, full_axes, settings_at
@@ -42,6 +43,7 @@ COMPLETE = 2_000_000  # settings of a shape searched in full up to this many
 BLOCK = 4096  # settings screened together (numpy amortisation)
 WORK = 65536  # settings per unit of work
 ORIENTED = True  # the orientation bounds (bounds.posed) screen settings before the IK (off: tests compare)
+EXACT = True  # 2- and 3-joint chains: the exact reach test (bounds_exact) after bounds.possible (off: tests compare)
 KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
 
 STOP = threading.Event()  # set by Ctrl-C in this process: blocks end at the next boundary
@@ -292,6 +294,8 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         ok = bounds.posed(f, tg, every=True) if ORIENTED and tg.oriented.any() else np.ones(len(piv), bool)
         if ok.any():
             ok[ok] = bounds.possible(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p).all(-1)
+        if EXACT and shape.n in (2, 3) and ok.any():  # most settings the interval bounds keep miss a target
+            ok[ok] = bounds_exact.prune(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p)
         excluded += int((~ok).sum())
         upto = end
         for tick in TICK:
