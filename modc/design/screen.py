@@ -174,14 +174,14 @@ def escape(obstacles: Obstacles, frames: np.ndarray, radii: np.ndarray,
     aa = a[r_i, n_i, s_i]
     pts = aa[:, None, :] + (b[r_i, n_i, s_i] - aa)[:, None, :] * ts[:, None]  # (M, m, 3)
     rad = radii[s_i]
-    d = np.full((len(r_i), m, K), np.inf)
+    by_k = np.full((len(r_i), m, K), np.inf)
     live = pair[r_i, n_i, s_i]  # (M, K)
     for k in range(K):
         rows = np.flatnonzero(live[:, k])
         if rows.size:
-            d[rows, :, k] = (obstacles._one(k, int(obstacles.shape[k]), pts[rows].reshape(-1, 3)).reshape(-1, m)
-                             - rad[rows][:, None])
-    d = d.reshape(len(r_i), m * K)
+            by_k[rows, :, k] = (obstacles._one(k, int(obstacles.shape[k]), pts[rows].reshape(-1, 3)).reshape(-1, m)
+                                - rad[rows][:, None])
+    d = by_k.reshape(len(r_i), m * K)
     first = d.argmin(1)
     low = d[np.arange(len(r_i)), first]
     starts = np.flatnonzero(np.r_[True, r_i[1:] != r_i[:-1]])
