@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..kinematics import transform
-from . import bounds, bounds_exact, dominance, prefix
+from . import bounds, bounds_exact, bounds_tilt, dominance, prefix
 from .batch import geometry
 from .evaluate import Spec, screen_batch
 from .settings import COARSE, Axes, axes, coarse_axes, full_axes, settings_at
@@ -43,6 +43,7 @@ COMPLETE = 2_000_000  # settings of a shape searched in full up to this many
 BLOCK = 4096  # settings screened together (numpy amortisation)
 WORK = 65536  # settings per unit of work
 ORIENTED = True  # the orientation bounds (bounds.posed) screen settings before the IK (off: tests compare)
+TILTED = True  # 2- and 3-joint chains, oriented targets: position and tilt at once (bounds_tilt; off: tests compare)
 EXACT = True  # 2- and 3-joint chains: the exact reach test (bounds_exact) after bounds.possible (off: tests compare)
 KEEP = 6  # feasible twist settings kept per shape (deepest inside the tolerances, then simplest)
 
@@ -289,13 +290,7 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         end = min(start + BLOCK, hi)
         piv, por = settings_at(ax, shape.n, numbers[start:end])
         g = geometry(types, piv, por, links, tool.xyz, tool.rpy)
-        f = bounds.frames(g)
-        # the orientation bounds first where they apply: cheaper per setting, and most settings fail them
-        ok = bounds.posed(f, tg, every=True) if ORIENTED and tg.oriented.any() else np.ones(len(piv), bool)
-        if ok.any():
-            ok[ok] = bounds.possible(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p).all(-1)
-        if EXACT and shape.n in (2, 3) and ok.any():  # most settings the interval bounds keep miss a target
-            ok[ok] = bounds_exact.prune(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p)
+        ok = _bounded(bounds.frames(g), tg, shape.n)
         excluded += int((~ok).sum())
         upto = end
         for tick in TICK:
@@ -316,6 +311,20 @@ def search_part(spec: Spec, shape: Shape, ranges: tuple[tuple[int, int], ...], s
         found = _keep(found, s, piv[k], por[k])
     return Part(shape, lo, hi, upto, tuple(found), screened, excluded, tuple(float(x) for x in closest),
                 tuple(bool(x) for x in hit), tuple(bool(x) for x in clear), full)
+
+
+def _bounded(f: bounds.Frames, tg, n: int) -> np.ndarray:
+    """(C,) the settings of f no sound bound rules out for the targets tg, cheapest tests first."""
+    # the orientation bounds first where they apply: cheaper per setting, and most settings fail them
+    ok = bounds.posed(f, tg, every=True) if ORIENTED and tg.oriented.any() else np.ones(len(f.t), bool)
+    if ok.any():
+        ok[ok] = bounds.possible(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p).all(-1)
+    if EXACT and n in (2, 3) and ok.any():  # most settings the interval bounds keep miss a target
+        ok[ok] = bounds_exact.prune(bounds.Frames(f.R[ok], f.t[ok]), tg.xyz, tg.tol_p)
+    if TILTED and ORIENTED and n in (2, 3) and tg.oriented.any() and ok.any():
+        # position and orientation at one joint vector: a 3-joint arm points its tool down only on a band
+        ok[ok] = bounds_tilt.posed(bounds.Frames(f.R[ok], f.t[ok]), tg, np.flatnonzero(tg.oriented))
+    return ok
 
 
 def _keep(found: list[Found], s, piv: np.ndarray, por: np.ndarray) -> list[Found]:
