@@ -255,7 +255,7 @@ def _test(lv: list[Level], R: np.ndarray, t: np.ndarray, mask: np.ndarray, picke
     each set's spread targets (picked) and orientations (keys) leave alive."""
     mask &= bounds.possible_all(bounds.Frames(R, t), np.concatenate([x for x, _ in picked]),
                                 np.concatenate([tl for _, tl in picked]), tail,
-                                np.cumsum([0] + [len(x) for x, _ in picked[:-1]]))
+                                np.cumsum([0] + [len(x) for x, _ in picked[:-1]]), mask)
     for j, k in enumerate(keys):
         if k is not None:
             rows = np.flatnonzero(mask[:, j])
