@@ -177,10 +177,10 @@ def possible_all(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float,
                  starts: np.ndarray | None = None, mask: np.ndarray | None = None) -> np.ndarray:
     """(C, G): possible(f, xyz, tol, tail)[:, group].all(-1) for each group of targets (the groups
     start at `starts`, in order; None: one group, every target), and False where mask (C, G), if
-    given, is. D_1 first, for every row: most rows fail it for some target of every group (9 in
-    10 of a refine's families); then each group's targets only on the rows still alive for that
-    group (a base grid's family is alive at a few of its poses: the others' targets are not
-    tested). Each test is row by row and target by target, so a row gets the same bits - and
+    given, is. Group by group, on the rows the mask leaves for it (a base grid's family is alive
+    at a few of its poses: the others' targets are not tested): D_1 first (most rows fail it for
+    some target: 9 in 10 of a refine's families), then every test on the rows still alive. Each
+    test is row by row and target by target, so a row gets the same bits - and
     rows go ELEMENTS // targets at a time (a refine's 1.6 M families against a base grid's 300
     targets would take gigabytes per temporary array)."""
     step = max(1, ELEMENTS // max(len(xyz), 1))
@@ -190,18 +190,18 @@ def possible_all(f: Frames, xyz: np.ndarray, tol: np.ndarray, tail: tuple[float,
                                for a in range(0, len(f.t), step)])
     starts = np.zeros(1, np.int64) if starts is None else np.asarray(starts, np.int64)
     lo, hi = _reach(f, 1, tail)
-    d1 = _norm(xyz[None] - f.t[:, 0][:, None])
-    tl = tol[None] + 1e-9
-    alive = np.logical_and.reduceat((d1 <= hi[:, None] + tl) & (d1 >= lo[:, None] - tl), starts, axis=1)
-    if mask is not None:
-        alive &= mask
-    if not alive.any() or f.t.shape[1] < 2:
-        return alive
-    out = np.zeros_like(alive)
+    out = np.zeros((len(f.t), len(starts)), bool)
     ends = np.r_[starts[1:], len(xyz)]
     for g, (a, b) in enumerate(zip(starts, ends, strict=True)):
-        rows = np.flatnonzero(alive[:, g])
-        if rows.size:
+        rows = np.arange(len(f.t)) if mask is None else np.flatnonzero(mask[:, g])
+        if not rows.size:
+            continue
+        d1 = _norm(xyz[a:b][None] - f.t[rows, 0][:, None])
+        tl = tol[a:b][None] + 1e-9
+        rows = rows[((d1 <= hi[rows, None] + tl) & (d1 >= lo[rows, None] - tl)).all(1)]
+        if rows.size and f.t.shape[1] < 2:
+            out[rows, g] = True
+        elif rows.size:
             out[rows, g] = possible(Frames(f.R[rows], f.t[rows]), xyz[a:b], tol[a:b], tail).all(-1)
     return out
 
