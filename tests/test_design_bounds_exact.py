@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import THREE_TARGETS
 
 from modc.compiler import check_text
 
@@ -192,15 +193,7 @@ def _problem(text: str):
     return checked.design.problems[0]
 
 
-CELL = """design bench {
-    payload 100 g
-    box shelf size (0.6, 0.4, 0.02) m at (0.3, 0, 0.05) m
-    box post size (0.05, 0.05, 0.6) m at (0.15, 0.3, 0.3) m
-    target a at (0.30, 0.10, 0.25) m
-    target b at (0.25, -0.15, 0.30) m
-    target c at (0.10, 0.30, 0.45) m
-    units 2 to 3
-"""
+CELL = THREE_TARGETS.removesuffix("}\n")  # the design benchmark's cell, its block left open
 
 
 def _ranking(o) -> list[tuple]:

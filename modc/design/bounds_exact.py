@@ -199,15 +199,19 @@ def _start(n: int, tab: np.ndarray) -> np.ndarray:
     return np.column_stack([tab[3, i2], tab[4, i2], c3, s3])
 
 
+def grid(K: int, n: int, tab: np.ndarray):
+    """The initial boxes of K pairs: their pairs, centres (cos, sin of both angles), levels."""
+    start = _start(n, tab)
+    pair = np.repeat(np.arange(K), len(start))
+    return pair, np.tile(start, (K, 1)), np.zeros(len(pair), np.int64), np.zeros(len(pair), np.int64)
+
+
 def _pairs_numpy(P: np.ndarray, rt: np.ndarray, ht: np.ndarray, tol: np.ndarray, n: int) -> np.ndarray:
     """(K,) the tree's answer for K pairs (P (K, 22), rt, ht, tol (K,)), level by level."""
     tab = tables()
     K = len(P)
     start = _start(n, tab)
-    pair = np.repeat(np.arange(K), len(start))
-    boxes = np.tile(start, (K, 1))
-    k2 = np.zeros(len(pair), np.int64)
-    k3 = np.zeros(len(pair), np.int64)
+    pair, boxes, k2, k3 = grid(K, n, tab)
     out = np.zeros(K, bool)
     tolx = tol + SLACK
     first = True
@@ -227,19 +231,24 @@ def _pairs_numpy(P: np.ndarray, rt: np.ndarray, ht: np.ndarray, tol: np.ndarray,
         out[pair[(d <= t) | ((low <= tolx[pair]) & ((e2 + e3 < MARGIN) | (k2 == LEVELS) | (k3 == LEVELS)))]] = True
         keep = ~out[pair] & (low <= tolx[pair])
         pair, boxes, k2, k3, e2, e3 = pair[keep], boxes[keep], k2[keep], k3[keep], e2[keep], e3[keep]
-        along3 = e3 > e2
-        pair = np.repeat(pair, 2)
-        boxes = np.repeat(boxes, 2, axis=0)
-        k2, k3, along3 = np.repeat(k2, 2), np.repeat(k3, 2), np.repeat(along3, 2)
-        sign = np.tile([1.0, -1.0], len(pair) // 2)
-        lv = np.where(along3, k3, k2) + 1
-        cd, sd = tab[1, lv], tab[2, lv] * sign
-        i = np.where(along3, 2, 0)
-        rows = np.arange(len(pair))
-        c, s = boxes[rows, i], boxes[rows, i + 1]
-        boxes[rows, i], boxes[rows, i + 1] = c * cd - s * sd, s * cd + c * sd
-        k2, k3 = np.where(along3, k2, lv), np.where(along3, lv, k3)
+        pair, boxes, k2, k3 = split(pair, boxes, k2, k3, e3 > e2, tab)
     return out
+
+
+def split(pair, boxes, k2, k3, along3, tab):
+    """Every box in two along theta_3 (along3) or theta_2: the pairs, centres (cos, sin of both
+    angles) and levels of the children, each box's two in a row."""
+    pair = np.repeat(pair, 2)
+    boxes = np.repeat(boxes, 2, axis=0)
+    k2, k3, along3 = np.repeat(k2, 2), np.repeat(k3, 2), np.repeat(along3, 2)
+    sign = np.tile([1.0, -1.0], len(pair) // 2)
+    lv = np.where(along3, k3, k2) + 1
+    cd, sd = tab[1, lv], tab[2, lv] * sign
+    i = np.where(along3, 2, 0)
+    rows = np.arange(len(pair))
+    c, s = boxes[rows, i], boxes[rows, i + 1]
+    boxes[rows, i], boxes[rows, i + 1] = c * cd - s * sd, s * cd + c * sd
+    return pair, boxes, np.where(along3, k2, lv), np.where(along3, lv, k3)
 
 
 def _numpy(P, rt, ht, tol, n, order) -> np.ndarray:

@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from .bounds import Frames
-from .bounds_exact import LEVELS, MARGIN, SLACK, _start, box, circles, params, tables
+from .bounds_exact import LEVELS, MARGIN, SLACK, box, circles, grid, params, split, tables
 
 TILT_MARGIN = 1e-2  # rad: a box whose tilt bound is finer than this is not split for it
 TILT_SLACK = 1e-9  # rad: rounding never excludes a target at the edge of its tolerance
@@ -80,11 +80,7 @@ def _pairs(P: np.ndarray, Qs: list[np.ndarray], rt, ht, tilts: list[np.ndarray],
     Qs per vector (K, 12), rt, ht (K,), tilts per vector the target's tilt (K,)."""
     tab = tables()
     K = len(P)
-    start = _start(n, tab)
-    pair = np.repeat(np.arange(K), len(start))
-    boxes = np.tile(start, (K, 1))
-    k2 = np.zeros(len(pair), np.int64)
-    k3 = np.zeros(len(pair), np.int64)
+    pair, boxes, k2, k3 = grid(K, n, tab)
     out = np.zeros(K, bool)
     first = True
     while len(pair):
@@ -106,17 +102,7 @@ def _pairs(P: np.ndarray, Qs: list[np.ndarray], rt, ht, tilts: list[np.ndarray],
         pair, boxes, k2, k3 = pair[keep], boxes[keep], k2[keep], k3[keep]
         e2, e3, h2, h3 = e2[keep], e3[keep], h2[keep], h3[keep]
         along3 = (e3 / MARGIN + h3 / TILT_MARGIN > e2 / MARGIN + h2 / TILT_MARGIN) & (n == 3)
-        pair = np.repeat(pair, 2)
-        boxes = np.repeat(boxes, 2, axis=0)
-        k2, k3, along3 = np.repeat(k2, 2), np.repeat(k3, 2), np.repeat(along3, 2)
-        sign = np.tile([1.0, -1.0], len(pair) // 2)
-        lv = np.where(along3, k3, k2) + 1
-        cd, sd = tab[1, lv], tab[2, lv] * sign
-        i = np.where(along3, 2, 0)
-        rows = np.arange(len(pair))
-        c, s = boxes[rows, i], boxes[rows, i + 1]
-        boxes[rows, i], boxes[rows, i + 1] = c * cd - s * sd, s * cd + c * sd
-        k2, k3 = np.where(along3, k2, lv), np.where(along3, lv, k3)
+        pair, boxes, k2, k3 = split(pair, boxes, k2, k3, along3, tab)
     return out
 
 

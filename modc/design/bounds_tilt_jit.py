@@ -15,7 +15,7 @@ from .reach_jit import _CACHED, numba
 
 # sha256 of bounds_exact.py, whose box (and constants) this kernel compiles in: numba keys a
 # kernel's cache on its own file alone (tests/test_design_bounds_tilt.py checks it)
-SHARED = "323d771dd46cf781b72626f29f975dd84d9070591e656b91c53ee3324e697b4e"
+SHARED = "94e0b1d924c251a89202696da50b87b355d0b3ea3c266d0751ec901844b37903"
 TILT_MARGIN = 1e-2  # bounds_tilt's (tests check they agree)
 TILT_SLACK = 1e-9
 STACK = GRID * GRID + 4 * (LEVELS + 1) + 4
