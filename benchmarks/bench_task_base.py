@@ -24,6 +24,13 @@ pinned core:
     visit             4.0 s (0.1 s)        5.9 s (2.5 s)          1.49 (16.8)
     region           10.6 s (1.2 s)       27.7 s (17.9 s)         2.61 (15.4)
 
+The same on the final tree of that session (27 Nov 2026 ~15:10 UTC, load 2-3, a test run
+beside it: the exact reach and pose tests, the family bounds per pose):
+
+    visit             3.8 s (0.1 s)        3.8 s (0.9 s)          1.00 (12.6)
+    region           10.2 s (0.7 s)       15.4 s (7.3 s)          1.50 (10.0)
+    static cell       0.15-0.2 s           1.3-1.6 s              8-10 (--static-only, four runs)
+
 Planning and timing the candidates dominates a task cell and does not grow with the grid (the
 same number of candidates is planned), so the design as a whole meets the goal; the static
 search alone grows about as the static cell below does.
