@@ -150,11 +150,14 @@ def posed(f: Frames, tg, idx: np.ndarray, compiled: bool | None = None) -> np.nd
         from . import reach
 
         compiled = reach.jit(C * len(idx))
-    if compiled:
-        from . import bounds_tilt_jit
+    if compiled and not _BROKEN:
+        try:
+            from . import bounds_tilt_jit
 
-        if bounds_tilt_jit.numba is not None:
-            return bounds_tilt_jit.posed(P, Qa, Qb, nv, rt, ht, ta, tb, tol, eps, n, order, tables())
+            if bounds_tilt_jit.numba is not None:
+                return bounds_tilt_jit.posed(P, Qa, Qb, nv, rt, ht, ta, tb, tol, eps, n, order, tables())
+        except Exception:  # noqa: BLE001 - a numba that cannot compile the kernel: the numpy walk, same answer
+            _BROKEN.append(True)
     alive = np.arange(C)
     for i in order:
         if alive.size == 0:
@@ -166,5 +169,7 @@ def posed(f: Frames, tg, idx: np.ndarray, compiled: bool | None = None) -> np.nd
     out[alive] = True
     return out
 
+
+_BROKEN: list[bool] = []
 
 __all__ = ["posed"]
