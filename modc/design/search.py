@@ -5,7 +5,8 @@ within the joint limits, then the obstacle screen) or excluded by a sound bound 
 of settings at once (modc.design.prefix: a prefix of the chain fixed, the rest free), then
 setting by setting (modc.design.bounds: no joint vector, limits or not, brings tool0 within
 tolerance of some target, or meets its orientation with its position - bounds.posed, first; for
-2- and 3-joint chains modc.design.bounds_exact decides it to within 0.5 mm). Exact reductions
+2- and 3-joint chains modc.design.bounds_exact decides the position to within 0.5 mm, and
+modc.design.bounds_tilt the position and an orientation's tilt at one joint vector). Exact reductions
 (modc.design.space) remove settings that cannot change tool0. A shape whose families left alive
 hold more than dominance.FIRST settings is searched level by level - fewest nonzero twists first
 - and closed by a dominance bound as soon as its kept settings cannot be beaten by any setting
