@@ -47,16 +47,17 @@ def _judge(p, Qa, Qb, nv, rt, ht, ta, tb, tol, eps, n, tab, c2, s2, c3, s3, k2, 
     centre (>= 0, the box to split) and its bound terms."""
     h2 = tab[5, k2]
     h3 = tab[5, k3] if n == 3 else 0.0
+    # the tilt first: cheaper than the position's bounds, and a box it excludes needs no more
+    # (the same decision: a box is excluded when either excludes it)
+    dev = abs(_tilt(Qa, c2, s2, c3, s3) - ta)
+    dev2 = abs(_tilt(Qb, c2, s2, c3, s3) - tb) if nv == 2 else 0.0
+    if dev - (h2 + h3) > eps + TILT_SLACK or dev2 - (h2 + h3) > eps + TILT_SLACK:
+        return -1, 0.0, 0.0, 0.0, h2, h3
     d, e2, e3, low = _box(p, rt, ht, c2, s2, c3, s3, tab[0, k2], tab[0, k3], h2, h3)
     if k2 == 0 and k3 == 0:  # the grid's boxes: the first-order bound alone
         low = d - (e2 + e3)
-    dev = abs(_tilt(Qa, c2, s2, c3, s3) - ta)
-    met = d <= tol and dev <= eps
-    out = low > tol + SLACK or dev - (h2 + h3) > eps + TILT_SLACK
-    if nv == 2:
-        dev2 = abs(_tilt(Qb, c2, s2, c3, s3) - tb)
-        met = met and dev2 <= eps
-        out = out or dev2 - (h2 + h3) > eps + TILT_SLACK
+    met = d <= tol and dev <= eps and dev2 <= eps
+    out = low > tol + SLACK
     fine = (e2 + e3 < MARGIN and h2 + h3 < TILT_MARGIN) or k2 == LEVELS or k3 == LEVELS
     if met or (not out and fine):
         return 1, d, e2, e3, h2, h3
